@@ -1,0 +1,5 @@
+"""python -m service -> the CLI."""
+
+from .cli import main
+
+raise SystemExit(main())

@@ -1,0 +1,134 @@
+"""Bodies as loaded: frozen, validated once, coordinates in the file's length unit.
+
+Coordinates stay exactly as read (float32 STL values widen exactly to
+float64); ``length_scale`` (metres per file unit) is applied to the results,
+not to the coordinates, so a unit conversion never perturbs the polyhedron.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+from numpy.typing import NDArray
+
+from .errors import EmptyGeometryError, InvalidParameterError
+
+__all__ = ["MeshBody", "VolumeBody", "PointBody", "Part", "Body"]
+
+
+def _frozen(arr: NDArray, dtype: type) -> NDArray:  # type: ignore[type-arg]
+    out = np.ascontiguousarray(arr, dtype=dtype)
+    out.flags.writeable = False
+    return out
+
+
+def _check_finite(name: str, arr: NDArray[np.float64]) -> None:
+    if not np.all(np.isfinite(arr)):
+        bad = int(np.count_nonzero(~np.isfinite(arr)))
+        raise InvalidParameterError(
+            f"{name} contain {bad} non-finite value(s) (NaN or infinity); fix the input", field=name
+        )
+
+
+@dataclass(frozen=True, slots=True)
+class MeshBody:
+    """A triangle surface.
+
+    vertices : (n, 3) float64, file units.  faces : (m, 3) int64 indices.
+    """
+
+    vertices: NDArray[np.float64]
+    faces: NDArray[np.int64]
+    length_scale: float = 1.0
+    name: str | None = None
+    warnings: tuple[str, ...] = ()
+
+    def __post_init__(self) -> None:
+        v = _frozen(self.vertices, np.float64)
+        f = _frozen(self.faces, np.int64)
+        if v.ndim != 2 or v.shape[1] != 3 or f.ndim != 2 or f.shape[1] != 3:
+            raise ValueError("vertices must be (n, 3) and faces (m, 3)")
+        if len(f) == 0 or len(v) == 0:
+            raise EmptyGeometryError("the mesh has no triangles; send a file that holds geometry")
+        _check_finite("vertex coordinates", v)
+        if f.min() < 0 or f.max() >= len(v):
+            raise InvalidParameterError("a face refers to a vertex that does not exist; the file is corrupt")
+        object.__setattr__(self, "vertices", v)
+        object.__setattr__(self, "faces", f)
+
+
+@dataclass(frozen=True, slots=True)
+class VolumeBody:
+    """Tetrahedra (other cells already split into tetrahedra).
+
+    points : (n, 3) float64, file units.  tets : (k, 4) int64.
+    cell_density : (k,) float64 kg/m^3 per tetrahedron, or None (uniform).
+    """
+
+    points: NDArray[np.float64]
+    tets: NDArray[np.int64]
+    cell_density: NDArray[np.float64] | None = None
+    length_scale: float = 1.0
+    name: str | None = None
+    warnings: tuple[str, ...] = ()
+
+    def __post_init__(self) -> None:
+        p = _frozen(self.points, np.float64)
+        t = _frozen(self.tets, np.int64)
+        if p.ndim != 2 or p.shape[1] != 3 or t.ndim != 2 or t.shape[1] != 4:
+            raise ValueError("points must be (n, 3) and tets (k, 4)")
+        if len(t) == 0:
+            raise EmptyGeometryError("the volume mesh has no 3-D cells; send tetrahedra, hexahedra, wedges or pyramids")
+        _check_finite("point coordinates", p)
+        if t.min() < 0 or t.max() >= len(p):
+            raise InvalidParameterError("a cell refers to a point that does not exist; the file is corrupt")
+        object.__setattr__(self, "points", p)
+        object.__setattr__(self, "tets", t)
+        if self.cell_density is not None:
+            rho = _frozen(self.cell_density, np.float64)
+            if rho.shape != (len(t),):
+                raise ValueError("cell_density needs one value per tetrahedron")
+            _check_finite("cell densities", rho)
+            if np.any(rho <= 0):
+                raise InvalidParameterError("cell densities must be positive (kg/m^3)", field="density")
+            object.__setattr__(self, "cell_density", rho)
+
+
+@dataclass(frozen=True, slots=True)
+class PointBody:
+    """Point masses.  masses : (n,) kg.  positions : (n, 3), file units."""
+
+    masses: NDArray[np.float64]
+    positions: NDArray[np.float64]
+    length_scale: float = 1.0
+    name: str | None = None
+    warnings: tuple[str, ...] = ()
+
+    def __post_init__(self) -> None:
+        m = _frozen(self.masses, np.float64)
+        x = _frozen(self.positions, np.float64)
+        if m.ndim != 1 or x.shape != (len(m), 3):
+            raise InvalidParameterError("each point needs a mass and a 3-component position")
+        if len(m) == 0:
+            raise EmptyGeometryError("no points were given; send at least one point mass")
+        _check_finite("masses", m)
+        _check_finite("positions", x)
+        if np.any(m <= 0):
+            raise InvalidParameterError(
+                f"masses must be positive; {int(np.count_nonzero(m <= 0))} are zero or negative", field="mass"
+            )
+        object.__setattr__(self, "masses", m)
+        object.__setattr__(self, "positions", x)
+
+
+Body = MeshBody | VolumeBody | PointBody
+
+
+@dataclass(frozen=True, slots=True)
+class Part:
+    """One named body of a scene or assembly, already placed in the scene frame."""
+
+    name: str
+    body: Body
+    extras: dict[str, object] = field(default_factory=dict)

@@ -1,0 +1,102 @@
+"""Conventions stated once: units, frames, axis order and the eigenvector sign rule.
+
+- Inside the service everything is SI: metres, kilograms, seconds, radians,
+  kg m^2 for inertia.  Lengths in other units are converted at the edge.
+- The *input frame* is the frame of the uploaded coordinates.  The *principal*
+  (body) frame has its axes along the principal axes of inertia, ordered by
+  ascending moment (I1 <= I2 <= I3).
+- Principal axes are the rows of a 3x3 matrix ``axes``; ``axes.T`` maps
+  principal-frame components to input-frame components.  The frame is
+  right-handed (det = +1).
+- Sign rule: the component of largest magnitude of axes 1 and 2 is positive
+  (the first such component on an exact tie); axis 3 = axis 1 x axis 2.
+- Quaternions are [w, x, y, z] with w >= 0 (scalar first, as in the contract).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import NDArray
+
+__all__ = [
+    "LENGTH_UNITS",
+    "length_scale",
+    "orient_axes",
+    "quaternion_from_matrix",
+    "matrix_from_quaternion",
+]
+
+LENGTH_UNITS: dict[str, float] = {
+    "m": 1.0,
+    "cm": 1e-2,
+    "mm": 1e-3,
+    "um": 1e-6,
+    "in": 0.0254,  # exact by the 1959 international yard and pound agreement
+    "ft": 0.3048,
+}
+
+
+def length_scale(unit: str) -> float:
+    """Metres per unit of ``unit``; raises ``InvalidParameterError`` when unknown."""
+    from .errors import InvalidParameterError
+
+    try:
+        return LENGTH_UNITS[unit]
+    except KeyError:
+        known = ", ".join(LENGTH_UNITS)
+        raise InvalidParameterError(
+            f"unknown length unit {unit!r}; use one of {known}", parameter="units"
+        ) from None
+
+
+def orient_axes(axes: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Apply the sign rule to unit axes given as rows; returns a new array."""
+    out = np.array(axes, dtype=np.float64)
+    for i in (0, 1):
+        k = int(np.argmax(np.abs(out[i])))  # argmax returns the first maximum
+        if out[i, k] < 0:
+            out[i] = -out[i]
+    out[2] = np.cross(out[0], out[1])
+    out[2] /= np.linalg.norm(out[2])
+    return out
+
+
+def quaternion_from_matrix(matrix: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Unit quaternion [w, x, y, z] (w >= 0) of a proper rotation matrix.
+
+    Shepperd's method (J. Guidance and Control 1, 1978): pick the largest of
+    the four squared components to divide by, so no step loses precision.
+    """
+    m = np.asarray(matrix, dtype=np.float64)
+    trace = m[0, 0] + m[1, 1] + m[2, 2]
+    candidates = (trace, m[0, 0], m[1, 1], m[2, 2])
+    k = int(np.argmax(candidates))
+    if k == 0:
+        s = 2.0 * np.sqrt(1.0 + trace)
+        q = [0.25 * s, (m[2, 1] - m[1, 2]) / s, (m[0, 2] - m[2, 0]) / s, (m[1, 0] - m[0, 1]) / s]
+    elif k == 1:
+        s = 2.0 * np.sqrt(1.0 + m[0, 0] - m[1, 1] - m[2, 2])
+        q = [(m[2, 1] - m[1, 2]) / s, 0.25 * s, (m[0, 1] + m[1, 0]) / s, (m[0, 2] + m[2, 0]) / s]
+    elif k == 2:
+        s = 2.0 * np.sqrt(1.0 - m[0, 0] + m[1, 1] - m[2, 2])
+        q = [(m[0, 2] - m[2, 0]) / s, (m[0, 1] + m[1, 0]) / s, 0.25 * s, (m[1, 2] + m[2, 1]) / s]
+    else:
+        s = 2.0 * np.sqrt(1.0 - m[0, 0] - m[1, 1] + m[2, 2])
+        q = [(m[1, 0] - m[0, 1]) / s, (m[0, 2] + m[2, 0]) / s, (m[1, 2] + m[2, 1]) / s, 0.25 * s]
+    quat = np.array(q, dtype=np.float64)
+    quat /= np.linalg.norm(quat)
+    if quat[0] < 0:
+        quat = -quat
+    return quat
+
+
+def matrix_from_quaternion(quaternion: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Rotation matrix of a unit quaternion [w, x, y, z]."""
+    w, x, y, z = np.asarray(quaternion, dtype=np.float64)
+    return np.array(
+        [
+            [1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
+            [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
+            [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)],
+        ]
+    )

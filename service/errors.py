@@ -1,0 +1,104 @@
+"""One hierarchy of errors, each carrying its API error code.
+
+Every failure the service can explain is a :class:`ServiceError`.  The HTTP
+layer (``service.api.errors``) maps classes to status codes and the CLI maps
+them to exit codes; nothing else needs to know about transports.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+__all__ = [
+    "ServiceError",
+    "LoadError",
+    "UnsupportedFormatError",
+    "UnreadableFileError",
+    "EmptyGeometryError",
+    "InvalidMeshError",
+    "NotWatertightError",
+    "DegenerateBodyError",
+    "ZeroVolumeError",
+    "InvalidParameterError",
+    "MotionError",
+    "PayloadTooLargeError",
+    "ComputeTimeoutError",
+    "UnauthorizedError",
+]
+
+
+class ServiceError(Exception):
+    """Base of every error the service reports to a client.
+
+    ``code`` is the snake_case API error code; ``message`` is one sentence a
+    person can act on; ``details`` are machine-readable extras.
+    """
+
+    code: str = "internal_error"
+
+    def __init__(self, message: str, **details: Any) -> None:
+        super().__init__(message)
+        self.message = message
+        self.details = details
+
+    def as_dict(self) -> dict[str, Any]:
+        """The error envelope of the API contract."""
+        return {"error": {"code": self.code, "message": self.message, "details": self.details}}
+
+
+class LoadError(ServiceError):
+    """The input could not be turned into a body."""
+
+    code = "unreadable_file"
+
+
+class UnsupportedFormatError(LoadError):
+    code = "unsupported_format"
+
+
+class UnreadableFileError(LoadError):
+    code = "unreadable_file"
+
+
+class EmptyGeometryError(LoadError):
+    code = "empty_geometry"
+
+
+class InvalidMeshError(ServiceError):
+    """The mesh was read but does not bound a solid."""
+
+    code = "not_watertight"
+
+
+class NotWatertightError(InvalidMeshError):
+    code = "not_watertight"
+
+
+class DegenerateBodyError(ServiceError):
+    code = "zero_volume"
+
+
+class ZeroVolumeError(DegenerateBodyError):
+    code = "zero_volume"
+
+
+class InvalidParameterError(ServiceError):
+    code = "invalid_parameter"
+
+
+class MotionError(InvalidParameterError):
+    """The motion cannot be predicted for these inputs."""
+
+    code = "invalid_parameter"
+
+
+class PayloadTooLargeError(ServiceError):
+    code = "payload_too_large"
+
+
+class ComputeTimeoutError(ServiceError):
+    code = "timeout"
+
+
+class UnauthorizedError(ServiceError):
+    code = "unauthorized"

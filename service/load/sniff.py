@@ -1,0 +1,74 @@
+"""Format detection: the explicit ``format`` wins, then the file name, then content."""
+
+from __future__ import annotations
+
+from ..errors import UnsupportedFormatError
+
+__all__ = ["SURFACE_FORMATS", "VOLUME_FORMATS", "SCENE_FORMATS", "POINT_FORMATS", "sniff_format", "FORMATS"]
+
+# surface meshes read through our STL reader or trimesh
+SURFACE_FORMATS = ("stl", "obj", "ply", "off", "glb", "gltf", "3mf")
+# volume meshes read through meshio (extension -> meshio file_format)
+VOLUME_FORMATS = {
+    "vtu": "vtu",
+    "vtk": "vtk",
+    "msh": "gmsh",
+    "mesh": "medit",
+    "inp": "abaqus",
+    "xdmf": "xdmf",
+    "med": "med",
+    "f3grid": "flac3d",
+    "dat": "tecplot",
+    "ugrid": "ugrid",
+    "ele": "tetgen",
+}
+# formats that can hold several named bodies
+SCENE_FORMATS = ("glb", "gltf", "3mf", "obj", "vtu", "vtk", "msh", "mesh", "inp", "xdmf", "med")
+POINT_FORMATS = ("json", "csv")
+FORMATS = SURFACE_FORMATS + tuple(VOLUME_FORMATS)
+
+_ALIASES = {"gmsh": "msh", "stla": "stl", "stlb": "stl", "ascii_stl": "stl"}
+
+
+def sniff_format(filename: str | None, declared: str | None, head: bytes = b"") -> str:
+    """The format key of an input, or ``UnsupportedFormatError``."""
+    if declared:
+        fmt = _ALIASES.get(declared.lower().lstrip("."), declared.lower().lstrip("."))
+        if fmt not in FORMATS and fmt not in POINT_FORMATS:
+            raise UnsupportedFormatError(
+                f"format {declared!r} is not supported; readable formats are {', '.join(FORMATS)}",
+                format=declared,
+            )
+        return fmt
+    if filename and "." in filename:
+        ext = filename.rsplit(".", 1)[1].lower()
+        ext = _ALIASES.get(ext, ext)
+        if ext in FORMATS or ext in POINT_FORMATS:
+            return ext
+        raise UnsupportedFormatError(
+            f"cannot read files ending in .{ext}; readable formats are {', '.join(FORMATS)} "
+            "(or pass format=... if the name is misleading)",
+            format=ext,
+        )
+    guessed = _from_content(head)
+    if guessed:
+        return guessed
+    raise UnsupportedFormatError(
+        "cannot tell the file's format from its name; pass format=stl (or obj, ply, ...)", filename=filename
+    )
+
+
+def _from_content(head: bytes) -> str | None:
+    if head.startswith(b"glTF"):
+        return "glb"
+    if head.startswith(b"ply"):
+        return "ply"
+    if head.startswith(b"OFF"):
+        return "off"
+    if head.startswith(b"$MeshFormat"):
+        return "msh"
+    if head.lstrip().startswith(b"solid"):
+        return "stl"
+    if b"<VTKFile" in head[:200]:
+        return "vtu"
+    return None

@@ -1,0 +1,59 @@
+"""STL reader: binary straight into a numpy array, ASCII by token scan.
+
+Binary STL (80-byte header, uint32 count, 50-byte records of normal, three
+float32 vertices and a uint16 attribute) is viewed with a structured dtype,
+no per-triangle Python.  Normals are ignored: the winding defines the
+orientation.  Vertices are returned unwelded (3 per triangle, float32 values
+widened exactly to float64); ``topology.weld`` merges them.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ..errors import EmptyGeometryError, UnreadableFileError
+
+__all__ = ["read_stl"]
+
+_RECORD = np.dtype([("normal", "<f4", (3,)), ("vertices", "<f4", (3, 3)), ("attr", "<u2")])
+
+
+def read_stl(data: bytes | memoryview) -> tuple[NDArray[np.float64], NDArray[np.int64]]:
+    """Vertices (3n, 3) and faces (n, 3) of a binary or ASCII STL file."""
+    buf = memoryview(data)
+    if len(buf) >= 84:
+        count = int(np.frombuffer(buf[80:84], dtype="<u4")[0])
+        if 84 + 50 * count == len(buf):
+            return _binary(buf, count)
+    head = bytes(buf[:512]).lstrip()
+    if head.startswith(b"solid"):
+        return _ascii(bytes(buf))
+    raise UnreadableFileError(
+        "the STL file is neither ASCII (starting with 'solid') nor binary of consistent length; "
+        "it may be truncated"
+    )
+
+
+def _binary(buf: memoryview, count: int) -> tuple[NDArray[np.float64], NDArray[np.int64]]:
+    if count == 0:
+        raise EmptyGeometryError("the STL file holds no triangles")
+    records = np.frombuffer(buf, dtype=_RECORD, count=count, offset=84)
+    vertices = records["vertices"].reshape(-1, 3).astype(np.float64)
+    return vertices, np.arange(3 * count, dtype=np.int64).reshape(-1, 3)
+
+
+def _ascii(data: bytes) -> tuple[NDArray[np.float64], NDArray[np.int64]]:
+    tokens = data.split()
+    idx = [i for i, tok in enumerate(tokens) if tok == b"vertex"]
+    if not idx:
+        if b"facet" in data:
+            raise UnreadableFileError("the ASCII STL file has facets without vertices; it is corrupt")
+        raise EmptyGeometryError("the STL file holds no triangles")
+    if len(idx) % 3:
+        raise UnreadableFileError("the ASCII STL file has a facet without exactly three vertices")
+    try:
+        coords = np.array([[float(tokens[i + k]) for k in (1, 2, 3)] for i in idx], dtype=np.float64)
+    except (ValueError, IndexError) as exc:
+        raise UnreadableFileError(f"the ASCII STL file has a malformed vertex line ({exc})") from exc
+    return coords, np.arange(len(idx), dtype=np.int64).reshape(-1, 3)

@@ -1,0 +1,338 @@
+"""analyze(): the one place where the stages meet.
+
+    bytes -> load_body -> mass_properties -> principal_frame -> classify
+          [-> predict_motion]                        -> AnalysisResult
+
+Each stage is computed only when the request needs it: no reference tensor
+without ``reference``, no motion without ``omega``, no trajectory without
+``duration`` and ``samples``, no ``parts`` for a single body.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import time
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field, replace
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from .classify import Classification, classify
+from .conventions import length_scale
+from .errors import InvalidParameterError
+from .load import Loaded, load_body, load_points
+from .mass import InertiaTensor, MassProperties, Model, mass_properties, parallel_axis
+from .principal import PrincipalFrame, jacobi_eigh, principal_frame
+from .tolerances import DEFAULT_TOLERANCES, EPS
+
+if TYPE_CHECKING:
+    from .motion import FreeMotion
+
+__all__ = ["AnalysisOptions", "AnalysisResult", "PartResult", "analyze", "analyze_points",
+           "analyze_loaded", "PrecessionResult", "precession"]
+
+METHODS = ("exact", "dop853", "rk45", "splitting")
+
+
+def _vector(name: str, value: Sequence[float] | None) -> tuple[float, float, float] | None:
+    if value is None:
+        return None
+    try:
+        vec = tuple(float(x) for x in value)
+    except (TypeError, ValueError) as exc:
+        raise InvalidParameterError(f"{name} must be three numbers x,y,z", parameter=name) from exc
+    if len(vec) != 3:
+        raise InvalidParameterError(f"{name} must have 3 components, got {len(vec)}", parameter=name)
+    if not all(math.isfinite(x) for x in vec):
+        raise InvalidParameterError(f"{name} must be finite (no NaN or infinity)", parameter=name)
+    return vec  # type: ignore[return-value]
+
+
+def _positive(name: str, value: float | None) -> None:
+    if value is not None and not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
+        raise InvalidParameterError(f"{name} must be a positive finite number, got {value!r}", parameter=name)
+
+
+@dataclass(frozen=True, slots=True)
+class AnalysisOptions:
+    """Options of one analysis, as in the API's query parameters.
+
+    Lengths (reference, thickness) are in ``units``; density kg/m^3; mass kg;
+    omega rad/s in the input frame; duration s.
+    """
+
+    format: str | None = None
+    units: str | None = None
+    density: float | None = None
+    mass: float | None = None
+    model: str = Model.SOLID
+    thickness: float | None = None
+    tolerance: float = DEFAULT_TOLERANCES.moment_rel
+    reference: tuple[float, float, float] | None = None
+    omega: tuple[float, float, float] | None = None
+    duration: float | None = None
+    samples: int | None = None
+    method: str = "exact"
+    densities: Mapping[str, float] | None = None
+
+    def __post_init__(self) -> None:
+        if self.units is not None:
+            length_scale(self.units)
+        for name in ("density", "mass", "thickness", "duration"):
+            _positive(name, getattr(self, name))
+        if self.density is not None and self.mass is not None:
+            raise InvalidParameterError("give either density or mass, not both", parameter="density")
+        if self.model not in Model.ALL:
+            raise InvalidParameterError(f"model must be 'solid' or 'shell', got {self.model!r}", parameter="model")
+        if not (isinstance(self.tolerance, (int, float)) and math.isfinite(self.tolerance) and 0 < self.tolerance < 1):
+            raise InvalidParameterError("tolerance must be a number between 0 and 1 (relative)", parameter="tolerance")
+        object.__setattr__(self, "reference", _vector("reference", self.reference))
+        object.__setattr__(self, "omega", _vector("omega", self.omega))
+        if self.samples is not None and (not isinstance(self.samples, int) or self.samples < 1):
+            raise InvalidParameterError("samples must be a positive whole number", parameter="samples")
+        if (self.duration is None) != (self.samples is None):
+            raise InvalidParameterError("duration and samples go together; give both for a trajectory", parameter="samples")
+        if self.duration is not None and self.omega is None:
+            raise InvalidParameterError("duration and samples need omega", parameter="omega")
+        if self.method not in METHODS:
+            raise InvalidParameterError(f"method must be one of {', '.join(METHODS)}", parameter="method")
+        if self.densities is not None:
+            for name, rho in self.densities.items():
+                _positive(f"densities[{name!r}]", rho)
+
+
+@dataclass(frozen=True, slots=True)
+class PartResult:
+    name: str
+    props: MassProperties
+    frame: PrincipalFrame
+    classification: Classification
+
+
+@dataclass(frozen=True, slots=True)
+class AnalysisResult:
+    """Everything one analysis computed; ``as_dict`` gives the API's JSON."""
+
+    source: dict[str, Any]
+    props: MassProperties
+    frame: PrincipalFrame
+    classification: Classification
+    reference: InertiaTensor | None = None
+    motion: "FreeMotion | None" = None
+    parts: tuple[PartResult, ...] | None = None
+    warnings: tuple[str, ...] = ()
+    elapsed_s: float = 0.0
+
+    def as_dict(self) -> dict[str, Any]:
+        from .report import analysis_dict
+
+        return analysis_dict(self)
+
+
+def analyze(
+    source: bytes | str | os.PathLike[str],
+    *,
+    filename: str | None = None,
+    options: AnalysisOptions = AnalysisOptions(),
+) -> AnalysisResult:
+    """Analyse a mesh or points file (bytes, or a path)."""
+    start = time.perf_counter()
+    loaded = load_body(source, filename=filename, format=options.format, units=options.units)
+    return analyze_loaded(loaded, options, start)
+
+
+def analyze_points(records: list[dict[str, Any]], options: AnalysisOptions = AnalysisOptions()) -> AnalysisResult:
+    """Analyse point masses ``[{"mass": m, "position": [x, y, z]}, ...]``."""
+    start = time.perf_counter()
+    return analyze_loaded(load_points(records, options.units), options, start)
+
+
+def analyze_loaded(loaded: Loaded, options: AnalysisOptions, start: float | None = None) -> AnalysisResult:
+    """The stages after loading."""
+    start = time.perf_counter() if start is None else start
+    if loaded.kind == "points" and options.model == Model.SHELL:
+        raise InvalidParameterError("model=shell applies to surface meshes, not point masses", parameter="model")
+    single = len(loaded.parts) == 1
+    part_results = tuple(_part(p.name, p.body, options, single) for p in loaded.parts)
+    if not single and options.mass is not None:
+        factor = options.mass / sum(p.props.mass for p in part_results)
+        part_results = tuple(_scaled(p, factor) for p in part_results)
+    if single:
+        props = part_results[0].props
+        frame, cls = part_results[0].frame, part_results[0].classification
+        parts = None
+    else:
+        props = _combined(part_results, options)
+        frame = principal_frame(props, options.tolerance)
+        cls = classify(frame)
+        parts = part_results
+    warnings = list(props.warnings)
+    if loaded.units_from == "file":
+        warnings.append(f"length unit {loaded.units!r} taken from the file")
+    reference = None
+    if options.reference is not None:
+        reference = props.about(np.asarray(options.reference) * length_scale(loaded.units))
+    motion = None
+    if options.omega is not None:
+        motion = _motion(frame, cls, options)
+        warnings.extend(motion.warnings)
+    return AnalysisResult(
+        source=_source(loaded, props),
+        props=props,
+        frame=frame,
+        classification=cls,
+        reference=reference,
+        motion=motion,
+        parts=parts,
+        warnings=tuple(dict.fromkeys(warnings)),
+        elapsed_s=time.perf_counter() - start,
+    )
+
+
+def _part(name: str, body: Any, options: AnalysisOptions, single: bool) -> PartResult:
+    density = options.density
+    if options.densities and name in options.densities:
+        density = float(options.densities[name])
+    # several parts: a total mass is shared out after all parts are integrated
+    mass = options.mass if single else None
+    props = mass_properties(body, density=None if mass is not None else density, mass=mass,
+                            model=options.model, thickness=options.thickness)
+    frame = principal_frame(props, options.tolerance)
+    return PartResult(name, props, frame, classify(frame))
+
+
+def _scaled(part: PartResult, factor: float) -> PartResult:
+    """The part with every density multiplied by ``factor`` (same geometry)."""
+    p = part.props
+    props = replace(
+        p,
+        mass=p.mass * factor,
+        inertia=InertiaTensor(p.inertia.matrix * factor, p.inertia.about, p.inertia.point),
+        principal_moments=p.principal_moments * factor,
+        density=None if p.density is None else p.density * factor,
+    )
+    frame = principal_frame(props, part.frame.tolerance)
+    return PartResult(part.name, props, frame, classify(frame))
+
+
+def _combined(parts: Sequence[PartResult], options: AnalysisOptions) -> MassProperties:
+    """Whole assembly by the parallel-axis theorem (Landau & Lifshitz eq. 32.12)."""
+    masses = np.array([p.props.mass for p in parts])
+    scale = 1.0  # parts are already scaled to a requested total mass
+    total = float(masses.sum())
+    com = sum(p.props.mass * scale * p.props.center_of_mass for p in parts) / total
+    tensor = np.zeros((3, 3))
+    for p in parts:
+        m = p.props.mass * scale
+        tensor = tensor + parallel_axis(p.props.inertia.matrix * scale, m, p.props.center_of_mass - com)
+    values, vectors = jacobi_eigh(tensor)
+    volumes = [p.props.volume for p in parts]
+    volume = float(sum(v for v in volumes if v is not None)) if all(v is not None for v in volumes) else None
+    densities = {p.props.density for p in parts}
+    density = (densities.pop() * scale) if len(densities) == 1 and None not in densities else None
+    estimate = max(p.props.relative_error_estimate for p in parts) + 16 * EPS * len(parts)
+    warnings: list[str] = []
+    for p in parts:
+        warnings.extend(f"{p.name}: {w}" for w in p.props.warnings)
+    return MassProperties(
+        mass=total,
+        center_of_mass=com,
+        inertia=InertiaTensor(tensor, "centre_of_mass", com),
+        principal_moments=values,
+        principal_axes=vectors,
+        relative_error_estimate=estimate,
+        volume=volume,
+        density=density,
+        warnings=tuple(warnings),
+    )
+
+
+def _motion(frame: PrincipalFrame, cls: Classification, options: AnalysisOptions) -> "FreeMotion":
+    from .motion import predict_motion
+
+    return predict_motion(
+        frame, cls, np.asarray(options.omega), duration=options.duration, samples=options.samples,
+        method=options.method,
+    )
+
+
+def _source(loaded: Loaded, props: MassProperties) -> dict[str, Any]:
+    out: dict[str, Any] = {"filename": loaded.filename, "format": loaded.format, "kind": loaded.kind,
+                           "units": loaded.units, "units_from": loaded.units_from}
+    if loaded.filename is None:
+        del out["filename"]
+    from .body import MeshBody, PointBody, VolumeBody
+
+    bodies = [p.body for p in loaded.parts]
+    if loaded.kind == "mesh":
+        meshes = [b for b in bodies if isinstance(b, MeshBody)]
+        out["vertices"] = int(sum(len(b.vertices) for b in meshes)) if props.mesh_vertices is None else props.mesh_vertices
+        out["triangles"] = int(sum(len(b.faces) for b in meshes))
+        if props.volume is not None:
+            out["watertight"] = True
+    elif loaded.kind == "volume":
+        vols = [b for b in bodies if isinstance(b, VolumeBody)]
+        out["points"] = int(len(vols[0].points))
+        out["tetrahedra"] = int(sum(len(b.tets) for b in vols))
+    else:
+        out["points"] = int(sum(len(b.masses) for b in bodies if isinstance(b, PointBody)))
+    if loaded.is_assembly:
+        out["parts"] = len(loaded.parts)
+    return out
+
+
+@dataclass(frozen=True, slots=True)
+class PrecessionResult:
+    """Result of POST /v1/precession: principal frame, class, motion."""
+
+    frame: PrincipalFrame
+    classification: Classification
+    motion: "FreeMotion"
+    relative_error_estimate: float
+    elapsed_s: float
+    warnings: tuple[str, ...] = field(default=())
+
+    def as_dict(self) -> dict[str, Any]:
+        from .report import precession_dict
+
+        return precession_dict(self)
+
+
+def precession(
+    omega: Sequence[float],
+    *,
+    inertia_tensor: NDArray[np.float64] | Sequence[Sequence[float]] | None = None,
+    principal_moments: Sequence[float] | None = None,
+    tolerance: float = DEFAULT_TOLERANCES.moment_rel,
+    duration: float | None = None,
+    samples: int | None = None,
+    method: str = "exact",
+) -> PrecessionResult:
+    """Torque-free motion from a known inertia (tensor about the COM, or principal moments)."""
+    start = time.perf_counter()
+    options = AnalysisOptions(tolerance=tolerance, omega=tuple(omega) if omega is not None else None,  # type: ignore[arg-type]
+                              duration=duration, samples=samples, method=method)
+    if options.omega is None:
+        raise InvalidParameterError("omega is required", parameter="omega")
+    if (inertia_tensor is None) == (principal_moments is None):
+        raise InvalidParameterError("give exactly one of inertia_tensor or principal_moments", parameter="inertia_tensor")
+    if inertia_tensor is not None:
+        try:
+            matrix = np.asarray(inertia_tensor, dtype=np.float64)
+        except (TypeError, ValueError) as exc:
+            raise InvalidParameterError("inertia_tensor must be a 3x3 array of numbers", parameter="inertia_tensor") from exc
+        frame = PrincipalFrame.from_tensor(matrix, tolerance)
+    else:
+        try:
+            moments = np.asarray(principal_moments, dtype=np.float64)
+        except (TypeError, ValueError) as exc:
+            raise InvalidParameterError("principal_moments must be three numbers", parameter="principal_moments") from exc
+        if moments.shape != (3,) or not np.all(np.isfinite(moments)):
+            raise InvalidParameterError("principal_moments must be three finite numbers", parameter="principal_moments")
+        frame = PrincipalFrame.from_tensor(np.diag(moments), tolerance)
+    cls = classify(frame)
+    motion = _motion(frame, cls, options)
+    return PrecessionResult(frame, cls, motion, 8 * EPS, time.perf_counter() - start, tuple(motion.warnings))
