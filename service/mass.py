@@ -334,12 +334,18 @@ def _refine(geometry: _Geometry, tolerances: Tolerances) -> tuple[_Sums, NDArray
         values, v_body = jacobi_eigh(tensor_body, tolerances)
         com = com + rotation @ c_body
         settled = _offdiagonal_ratio(tensor_body) <= FRAME_SETTLED
-        step = float(np.max(np.abs(values - previous) / np.abs(values).max()))
+        top = float(np.abs(values).max())
+        step = float(np.max(np.abs(values - previous)) / top) if top > 0 else 0.0
         rotation = rotation @ v_body.T
         previous = values
         if settled:
             break
     _check_volume(s, geometry.kind)
+    if not np.abs(values).max() > 0:
+        raise InvalidParameterError(
+            "the masses all sit at one point, so the body has no rotational inertia; "
+            "send at least two distinct positions"
+        )
     estimate = _error_estimate(s, values)
     if not settled:
         estimate = max(estimate, step)
