@@ -38,14 +38,16 @@ def read_trimesh_parts(data: bytes, fmt: str, length_scale: float) -> tuple[list
     """Parts of a surface file (one per scene node) and the unit it declares."""
     import trimesh
 
+    extra = {"split_objects": True, "split_groups": True, "group_material": False} if fmt == "obj" else {}
     try:
         scene = trimesh.load_scene(
-            io.BytesIO(data), file_type=fmt, process=False, skip_materials=True, merge_primitives=False
+            io.BytesIO(data), file_type=fmt, process=False, skip_materials=True, merge_primitives=False, **extra
         )
     except Exception as exc:  # trimesh raises many types for bad input
         raise UnreadableFileError(f"could not read the {fmt.upper()} file: {_short(exc)}", format=fmt) from exc
     parts: list[Part] = []
-    for node in scene.graph.nodes_geometry:
+    # sorted: the scene graph's node order is not stable across processes
+    for node in sorted(scene.graph.nodes_geometry, key=str):
         transform, geom_name = scene.graph[node]
         geom = scene.geometry.get(geom_name)
         if not isinstance(geom, trimesh.Trimesh) or len(geom.faces) == 0:

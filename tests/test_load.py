@@ -1,0 +1,186 @@
+"""Loading every format, units, assemblies and bad files."""
+
+from __future__ import annotations
+
+import io
+import json
+
+import meshio
+import numpy as np
+import pytest
+import trimesh
+
+from generate import box
+from service.errors import EmptyGeometryError, UnreadableFileError, UnsupportedFormatError
+from service.mass import parallel_axis
+from service.pipeline import AnalysisOptions, analyze
+
+BOX_MOMENTS = sorted([6000 * (4 + 9) / 12, 6000 * (1 + 9) / 12, 6000 * (1 + 4) / 12])
+
+
+def box_mesh() -> trimesh.Trimesh:
+    return trimesh.Trimesh(*box(1.0, 2.0, 3.0), process=False)
+
+
+def export(obj: trimesh.Trimesh | trimesh.Scene, fmt: str, **kw: object) -> bytes:
+    data = obj.export(file_type=fmt, **kw)
+    if isinstance(data, dict):  # gltf with embedded buffers
+        data = data["model.gltf"]
+    return data.encode() if isinstance(data, str) else data
+
+
+@pytest.mark.parametrize("fmt,ext", [("stl", "stl"), ("stl_ascii", "stl"), ("obj", "obj"), ("ply", "ply"),
+                                     ("off", "off"), ("glb", "glb"), ("3mf", "3mf")])
+def test_every_surface_format_gives_the_box(fmt: str, ext: str) -> None:
+    doc = analyze(export(box_mesh(), fmt), filename=f"part.{ext}").as_dict()
+    scale = 1e-3 if ext == "3mf" else 1.0  # 3MF declares millimetres
+    assert doc["mass"] == pytest.approx(6000 * scale**3, rel=1e-14)
+    np.testing.assert_allclose(doc["principal"]["moments"], np.array(BOX_MOMENTS) * scale**5, rtol=1e-14)
+    assert doc["source"]["triangles"] == 12 and doc["source"]["vertices"] == 8
+
+
+def test_gltf_with_embedded_buffers_is_read_in_metres() -> None:
+    data = export(trimesh.Scene(box_mesh()), "gltf", embed_buffers=True)
+    doc = analyze(data, filename="part.gltf").as_dict()
+    assert doc["source"]["units"] == "m" and doc["source"]["units_from"] == "file"
+    assert doc["mass"] == pytest.approx(6000, rel=1e-14)
+
+
+def test_3mf_declared_unit_is_used_and_reported() -> None:
+    doc = analyze(export(box_mesh(), "3mf"), filename="part.3mf").as_dict()
+    assert doc["source"]["units"] == "mm" and doc["source"]["units_from"] == "file"
+    assert any("taken from the file" in w for w in doc["warnings"])
+
+
+def test_requested_unit_overrides_the_file() -> None:
+    doc = analyze(export(box_mesh(), "3mf"), filename="part.3mf", options=AnalysisOptions(units="m")).as_dict()
+    assert doc["source"]["units_from"] == "request"
+    assert doc["mass"] == pytest.approx(6000, rel=1e-14)
+
+
+def two_box_scene() -> trimesh.Scene:
+    scene = trimesh.Scene()
+    scene.add_geometry(trimesh.Trimesh(*box(1.0, 1.0, 1.0), process=False), node_name="left", geom_name="left")
+    shift = np.eye(4)
+    shift[:3, 3] = [3.0, 1.0, 0.0]
+    scene.add_geometry(trimesh.Trimesh(*box(1.0, 2.0, 1.0), process=False), node_name="right",
+                       geom_name="right", transform=shift)
+    return scene
+
+
+def expected_two_boxes(rho_left: float, rho_right: float) -> tuple[float, np.ndarray, np.ndarray]:
+    m1, c1 = rho_left * 1.0, np.array([0.5, 0.5, 0.5])
+    i1 = np.diag([m1 * 2 / 12, m1 * 2 / 12, m1 * 2 / 12])
+    m2, c2 = rho_right * 2.0, np.array([3.5, 2.0, 0.5])
+    i2 = np.diag([m2 * (4 + 1) / 12, m2 * (1 + 1) / 12, m2 * (1 + 4) / 12])
+    m = m1 + m2
+    com = (m1 * c1 + m2 * c2) / m
+    return m, com, parallel_axis(i1, m1, c1 - com) + parallel_axis(i2, m2, c2 - com)
+
+
+@pytest.mark.parametrize("fmt", ["glb", "obj"])
+def test_assembly_is_the_parallel_axis_sum_of_its_parts(fmt: str) -> None:
+    doc = analyze(export(two_box_scene(), fmt), filename=f"asm.{fmt}",
+                  options=AnalysisOptions(densities={"right": 2000.0})).as_dict()
+    m, com, tensor = expected_two_boxes(1000.0, 2000.0)
+    assert doc["mass"] == pytest.approx(m, rel=1e-14)
+    np.testing.assert_allclose(doc["center_of_mass"], com, rtol=1e-14)
+    np.testing.assert_allclose(doc["inertia_tensor"], tensor, rtol=1e-13, atol=1e-12 * np.abs(tensor).max())
+    names = [p["name"] for p in doc["parts"]]
+    assert names == ["left", "right"]
+    assert [p["mass"] for p in doc["parts"]] == pytest.approx([1000.0, 4000.0], rel=1e-14)
+    assert doc["source"]["parts"] == 2
+
+
+def test_assembly_equals_its_parts_as_separate_files() -> None:
+    whole = analyze(export(two_box_scene(), "glb"), filename="asm.glb").as_dict()
+    scene = two_box_scene()
+    singles = []
+    for node in ("left", "right"):
+        transform, geom = scene.graph[node]
+        mesh = scene.geometry[geom].copy()
+        mesh.apply_transform(transform)
+        singles.append(analyze(export(mesh, "stl"), filename=f"{node}.stl").as_dict())
+    assert whole["mass"] == pytest.approx(sum(s["mass"] for s in singles), rel=1e-14)
+    for part, single in zip(whole["parts"], singles):
+        np.testing.assert_allclose(part["inertia_tensor"], single["inertia_tensor"], rtol=1e-13, atol=1e-10)
+
+
+def test_assembly_total_mass_scales_every_part() -> None:
+    doc = analyze(export(two_box_scene(), "glb"), filename="asm.glb",
+                  options=AnalysisOptions(mass=10.0, densities={"right": 2000.0})).as_dict()
+    assert doc["mass"] == pytest.approx(10.0, rel=1e-14)
+    assert [p["mass"] for p in doc["parts"]] == pytest.approx([2.0, 8.0], rel=1e-14)
+
+
+def test_single_body_scene_has_no_parts() -> None:
+    doc = analyze(export(trimesh.Scene(box_mesh()), "glb"), filename="one.glb").as_dict()
+    assert "parts" not in doc
+
+
+def hex_wedge_pyramid_mesh() -> meshio.Mesh:
+    """Unit cube as one hexahedron, a unit wedge beside it, a pyramid on top."""
+    pts = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0], [0, 0, 1], [1, 0, 1], [1, 1, 1], [0, 1, 1],
+                    [2, 0, 0], [2, 0, 1], [0.5, 0.5, 2.0]], dtype=float)
+    cells = [("hexahedron", np.array([[0, 1, 2, 3, 4, 5, 6, 7]])),
+             ("wedge", np.array([[1, 8, 2, 5, 9, 6]])),
+             ("pyramid", np.array([[4, 5, 6, 7, 10]]))]
+    return meshio.Mesh(pts, cells)
+
+
+@pytest.mark.parametrize("ext,fmt", [("vtu", "vtu"), ("vtk", "vtk"), ("msh", "gmsh22")])
+def test_volume_cells_of_every_kind_integrate_exactly(tmp_path, ext: str, fmt: str) -> None:  # noqa: ANN001
+    path = tmp_path / f"cells.{ext}"
+    meshio.write(path, hex_wedge_pyramid_mesh(), file_format=fmt, **({"binary": False} if fmt.startswith("gmsh") else {}))
+    doc = analyze(path, options=AnalysisOptions(density=1.0)).as_dict()
+    volumes = [1.0, 0.5, 1.0 / 3.0]  # cube, wedge (triangle 1x1/2 times 1), pyramid (base 1, height 1)
+    assert sum(p.get("volume", 0) for p in doc["parts"]) == pytest.approx(sum(volumes), rel=1e-14)
+    assert doc["source"]["kind"] == "volume"
+    wedge_com = np.array([1 + 1 / 3, 1 / 3, 0.5])
+    pyramid_com = np.array([0.5, 0.5, 1.25])  # apex height 1 above the base: a quarter up
+    com = (np.array([0.5, 0.5, 0.5]) * 1.0 + wedge_com * 0.5 + pyramid_com / 3) / sum(volumes)
+    np.testing.assert_allclose(doc["center_of_mass"], com, rtol=1e-14)
+
+
+def test_points_files_json_and_csv(tmp_path) -> None:  # noqa: ANN001
+    pts = [{"mass": 1.0, "position": [0, 0, 0]}, {"mass": 3.0, "position": [2, 0, 0]}]
+    (tmp_path / "p.json").write_text(json.dumps(pts))
+    (tmp_path / "p.csv").write_text("mass,x,y,z\n1,0,0,0\n3,2,0,0\n")
+    expected = 1 * 3 * 4 / 4  # m1 m2 l² / (m1 + m2)
+    for name in ("p.json", "p.csv"):
+        doc = analyze(tmp_path / name).as_dict()
+        assert doc["source"]["kind"] == "points"
+        np.testing.assert_allclose(doc["principal"]["moments"][1:], [expected, expected], rtol=1e-15)
+        assert doc["classification"]["kind"] == "linear_rotator"
+
+
+def test_truncated_binary_stl_is_unreadable() -> None:
+    data = export(box_mesh(), "stl")
+    with pytest.raises(UnreadableFileError):
+        analyze(data[:-7], filename="cut.stl")
+
+
+def test_garbage_is_unreadable() -> None:
+    with pytest.raises(UnreadableFileError):
+        analyze(b"\x00\x01garbage" * 20, filename="junk.ply")
+
+
+def test_empty_file_is_empty_geometry() -> None:
+    with pytest.raises(EmptyGeometryError):
+        analyze(b"", filename="empty.stl")
+
+
+def test_stl_without_triangles_is_empty_geometry() -> None:
+    with pytest.raises(EmptyGeometryError):
+        analyze(b"solid empty\nendsolid empty\n", filename="empty.stl")
+
+
+def test_unknown_extension_is_unsupported() -> None:
+    with pytest.raises(UnsupportedFormatError) as err:
+        analyze(b"whatever", filename="part.xyz123")
+    assert err.value.code == "unsupported_format"
+
+
+def test_content_sniffing_without_a_name() -> None:
+    doc = analyze(export(box_mesh(), "stl_ascii")).as_dict()
+    assert doc["source"]["format"] == "stl"
