@@ -1,0 +1,80 @@
+"""The CLI as a user runs it, and what each job imports."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+
+import pytest
+
+from conftest import ROOT, SAMPLES
+
+
+def run(*args: str) -> subprocess.CompletedProcess[str]:
+    return subprocess.run([sys.executable, "-m", "service", *args], capture_output=True, text=True, cwd=ROOT)
+
+
+def test_analyze_prints_a_table() -> None:
+    out = run("analyze", str(SAMPLES / "l_bracket.stl"))
+    assert out.returncode == 0, out.stderr
+    assert "asymmetric_top" in out.stdout
+    assert "9000" in out.stdout and "25000" in out.stdout
+
+
+def test_analyze_json_matches_closed_form_box() -> None:
+    out = run("analyze", str(SAMPLES / "box.stl"), "--json", "--density", "2", "--reference", "0,0,0")
+    doc = json.loads(out.stdout)
+    assert doc["mass"] == pytest.approx(12.0, rel=1e-15)
+    assert doc["principal"]["moments"] == pytest.approx([5.0, 10.0, 13.0], rel=1e-14)
+    assert doc["reference_inertia"]["tensor"][0][0] == pytest.approx(12.0 * (4 + 9) / 3, rel=1e-14)
+    assert "precession" not in doc and "parts" not in doc
+
+
+def test_errors_go_to_stderr_in_the_envelope_with_exit_code() -> None:
+    out = run("analyze", str(SAMPLES / "open_box.stl"))
+    assert out.returncode == 4
+    assert out.stdout == ""
+    err = json.loads(out.stderr)
+    assert err["error"]["code"] == "not_watertight"
+    assert err["error"]["details"]["open_edges"] == 4
+
+
+def test_bad_parameter_exit_code() -> None:
+    out = run("analyze", str(SAMPLES / "box.stl"), "--density", "-3")
+    assert out.returncode == 2
+    assert json.loads(out.stderr)["error"]["code"] == "invalid_parameter"
+
+
+def test_inverted_box_warns_on_the_table() -> None:
+    out = run("analyze", str(SAMPLES / "inverted_box.stl"))
+    assert out.returncode == 0 and "inverted winding corrected" in out.stdout
+
+
+def imported_after(code: str) -> set[str]:
+    probe = code + "\nimport sys, json; print(json.dumps(sorted(sys.modules)))"
+    out = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True, cwd=ROOT, check=True)
+    return set(json.loads(out.stdout.strip().splitlines()[-1]))
+
+
+def test_mesh_analysis_imports_no_web_stack_or_ode_solver() -> None:
+    mods = imported_after(f"import service; service.analyze({str(SAMPLES / 'box.stl')!r})")
+    assert not {"fastapi", "uvicorn", "scipy.integrate", "pydantic", "dask"} & mods
+
+
+def test_point_analysis_imports_no_mesh_library() -> None:
+    mods = imported_after("import service; service.analyze_points([{'mass': 1, 'position': [0, 0, 0]}, "
+                          "{'mass': 2, 'position': [1, 1, 0]}])")
+    assert not {"trimesh", "meshio", "fastapi", "scipy.integrate"} & mods
+
+
+def test_cli_mesh_job_imports_no_web_stack() -> None:
+    mods = imported_after(f"from service.cli import main; main(['analyze', {str(SAMPLES / 'box.stl')!r}, '--json'])")
+    assert not {"fastapi", "uvicorn", "scipy.integrate"} & mods
+
+
+def test_result_holds_only_requested_sections() -> None:
+    from service import analyze
+
+    doc = analyze(SAMPLES / "box.stl").as_dict()
+    assert not {"reference_inertia", "precession", "parts"} & set(doc)
