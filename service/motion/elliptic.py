@@ -88,6 +88,10 @@ def jacobi_sncndn(
         dn = np.sqrt(cn * cn + m1s[level + 1] * sn * sn)
         denom = 1.0 + k * sn * sn
         sn, cn = (1.0 + k) * sn / denom, cn * dn / denom
+    # Each level rounds sn and cn separately; renormalising restores
+    # sn^2 + cn^2 = 1 to one rounding (it moves them by the accumulated error only).
+    norm = np.hypot(sn, cn)
+    sn, cn = sn / norm, cn / norm
     dn = np.sqrt(cn * cn + m1 * sn * sn)
     return sn, cn, dn
 

@@ -41,6 +41,7 @@ which keeps both Pi - u and |m x e_a| away from cancellation.  M in space is
 from __future__ import annotations
 
 from dataclasses import dataclass
+from fractions import Fraction
 
 import numpy as np
 from numpy.typing import NDArray
@@ -62,6 +63,25 @@ Array = NDArray[np.float64]
 
 def _sign(x: float) -> float:
     return -1.0 if x < 0 else 1.0
+
+
+def _energy_gaps(moments: Array, omega_body: Array) -> tuple[float, float, float, float]:
+    """D1 = M^2 - 2E I1, D2 = M^2 - 2E I2, D3 = 2E I3 - M^2, and the scale of D2, correctly rounded.
+
+    D1 = I2(I2-I1)W2^2 + I3(I3-I1)W3^2 and D3 = I1(I3-I1)W1^2 + I2(I3-I2)W2^2
+    are sums of non-negative terms, but D2 = I3(I3-I2)W3^2 - I1(I2-I1)W1^2, the
+    distance to the separatrix, cancels: in floating point it would carry an
+    absolute error ~EPS x its terms, i.e. 1e-4 relative at 1e-12 from the
+    separatrix, and the period (~ln 1/|D2|) with it.  The inputs are floats, so
+    all three are evaluated exactly in rational arithmetic and rounded once
+    (a few scalar operations per prediction).
+    """
+    I1, I2, I3 = (Fraction(float(x)) for x in moments)
+    W1, W2, W3 = (Fraction(float(x)) for x in omega_body)
+    p3, p1 = I3 * (I3 - I2) * W3 * W3, I1 * (I2 - I1) * W1 * W1
+    D1 = I2 * (I2 - I1) * W2 * W2 + I3 * (I3 - I1) * W3 * W3
+    D3 = I1 * (I3 - I1) * W1 * W1 + I2 * (I3 - I2) * W2 * W2
+    return float(D1), float(p3 - p1), float(D3), float(p3 + p1)
 
 
 @dataclass(frozen=True, slots=True)
@@ -90,13 +110,10 @@ class AsymmetricTop:
     @classmethod
     def from_initial(cls, moments: Array, omega_body: Array, separatrix_rel: float) -> "AsymmetricTop":
         I1, I2, I3 = (float(x) for x in moments)
-        W1, W2, W3 = (float(x) for x in omega_body)
+        W1, W3 = float(omega_body[0]), float(omega_body[2])
         g21, g32, g31 = I2 - I1, I3 - I2, I3 - I1
-        D3 = I1 * g31 * W1 * W1 + I2 * g32 * W2 * W2  # 2E I3 - M^2 >= 0
-        D1 = I2 * g21 * W2 * W2 + I3 * g31 * W3 * W3  # M^2 - 2E I1 >= 0
-        p3, p1 = I3 * g32 * W3 * W3, I1 * g21 * W1 * W1
-        D2 = p3 - p1  # M^2 - 2E I2, the only cancelling difference (intrinsic)
-        separatrix = abs(D2) <= separatrix_rel * (p3 + p1)
+        D1, D2, D3, scale2 = _energy_gaps(moments, omega_body)
+        separatrix = abs(D2) <= separatrix_rel * scale2
         momentum = float(np.linalg.norm(np.asarray(moments) * np.asarray(omega_body)))
         inv_i123 = 1.0 / I1 / I2 / I3
         if D2 >= 0.0 or separatrix:  # circulation about x3 (L&L 37.10)

@@ -1,0 +1,70 @@
+"""Independent references for the motion tests (never the code under test).
+
+- ``euler_reference``: Euler's equations (Landau & Lifshitz eq. 36.5) with the
+  attitude as a rotation matrix, dR/dt = R [Omega]x, integrated by scipy's
+  DOP853 at rtol 1e-12 (Hairer, Norsett & Wanner, Solving ODEs I, §II.5).
+- ``ll_period``: the period 4K(k)/rate of L&L §37 in mpmath at 50 digits.
+"""
+
+from __future__ import annotations
+
+import mpmath as mp
+import numpy as np
+from scipy.integrate import solve_ivp
+
+from service.classify import Classification, classify
+from service.principal import PrincipalFrame
+
+
+def body(moments, rotation=None, tolerance=1e-6) -> tuple[PrincipalFrame, Classification]:
+    """Principal frame and classification of a body with these principal moments,
+    its principal axes the rows of ``rotation`` (identity by default)."""
+    axes = np.eye(3) if rotation is None else np.asarray(rotation, dtype=float)
+    frame = PrincipalFrame.from_eigen(np.asarray(moments, dtype=float), axes, tolerance)
+    return frame, classify(frame)
+
+
+def euler_reference(moments, omega_body, t, rtol=1e-12):
+    """Omega(t) (N, 3) in the body and R(t) (N, 3, 3), the rotation since t = 0 in the body frame at 0."""
+    I1, I2, I3 = (float(x) for x in moments)
+
+    def rhs(_t, y):
+        w = y[:3]
+        r = y[3:].reshape(3, 3)
+        dw = [(I2 - I3) / I1 * w[1] * w[2], (I3 - I1) / I2 * w[2] * w[0], (I1 - I2) / I3 * w[0] * w[1]]
+        hat = np.array([[0, -w[2], w[1]], [w[2], 0, -w[0]], [-w[1], w[0], 0]])
+        return np.r_[dw, (r @ hat).ravel()]
+
+    scale = float(np.linalg.norm(omega_body))
+    atol = np.r_[np.full(3, 1e-15 * scale), np.full(9, 1e-15)]
+    y0 = np.r_[np.asarray(omega_body, dtype=float), np.eye(3).ravel()]
+    sol = solve_ivp(rhs, (0.0, float(t[-1])), y0, method="DOP853", t_eval=t, rtol=rtol, atol=atol)
+    assert sol.success
+    return sol.y[:3].T, sol.y[3:].T.reshape(-1, 3, 3)
+
+
+def ll_period(moments, omega_body) -> float:
+    """4 K(k) / rate for the asymmetric top, L&L eqs. 37.10-37.12, at 50 digits."""
+    with mp.workdps(50):
+        I1, I2, I3 = (mp.mpf(float(x)) for x in moments)
+        W = [mp.mpf(float(x)) for x in omega_body]
+        E2 = I1 * W[0] ** 2 + I2 * W[1] ** 2 + I3 * W[2] ** 2
+        M2 = (I1 * W[0]) ** 2 + (I2 * W[1]) ** 2 + (I3 * W[2]) ** 2
+        if M2 < E2 * I2:  # swap the roles of 1 and 3
+            I1, I3 = I3, I1
+        rate = mp.sqrt((I3 - I2) * (M2 - E2 * I1) / (I1 * I2 * I3))
+        k2 = (I2 - I1) * (E2 * I3 - M2) / ((I3 - I2) * (M2 - E2 * I1))
+        return float(4 * mp.ellipk(k2) / rate)
+
+
+def quaternion_matrix(q):
+    """Rotation matrices of quaternions [w, x, y, z] (written out, independent of the service)."""
+    w, x, y, z = np.moveaxis(np.asarray(q, dtype=float), -1, 0)
+    return np.stack(
+        [
+            np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)], -1),
+            np.stack([2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)], -1),
+            np.stack([2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)], -1),
+        ],
+        -2,
+    )
