@@ -344,9 +344,13 @@ def _propagate_exact(setup: _Setup, t: Array, tol: Tolerances) -> tuple[Array, A
 
 
 def _trajectory(problem: RigidProblem, t: Array, omega_body: Array, attitude: Array) -> Trajectory:
-    """Express the principal-frame attitude in the input frame: q = q_axes q~ q_axes*."""
-    to_input = problem.to_input
-    q = quat.multiply(quat.multiply(to_input, attitude), quat.conjugate(to_input))
+    """Express the principal-frame attitude in the input frame.
+
+    q = q_A q~ q_A* with q_A the principal->input rotation: the same angle about
+    the rotated axis, so the scalar part is kept and the vector part is taken
+    through the axes (exactly the identity at t = 0).
+    """
+    q = np.concatenate([attitude[:, :1], attitude[:, 1:] @ problem.axes], axis=1)
     q = quat.canonical(q)
     omega = quat.rotate(q, omega_body @ problem.axes)
     return Trajectory(t=t, omega_body=omega_body, omega=omega, quaternion=q)
