@@ -1,0 +1,68 @@
+"""One result row per input file, as a JSON line or as a flat table row.
+
+A JSON line is exactly what ``POST /v1/batch`` streams: the analysis result of
+the contract (``AnalysisResult.as_dict()``), or ``{"source": {"filename":
+name}, "error": {...}}`` for a file that failed.  ``source.filename`` is the
+input's name, the key ``--resume`` uses.
+
+A flat row (CSV, Parquet) has the columns of :data:`COLUMNS`, all SI:
+``mass`` kg, ``volume`` m^3 (empty for shells and points), ``com_*`` m, the six
+components of the inertia tensor about the centre of mass in the input frame
+and the principal moments ``I1 <= I2 <= I3`` in kg m^2.  ``Ixy`` is the (x, y)
+element of the tensor, i.e. the product of inertia with its minus sign,
+``-integral(x y dm)``.  ``class`` is ``classification.kind``, ``kappa`` Ray's
+asymmetry (empty where the contract leaves it out), ``warnings`` joined by
+``"; "``, ``error`` ``"<code>: <message>"`` (empty when the analysis worked).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from ..errors import ServiceError
+
+__all__ = ["COLUMNS", "FLOAT_COLUMNS", "error_row", "flat_row", "row_name"]
+
+COLUMNS = (
+    "name", "format", "mass", "volume", "com_x", "com_y", "com_z",
+    "Ixx", "Iyy", "Izz", "Ixy", "Ixz", "Iyz", "I1", "I2", "I3",
+    "class", "kappa", "warnings", "error",
+)
+FLOAT_COLUMNS = frozenset(COLUMNS[2:16]) | {"kappa"}
+
+# (column, row, col) of the tensor components, in COLUMNS order
+_TENSOR = (("Ixx", 0, 0), ("Iyy", 1, 1), ("Izz", 2, 2), ("Ixy", 0, 1), ("Ixz", 0, 2), ("Iyz", 1, 2))
+
+
+def error_row(name: str, error: ServiceError) -> dict[str, Any]:
+    """The JSON line of a file that failed: the API's error envelope plus its name."""
+    return {"source": {"filename": name}, **error.as_dict()}
+
+
+def row_name(row: dict[str, Any]) -> str:
+    """The input name a JSON line belongs to."""
+    return str(row["source"]["filename"])
+
+
+def flat_row(row: dict[str, Any]) -> dict[str, Any]:
+    """The CSV/Parquet row of a JSON line; missing values are None."""
+    out: dict[str, Any] = dict.fromkeys(COLUMNS)
+    out["name"] = row_name(row)
+    if "error" in row:
+        err = row["error"]
+        out["error"] = f"{err['code']}: {err['message']}"
+        return out
+    out["format"] = row["source"].get("format")
+    out["mass"] = row["mass"]
+    out["volume"] = row.get("volume")
+    out["com_x"], out["com_y"], out["com_z"] = row["center_of_mass"]
+    tensor = row["inertia_tensor"]
+    for column, i, j in _TENSOR:
+        out[column] = tensor[i][j]
+    out["I1"], out["I2"], out["I3"] = row["principal"]["moments"]
+    cls = row["classification"]
+    out["class"] = cls["kind"]
+    out["kappa"] = cls.get("asymmetry")
+    out["warnings"] = "; ".join(row.get("warnings", []))
+    out["error"] = ""
+    return out

@@ -1,0 +1,204 @@
+"""Where batch rows go: JSONL, CSV or Parquet, chosen by the output's extension.
+
+JSONL and CSV rows are written and flushed one by one as files complete, so an
+interrupted run keeps every finished row and ``--resume`` carries on.  A line
+cut short by a crash is removed before appending (its file is analysed again).
+
+Parquet cannot grow row by row: rows are written in row groups to
+``<out>.partial`` and that file replaces ``<out>`` when the run ends (also on
+Ctrl-C or an error).  On ``--resume`` the existing rows are copied first.  Only
+a hard kill loses the rows of the current run; the previous output stays whole.
+
+Rows come in completion order, not input order; each carries its input's name.
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+import os
+from collections.abc import Iterator
+from typing import IO, Any, Protocol
+
+from ..errors import InvalidParameterError
+from .rows import COLUMNS, FLOAT_COLUMNS, flat_row, row_name
+
+__all__ = ["Sink", "open_sink", "done_names", "OUTPUT_FORMATS"]
+
+OUTPUT_FORMATS = {".jsonl": "jsonl", ".ndjson": "jsonl", ".csv": "csv", ".parquet": "parquet"}
+PARQUET_ROW_GROUP = 4096  # rows per Parquet row group: ~1 MB of columns, few enough groups to read fast
+
+
+class Sink(Protocol):
+    def write(self, row: dict[str, Any]) -> None: ...
+    def close(self) -> None: ...
+
+
+def output_format(path: str) -> str:
+    """``jsonl``, ``csv`` or ``parquet`` from the output's extension."""
+    ext = os.path.splitext(path)[1].lower()
+    try:
+        fmt = OUTPUT_FORMATS[ext]
+    except KeyError:
+        raise InvalidParameterError(
+            f"cannot tell the output format of {path!r}; end --out with .jsonl, .csv or .parquet", parameter="out"
+        ) from None
+    if fmt == "parquet":
+        _pyarrow()
+    return fmt
+
+
+def _pyarrow() -> Any:
+    try:
+        import pyarrow
+        import pyarrow.parquet
+    except ImportError as exc:
+        raise InvalidParameterError(
+            "Parquet output needs pyarrow: pip install 'inertia-service[parquet]'", parameter="out"
+        ) from exc
+    return pyarrow
+
+
+# ---------------------------------------------------------------------------
+# resume
+
+
+def done_names(path: str) -> set[str]:
+    """Names of the inputs that already have a row in ``path`` (error rows included).
+
+    A missing or empty output has none.  A trailing line cut short by a crash
+    is dropped from the file here, so appending starts on a fresh line.
+    """
+    if not os.path.exists(path) or os.path.getsize(path) == 0:
+        return set()
+    fmt = output_format(path)
+    if fmt == "parquet":
+        table = _pyarrow().parquet.read_table(path, columns=["name"])
+        return {str(n) for n in table.column("name").to_pylist()}
+    _drop_partial_line(path)
+    with open(path, encoding="utf-8", newline="") as fh:
+        if fmt == "csv":
+            return _csv_names(fh, path)
+        return set(_jsonl_names(fh))
+
+
+def _drop_partial_line(path: str) -> None:
+    with open(path, "rb+") as fh:
+        fh.seek(0, os.SEEK_END)
+        end = fh.tell()
+        fh.seek(max(0, end - 1))
+        if fh.read(1) == b"\n":
+            return
+        # scan back to the last newline; the tail after it is an unfinished row
+        pos = end
+        while pos > 0:
+            step = min(1 << 16, pos)
+            fh.seek(pos - step)
+            chunk = fh.read(step)
+            idx = chunk.rfind(b"\n")
+            if idx >= 0:
+                fh.truncate(pos - step + idx + 1)
+                return
+            pos -= step
+        fh.truncate(0)
+
+
+def _jsonl_names(fh: IO[str]) -> Iterator[str]:
+    for lineno, line in enumerate(fh, 1):
+        if not line.strip():
+            continue
+        try:
+            yield row_name(json.loads(line))
+        except (json.JSONDecodeError, KeyError, TypeError) as exc:
+            raise InvalidParameterError(
+                f"line {lineno} of --out is not a batch result line ({exc}); "
+                "give a new --out or drop --resume", parameter="out",
+            ) from exc
+
+
+def _csv_names(fh: IO[str], path: str) -> set[str]:
+    reader = csv.DictReader(fh)
+    if tuple(reader.fieldnames or ()) != COLUMNS:
+        raise InvalidParameterError(
+            f"{path!r} does not have the batch CSV columns; give a new --out or drop --resume", parameter="out"
+        )
+    return {row["name"] for row in reader}
+
+
+# ---------------------------------------------------------------------------
+# writers
+
+
+def open_sink(path: str, append: bool) -> Sink:
+    """A writer for ``path``; ``append`` keeps the rows already there."""
+    fmt = output_format(path)
+    append = append and os.path.exists(path) and os.path.getsize(path) > 0
+    if fmt == "jsonl":
+        return JsonlSink(path, append)
+    if fmt == "csv":
+        return CsvSink(path, append)
+    return ParquetSink(path, append)
+
+
+class JsonlSink:
+    def __init__(self, path: str, append: bool) -> None:
+        self._fh = open(path, "a" if append else "w", encoding="utf-8")
+
+    def write(self, row: dict[str, Any]) -> None:
+        # allow_nan=False: the contract never sends NaN, so one here is a bug to see
+        self._fh.write(json.dumps(row, allow_nan=False) + "\n")
+        self._fh.flush()
+
+    def close(self) -> None:
+        self._fh.close()
+
+
+class CsvSink:
+    def __init__(self, path: str, append: bool) -> None:
+        self._fh = open(path, "a" if append else "w", encoding="utf-8", newline="")
+        self._writer = csv.DictWriter(self._fh, fieldnames=COLUMNS)
+        if not append:
+            self._writer.writeheader()
+
+    def write(self, row: dict[str, Any]) -> None:
+        # csv writes floats with repr(): they read back bit for bit
+        self._writer.writerow(flat_row(row))
+        self._fh.flush()
+
+    def close(self) -> None:
+        self._fh.close()
+
+
+def parquet_schema() -> Any:
+    pa = _pyarrow()
+    return pa.schema([(c, pa.float64() if c in FLOAT_COLUMNS else pa.string()) for c in COLUMNS])
+
+
+class ParquetSink:
+    def __init__(self, path: str, append: bool) -> None:
+        pa = _pyarrow()
+        self._pa = pa
+        self._path = path
+        self._partial = path + ".partial"
+        self._schema = parquet_schema()
+        self._writer = pa.parquet.ParquetWriter(self._partial, self._schema)
+        self._buffer: list[dict[str, Any]] = []
+        if append:
+            old = pa.parquet.ParquetFile(path)
+            for i in range(old.num_row_groups):
+                self._writer.write_table(old.read_row_group(i).select(list(COLUMNS)).cast(self._schema))
+
+    def write(self, row: dict[str, Any]) -> None:
+        self._buffer.append(flat_row(row))
+        if len(self._buffer) >= PARQUET_ROW_GROUP:
+            self._flush()
+
+    def _flush(self) -> None:
+        if self._buffer:
+            self._writer.write_table(self._pa.Table.from_pylist(self._buffer, schema=self._schema))
+            self._buffer = []
+
+    def close(self) -> None:
+        self._flush()
+        self._writer.close()
+        os.replace(self._partial, self._path)

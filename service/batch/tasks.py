@@ -1,0 +1,57 @@
+"""The work of one batch task, run on a Dask worker (or anywhere): read, analyse, report.
+
+A task is a small group of :class:`~service.batch.sources.Source` (one file,
+or several small ones to amortise the per-task overhead).  The worker reads
+each file itself (path, URL or zip member), analyses it with exactly the
+``AnalysisOptions`` of the run, and returns one JSON-ready row per file.  A
+file that fails gives an error row; nothing a file does stops the group.
+Only the rows travel back, so a worker holds at most one group's files.
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Sequence
+from typing import Any
+
+from ..errors import ServiceError, UnreadableFileError
+from ..pipeline import AnalysisOptions, analyze
+from .rows import error_row
+from .sources import Source, ZipCache, read_source
+
+__all__ = ["analyze_sources", "analyze_source", "InternalError"]
+
+
+class InternalError(ServiceError):
+    """Something the service cannot explain went wrong with one file."""
+
+    code = "internal_error"
+
+
+def analyze_source(source: Source, options: AnalysisOptions, zips: ZipCache | None = None) -> dict[str, Any]:
+    """The JSON line of one input: its analysis result or its error."""
+    try:
+        if source.member is None and source.name.lower().endswith(".zip"):
+            raise UnreadableFileError(f"{source.name!r} is not a readable zip archive", filename=source.name)
+        data = read_source(source, zips)
+        return analyze(data, filename=source.name, options=options).as_dict()
+    except ServiceError as exc:
+        return _json_safe(error_row(source.name, exc))
+    except Exception as exc:  # one file never stops the run; the row says what happened
+        err = InternalError(f"unexpected {type(exc).__name__} while analysing this file: {exc}; please report it")
+        return error_row(source.name, err)
+
+
+def analyze_sources(sources: Sequence[Source], options: AnalysisOptions) -> list[dict[str, Any]]:
+    """The JSON lines of a group of inputs, in the group's order."""
+    zips = ZipCache()
+    try:
+        return [analyze_source(src, options, zips) for src in sources]
+    finally:
+        zips.close()
+
+
+def _json_safe(row: dict[str, Any]) -> dict[str, Any]:
+    """Error details may hold numpy scalars or paths: make them plain JSON."""
+    result: dict[str, Any] = json.loads(json.dumps(row, default=str))
+    return result
