@@ -5,10 +5,19 @@ A surface bounds a solid exactly when it is a closed, consistently oriented
 the other.  Then the divergence theorem holds and the signed-tetrahedron
 integrals in ``mass`` are exact.  Everything here is vectorised and
 sort-based: one sort of the vertices (welding) and one of the edges.
+
+Speed.  numpy sorts plain integers far faster than it argsorts them (a SIMD
+value sort), so a sort that must also return the permutation packs the key
+into the high bits of a uint64 and the element index into the low bits, and
+sorts the values: equal keys come out in index order, as a stable argsort
+would give them.  Connected components use vectorised union-find (hook each
+root to the smaller one, then pointer jumping), so the common path needs no
+scipy import.
 """
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -16,39 +25,128 @@ from numpy.typing import NDArray
 
 from .errors import NotWatertightError
 
-__all__ = ["weld", "SurfaceTopology", "surface_topology", "orient_consistently"]
+__all__ = ["weld", "row_ids", "SurfaceTopology", "surface_topology", "orient_consistently", "face_components"]
+
+_MIX = (np.uint64(0x9E3779B97F4A7C15), np.uint64(0xBF58476D1CE4E5B9), np.uint64(0x94D049BB133111EB))
+MIN_HASH_BITS = 16  # below this many hash bits beside the index, collisions would dominate: argsort instead
+SCATTER_CHUNK = 1 << 20  # rows per block when scattering ids back: bounds the temporaries to ~16 MB
 
 
 def weld(vertices: NDArray[np.float64], faces: NDArray[np.int64]) -> tuple[NDArray[np.float64], NDArray[np.int64]]:
     """Merge vertices with bit-identical coordinates (-0.0 equals 0.0).
 
-    Sorting the raw 24-byte rows would need a slow row-wise unique; instead
-    the rows are hashed to uint64, sorted once, and runs of equal hash are
-    checked for equal coordinates (a hash collision falls back to lexsort).
+    Distinct vertices are numbered in order of first occurrence, so an
+    already welded mesh comes back unchanged (the same arrays, no copy).
     """
-    v = vertices + 0.0  # turns -0.0 into 0.0 so both weld together
-    bits = np.ascontiguousarray(v).view(np.uint64).reshape(-1, 3)
+    v = np.ascontiguousarray(vertices + 0.0)  # turns -0.0 into 0.0 so both weld together
+    bits = v.view(np.uint64).reshape(-1, 3)
+    ids, heads = row_ids([bits[:, 0], bits[:, 1], bits[:, 2]])
+    if len(heads) == len(vertices):
+        return vertices, faces  # every vertex distinct: ids is the identity
+    return vertices[heads], ids[faces]
+
+
+def row_ids(columns: Sequence[NDArray[np.unsignedinteger]]) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
+    """Group equal rows of integer columns exactly.
+
+    Returns ``ids`` (n,): the group of each row, numbered in order of first
+    occurrence, and ``heads`` (k,): the first row of each group, ascending.
+    Rows are hashed to uint64 and sorted once; rows are then compared
+    exactly, and a run of equal hash holding different rows (a collision)
+    is re-sorted by the columns themselves, so distinct rows never merge.
+    """
+    n = len(columns[0])
+    order, same_hash = _hash_order(_row_hash(columns))
+    same = _equal_neighbours(columns, order)
+    collided = same_hash & ~same
+    if np.any(collided):
+        order = _resolve_collisions(columns, order, same_hash)
+        same = _equal_neighbours(columns, order)
+    new = np.empty(n, dtype=bool)
+    new[0] = True
+    np.logical_not(same, out=new[1:])
+    del same, same_hash, collided
+    first = order[new]  # smallest row of each group: runs keep index order
+    heads = np.sort(first)
+    rank = np.empty(len(first), dtype=np.int64)
+    rank[np.argsort(first)] = np.arange(len(first))
+    group = np.cumsum(new, dtype=np.int32 if len(first) < 2**31 else np.int64)
+    group -= 1
+    ids = np.empty(n, dtype=np.int64)
+    for start in range(0, n, SCATTER_CHUNK):
+        stop = start + SCATTER_CHUNK
+        ids[order[start:stop]] = rank[group[start:stop]]
+    return ids, heads
+
+
+def _row_hash(columns: Sequence[NDArray[np.unsignedinteger]]) -> NDArray[np.uint64]:
+    """A 64-bit hash of each row, well mixed in its high bits (multiply-xorshift)."""
     with np.errstate(over="ignore"):
-        h = bits[:, 0] * np.uint64(0x9E3779B97F4A7C15)
-        h ^= (h >> np.uint64(29)) + bits[:, 1] * np.uint64(0xBF58476D1CE4E5B9)
-        h ^= (h >> np.uint64(31)) + bits[:, 2] * np.uint64(0x94D049BB133111EB)
-    order = np.argsort(h, kind="stable")
-    hs = h[order]
-    vs = bits[order]
-    same_hash = hs[1:] == hs[:-1]
-    same_xyz = np.all(vs[1:] == vs[:-1], axis=1)
-    if np.any(same_hash & ~same_xyz):
-        order = np.lexsort((bits[:, 2], bits[:, 1], bits[:, 0]))
-        vs = bits[order]
-        same_xyz = np.all(vs[1:] == vs[:-1], axis=1)
-    new_run = np.empty(len(v), dtype=bool)
-    new_run[0] = True
-    new_run[1:] = ~same_xyz
-    ids_sorted = np.cumsum(new_run) - 1
-    remap = np.empty(len(v), dtype=np.int64)
-    remap[order] = ids_sorted
-    unique_vertices = vertices[order[new_run]]
-    return unique_vertices, remap[faces]
+        h = columns[0].astype(np.uint64)
+        h *= _MIX[0]
+        for col in columns[1:]:
+            h ^= h >> np.uint64(31)
+            h += col
+            h *= _MIX[1]
+        h ^= h >> np.uint64(29)
+        h *= _MIX[2]
+        h ^= h >> np.uint64(32)
+    return h
+
+
+def _hash_order(h: NDArray[np.uint64]) -> tuple[NDArray[np.int64], NDArray[np.bool_]]:
+    """Row order sorted by hash (ties by index) and whether neighbours share a hash.
+
+    Consumes ``h``: only its top ``64 - index_bits`` bits are compared.
+    """
+    n = len(h)
+    index_bits = max(1, (n - 1).bit_length())
+    if 64 - index_bits < MIN_HASH_BITS:
+        order = np.argsort(h, kind="stable")
+        hs = h[order]
+        return order, hs[1:] == hs[:-1]
+    h >>= np.uint64(index_bits)
+    return _packed_sort(h, index_bits)
+
+
+def _packed_sort(key: NDArray[np.uint64], index_bits: int) -> tuple[NDArray[np.int64], NDArray[np.bool_]]:
+    """Indices sorting ``key`` (< 2**(64 - index_bits)) stably, and equal-neighbour flags.
+
+    Consumes ``key``: it is shifted and sorted in place.
+    """
+    key <<= np.uint64(index_bits)
+    key |= np.arange(len(key), dtype=np.uint64)
+    key.sort()
+    diff = key[1:] ^ key[:-1]
+    diff >>= np.uint64(index_bits)
+    same = diff == 0
+    del diff
+    key &= np.uint64((1 << index_bits) - 1)
+    return key.view(np.int64), same
+
+
+def _equal_neighbours(columns: Sequence[NDArray[np.unsignedinteger]], order: NDArray[np.int64]) -> NDArray[np.bool_]:
+    """Rows ``order[i]`` and ``order[i + 1]`` equal in every column."""
+    same = np.ones(len(order) - 1, dtype=bool)
+    for col in columns:
+        c = col[order]
+        same &= c[1:] == c[:-1]
+    return same
+
+
+def _resolve_collisions(columns: Sequence[NDArray[np.unsignedinteger]], order: NDArray[np.int64],
+                        same_hash: NDArray[np.bool_]) -> NDArray[np.int64]:
+    """Re-sort the hash runs that hold distinct rows by (run, columns, index)."""
+    run = np.cumsum(np.r_[True, ~same_hash])
+    same = _equal_neighbours(columns, order)
+    bad_runs = np.zeros(int(run[-1]) + 1, dtype=bool)
+    bad_runs[run[1:][same_hash & ~same]] = True
+    pos = np.flatnonzero(bad_runs[run])
+    sub = order[pos]
+    keys = [col[sub] for col in reversed(columns)] + [run[pos]]
+    out = order.copy()
+    out[pos] = sub[np.lexsort(keys)]  # lexsort is stable: index order kept among equal rows
+    return out
 
 
 @dataclass(frozen=True, slots=True)
@@ -74,29 +172,110 @@ class SurfaceTopology:
 
 def surface_topology(faces: NDArray[np.int64], n_vertices: int) -> SurfaceTopology:
     """Count open, unbalanced and non-manifold edges in one sort of the edges."""
-    u = faces.reshape(-1)
-    v = faces[:, [1, 2, 0]].reshape(-1)
-    lo = np.minimum(u, v)
-    hi = np.maximum(u, v)
-    key = lo * np.int64(n_vertices) + hi
-    forward = (u < v).astype(np.int64) * 2 - 1  # +1 if traversed lo->hi
-    order = np.argsort(key, kind="stable")
-    ks = key[order]
-    starts = np.flatnonzero(np.r_[True, ks[1:] != ks[:-1]])
-    counts = np.diff(np.r_[starts, len(ks)])
-    balance = np.add.reduceat(forward[order], starts)
-    face_of = order // 3
-    pair = counts == 2
-    first = starts[pair]
-    edge_faces = np.stack([face_of[first], face_of[first + 1]], axis=1)
-    same = balance[pair] != 0
+    half, forward = _edge_keys(faces, n_vertices)
+    key_bits = max(1, (n_vertices * n_vertices - 1).bit_length())
+    order, starts = _edge_order(half, key_bits)
+    del half
+    m = len(order)
+    counts = np.diff(np.r_[starts, m])
+    fwd = forward[order]
+    del forward
+    balance = 2 * np.add.reduceat(fwd, starts, dtype=np.int64) - counts
+    del fwd
+    first = starts[counts == 2]
+    face_a = order[first] // 3
+    face_b = order[first + 1] // 3
+    edge_faces = np.stack([np.minimum(face_a, face_b), np.maximum(face_a, face_b)], axis=1)
+    same = balance[counts == 2] != 0
     return SurfaceTopology(
         open_edges=int(np.count_nonzero(counts == 1)),
-        unbalanced_edges=int(np.count_nonzero(balance != 0)),
+        unbalanced_edges=int(np.count_nonzero(balance)),
         nonmanifold_edges=int(np.count_nonzero(counts > 2)),
         edge_faces=edge_faces,
         edge_same_direction=same,
     )
+
+
+def _edge_keys(faces: NDArray[np.int64], n_vertices: int) -> tuple[NDArray[np.uint64], NDArray[np.bool_]]:
+    """Undirected key lo * n + hi of each half-edge (face-major) and whether it runs lo -> hi."""
+    u = faces.reshape(-1)
+    v = np.empty_like(faces)
+    v[:, :2] = faces[:, 1:]
+    v[:, 2] = faces[:, 0]
+    v = v.reshape(-1)
+    forward = u < v
+    lo = np.minimum(u, v)
+    np.maximum(u, v, out=v)
+    key = lo.view(np.uint64)
+    key *= np.uint64(n_vertices)
+    key += v.view(np.uint64)
+    return key, forward
+
+
+def _edge_order(key: NDArray[np.uint64], key_bits: int) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
+    """Half-edges sorted by key (ties in index order) and the start of each run of equal key.
+
+    The key and the index are packed into one uint64 and value-sorted; when
+    they need more than 64 bits, the half-edges are first split by the top
+    bits of the key (a radix pass) and each bucket is packed and sorted.
+    """
+    m = len(key)
+    index_bits = max(1, (m - 1).bit_length())
+    spill = key_bits + index_bits - 64
+    if spill <= 0:
+        order, same = _packed_sort(key, index_bits)
+        return order, np.flatnonzero(np.r_[True, ~same])
+    if spill > 16:
+        order = np.argsort(key, kind="stable")
+        ks = key[order]
+        return order, np.flatnonzero(np.r_[True, ks[1:] != ks[:-1]])
+    low_bits = key_bits - spill
+    bucket = (key >> np.uint64(low_bits)).astype(np.uint16)
+    by_bucket = np.argsort(bucket, kind="stable")  # radix sort for 16-bit keys
+    bounds = np.searchsorted(bucket[by_bucket], np.arange((1 << spill) + 1))
+    del bucket
+    order = np.empty(m, dtype=np.int64)
+    starts = []
+    for b0, b1 in zip(bounds[:-1], bounds[1:]):
+        if b1 == b0:
+            continue
+        sub = by_bucket[b0:b1]
+        part = key[sub] & np.uint64((1 << low_bits) - 1)
+        part <<= np.uint64(index_bits)
+        part |= sub.view(np.uint64)
+        part.sort()
+        diff = (part[1:] ^ part[:-1]) >> np.uint64(index_bits)
+        starts.append(b0 + np.flatnonzero(np.r_[True, diff != 0]))
+        part &= np.uint64((1 << index_bits) - 1)
+        order[b0:b1] = part.view(np.int64)
+    return order, np.concatenate(starts)
+
+
+def _components(n: int, a: NDArray[np.int64], b: NDArray[np.int64]) -> tuple[int, NDArray[np.int64]]:
+    """Connected components of the undirected graph on n nodes with edges (a, b).
+
+    Vectorised union-find: every edge hooks the larger of its two roots onto
+    the smaller, then pointer jumping flattens the trees into stars; repeat
+    until no edge joins two roots.  Labels are numbered by the smallest node
+    of each component, as a breadth-first search from node 0 upwards would.
+    """
+    parent = np.arange(n, dtype=np.int64)
+    while True:
+        ra, rb = parent[a], parent[b]
+        join = ra != rb
+        if not np.any(join):
+            break
+        ra, rb = ra[join], rb[join]
+        np.minimum.at(parent, np.maximum(ra, rb), np.minimum(ra, rb))
+        while True:
+            grand = parent[parent]
+            if np.array_equal(grand, parent):
+                break
+            parent = grand
+        a, b = a[join], b[join]
+    roots = parent == np.arange(n)
+    rank = np.cumsum(roots) - 1
+    return int(rank[-1] + 1) if n else 0, rank[parent]
 
 
 def orient_consistently(faces: NDArray[np.int64], topo: SurfaceTopology) -> tuple[NDArray[np.int64], int]:
@@ -107,16 +286,12 @@ def orient_consistently(faces: NDArray[np.int64], topo: SurfaceTopology) -> tupl
     whose two orientations fall in one component lies on a non-orientable
     surface.  Returns the re-wound faces and the number of flipped faces.
     """
-    from scipy.sparse import coo_matrix
-    from scipy.sparse.csgraph import connected_components
-
     n = len(faces)
     f1, f2 = topo.edge_faces[:, 0], topo.edge_faces[:, 1]
     flip = topo.edge_same_direction.astype(np.int64) * n
     rows = np.concatenate([f1, f1 + n])
     cols = np.concatenate([f2 + flip, f2 + n - flip])
-    graph = coo_matrix((np.ones(len(rows), dtype=np.int8), (rows, cols)), shape=(2 * n, 2 * n))
-    _, label = connected_components(graph, directed=False)
+    _, label = _components(2 * n, rows, cols)
     a, b = label[:n], label[n:]
     if np.any(a == b):
         raise NotWatertightError(
@@ -137,11 +312,5 @@ def orient_consistently(faces: NDArray[np.int64], topo: SurfaceTopology) -> tupl
 
 def face_components(faces: NDArray[np.int64], topo: SurfaceTopology) -> tuple[int, NDArray[np.int64]]:
     """Connected components of faces joined across manifold edges."""
-    from scipy.sparse import coo_matrix
-    from scipy.sparse.csgraph import connected_components
-
-    n = len(faces)
     e = topo.edge_faces
-    graph = coo_matrix((np.ones(len(e), dtype=np.int8), (e[:, 0], e[:, 1])), shape=(n, n))
-    count, label = connected_components(graph, directed=False)
-    return int(count), label.astype(np.int64)
+    return _components(len(faces), e[:, 0], e[:, 1])
