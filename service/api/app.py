@@ -1,0 +1,60 @@
+"""``create_app(settings)``: the FastAPI application of API.md."""
+
+from __future__ import annotations
+
+import logging
+import sys
+from collections.abc import AsyncIterator
+from contextlib import asynccontextmanager
+
+from fastapi import Depends, FastAPI
+from fastapi.security import APIKeyHeader
+
+from .compute import ComputePool
+from .errors import install_error_handlers
+from .middleware import AccessLog, Guard
+from .routes import health, v1
+from .settings import Settings
+
+__all__ = ["create_app"]
+
+DESCRIPTION = """Mass properties, principal axes, top classification and torque-free precession of
+rigid bodies, from meshes or point masses. All numbers are SI. Errors always come as
+`{"error": {"code", "message", "details"}}`."""
+
+
+def _configure_logging() -> None:
+    """Give the service's loggers a handler when the host (uvicorn, a test) did not."""
+    logger = logging.getLogger("service")
+    if logger.level == logging.NOTSET:
+        logger.setLevel(logging.INFO)
+    if not logger.handlers and not logging.getLogger().handlers:
+        handler = logging.StreamHandler(sys.stderr)
+        handler.setFormatter(logging.Formatter("%(asctime)s %(levelname)s %(name)s %(message)s"))
+        logger.addHandler(handler)
+
+
+def create_app(settings: Settings | None = None) -> FastAPI:
+    settings = settings or Settings()
+    _configure_logging()
+    pool = ComputePool(settings.compute_processes, settings.timeout_s)
+
+    @asynccontextmanager
+    async def lifespan(app: FastAPI) -> AsyncIterator[None]:
+        await pool.warm_up()
+        try:
+            yield
+        finally:
+            pool.close()
+
+    app = FastAPI(title="inertia", version="1", description=DESCRIPTION, lifespan=lifespan)
+    app.state.settings = settings
+    app.state.pool = pool
+    install_error_handlers(app)
+    # the key is checked by Guard before the body is read; the dependency only documents it
+    security = [Depends(APIKeyHeader(name="X-API-Key", auto_error=False))] if settings.api_key else []
+    app.include_router(health)
+    app.include_router(v1, dependencies=security)
+    app.add_middleware(Guard, settings=settings)
+    app.add_middleware(AccessLog)
+    return app

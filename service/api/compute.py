@@ -1,0 +1,204 @@
+"""A small pool of compute processes with a hard per-job deadline.
+
+Why processes, and why not ``concurrent.futures.ProcessPoolExecutor``: the
+analyses are CPU-bound numpy, so a thread would keep the GIL busy between
+numpy calls and, worse, cannot be stopped; a job past its deadline would go on
+eating a core. ``ProcessPoolExecutor`` cannot stop one running job either
+(killing a worker breaks the whole pool and every other request in it). So
+each job runs in a process of our own; at the deadline that one process is
+killed (the job really stops), the client gets 503 ``timeout``, and a fresh
+process replaces it on the next request. Healthy processes are reused, so the
+usual cost is one pickle of the upload each way, not a process start.
+
+Processes come from the ``forkserver`` start method where it exists (a clean
+single-threaded parent, safe in a threaded server) with the pipeline modules
+preloaded, so a replacement starts in milliseconds.
+
+Deadlines: waiting for a free process is bounded by ``timeout_s``, and the job
+itself by ``timeout_s`` from the moment it is handed over; starting a process
+is not counted.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import logging
+import multiprocessing
+import sys
+import threading
+import traceback
+from collections.abc import Iterator
+from contextlib import contextmanager
+from concurrent.futures import ThreadPoolExecutor
+from multiprocessing.connection import Connection
+from typing import Any
+
+from ..errors import ComputeTimeoutError, ServiceError
+from .jobs import Job, run_job
+
+__all__ = ["ComputePool", "WorkerCrashError"]
+
+log = logging.getLogger("service.api")
+
+PRELOAD = ["service.api.jobs", "service.report", "service.load.stl", "service.load.meshes", "service.motion"]
+KILL_GRACE_S = 5.0  # how long to wait for a killed process to be reaped
+
+
+class WorkerCrashError(RuntimeError):
+    """A compute process died or failed outside the pipeline's own errors."""
+
+
+def _context() -> multiprocessing.context.BaseContext:
+    if "forkserver" in multiprocessing.get_all_start_methods():
+        ctx = multiprocessing.get_context("forkserver")
+        ctx.set_forkserver_preload(PRELOAD)
+        return ctx
+    return multiprocessing.get_context("spawn")
+
+
+def _serve_jobs(conn: Connection) -> None:
+    """Main loop of a compute process: receive a job, send back its outcome."""
+    while True:
+        try:
+            job = conn.recv()
+        except (EOFError, OSError):
+            return
+        try:
+            outcome: tuple[str, Any] = ("ok", run_job(job))
+        except ServiceError as exc:
+            outcome = ("error", exc)
+        except BaseException:  # noqa: BLE001 - reported to the parent, which logs it
+            outcome = ("crash", traceback.format_exc())
+        try:
+            conn.send(outcome)
+        except Exception:  # noqa: BLE001 - e.g. an unpicklable error: report it as a crash
+            conn.send(("crash", traceback.format_exc()))
+
+
+@contextmanager
+def _main_not_rerun() -> Iterator[None]:
+    """Start a child without re-running the parent's ``__main__`` script.
+
+    spawn and forkserver children import the parent's main script unless it
+    was run with ``-m``; the job loop lives in this module and needs none of
+    it, and a script without a ``__main__`` guard (or stdin) would break or
+    start a second server in every worker.
+    """
+    main = sys.modules.get("__main__")
+    hidden = main is not None and getattr(main, "__spec__", None) is None and hasattr(main, "__file__")
+    if hidden:
+        path = main.__file__  # type: ignore[union-attr]
+        del main.__file__  # type: ignore[union-attr]
+    try:
+        yield
+    finally:
+        if hidden:
+            main.__file__ = path  # type: ignore[union-attr]
+
+
+_START_LOCK = threading.Lock()
+
+
+class _Worker:
+    def __init__(self, ctx: multiprocessing.context.BaseContext) -> None:
+        parent, child = ctx.Pipe()
+        self.process = ctx.Process(target=_serve_jobs, args=(child,), daemon=True, name="inertia-compute")
+        with _START_LOCK, _main_not_rerun():
+            self.process.start()
+        child.close()
+        self.conn = parent
+
+    def call(self, job: Job) -> tuple[str, Any]:
+        try:
+            self.conn.send(job)
+            return self.conn.recv()  # type: ignore[no-any-return]
+        except (EOFError, OSError) as exc:
+            self.conn.close()
+            raise WorkerCrashError(f"compute process exited with code {self.process.exitcode}") from exc
+
+    def kill(self) -> None:
+        if self.process.is_alive():
+            self.process.kill()
+        self.process.join(KILL_GRACE_S)
+
+
+class ComputePool:
+    """At most ``size`` jobs at once, each in its own reusable process."""
+
+    def __init__(self, size: int, timeout_s: float) -> None:
+        self.size = size
+        self.timeout_s = timeout_s
+        self._ctx = _context()
+        self._idle: list[_Worker] = []
+        self._lock = threading.Lock()
+        self._slots: tuple[asyncio.AbstractEventLoop, asyncio.Semaphore] | None = None
+        # one thread per job in flight blocks on its pipe; extra room for spawns and killed jobs' threads
+        self._threads = ThreadPoolExecutor(max_workers=2 * size + 2, thread_name_prefix="inertia-pipe")
+
+    async def warm_up(self) -> None:
+        """Start the fork server and one process, so the first request does not wait for imports."""
+        loop = asyncio.get_running_loop()
+        worker = await loop.run_in_executor(self._threads, _Worker, self._ctx)
+        self._release(worker)
+
+    async def run(self, job: Job) -> dict[str, Any]:
+        """The job's result; its ``ServiceError``, ``ComputeTimeoutError`` or ``WorkerCrashError``."""
+        slots = self._slots_of(asyncio.get_running_loop())
+        try:
+            await asyncio.wait_for(slots.acquire(), self.timeout_s)
+        except TimeoutError:
+            raise self._timeout("the server is busy; no compute process became free") from None
+        try:
+            return await self._run_in_worker(job)
+        finally:
+            slots.release()
+
+    def _slots_of(self, loop: asyncio.AbstractEventLoop) -> asyncio.Semaphore:
+        # a semaphore belongs to one event loop; a server has one, test clients may make several
+        if self._slots is None or self._slots[0] is not loop:
+            self._slots = (loop, asyncio.Semaphore(self.size))
+        return self._slots[1]
+
+    async def _run_in_worker(self, job: Job) -> dict[str, Any]:
+        loop = asyncio.get_running_loop()
+        worker = await loop.run_in_executor(self._threads, self._acquire)
+        try:
+            status, payload = await asyncio.wait_for(loop.run_in_executor(self._threads, worker.call, job),
+                                                     self.timeout_s)
+        except TimeoutError:
+            await loop.run_in_executor(self._threads, worker.kill)
+            raise self._timeout("the computation took too long and was stopped") from None
+        except BaseException:
+            await asyncio.shield(loop.run_in_executor(self._threads, worker.kill))
+            raise
+        self._release(worker)
+        if status == "ok":
+            return payload  # type: ignore[no-any-return]
+        if status == "error":
+            raise payload
+        raise WorkerCrashError(f"compute process failed:\n{payload}")
+
+    def _timeout(self, what: str) -> ComputeTimeoutError:
+        return ComputeTimeoutError(f"{what} (limit {self.timeout_s:g} s); send a smaller input or "
+                                   "raise INERTIA_TIMEOUT_S", timeout_s=self.timeout_s)
+
+    def _acquire(self) -> _Worker:
+        with self._lock:
+            while self._idle:
+                worker = self._idle.pop()
+                if worker.process.is_alive():
+                    return worker
+                worker.kill()
+        return _Worker(self._ctx)
+
+    def _release(self, worker: _Worker) -> None:
+        with self._lock:
+            self._idle.append(worker)
+
+    def close(self) -> None:
+        with self._lock:
+            idle, self._idle = self._idle, []
+        for worker in idle:
+            worker.conn.close()
+            worker.kill()
+        self._threads.shutdown(wait=False, cancel_futures=True)

@@ -1,0 +1,113 @@
+"""One table from error class to HTTP status, and one handler for every failure.
+
+Everything a client can get wrong, and everything that goes wrong inside,
+leaves as the contract's envelope
+``{"error": {"code": ..., "message": ..., "details": {...}}}``.
+"""
+
+from __future__ import annotations
+
+import logging
+from typing import Any
+
+from fastapi import FastAPI, Request
+from fastapi.exceptions import RequestValidationError
+from starlette.exceptions import HTTPException
+from starlette.responses import JSONResponse
+
+from ..errors import (
+    ComputeTimeoutError,
+    DegenerateBodyError,
+    InvalidMeshError,
+    InvalidParameterError,
+    LoadError,
+    PayloadTooLargeError,
+    ServiceError,
+    UnauthorizedError,
+    UnsupportedFormatError,
+)
+
+__all__ = ["STATUS", "error_response", "install_error_handlers", "status_of"]
+
+log = logging.getLogger("service.api")
+
+# most specific class first is not needed: the lookup walks the class's MRO
+STATUS: dict[type[ServiceError], int] = {
+    UnsupportedFormatError: 415,
+    LoadError: 422,
+    InvalidMeshError: 422,
+    DegenerateBodyError: 422,
+    InvalidParameterError: 422,
+    PayloadTooLargeError: 413,
+    UnauthorizedError: 401,
+    ComputeTimeoutError: 503,
+    ServiceError: 500,
+}
+
+# framework errors that are not ServiceErrors: status -> code
+_HTTP_CODES = {401: "unauthorized", 404: "not_found", 405: "method_not_allowed", 413: "payload_too_large"}
+
+
+def status_of(exc: ServiceError) -> int:
+    return next(STATUS[cls] for cls in type(exc).__mro__ if cls in STATUS)
+
+
+def error_response(exc: ServiceError) -> JSONResponse:
+    return JSONResponse(exc.as_dict(), status_code=status_of(exc))
+
+
+def _envelope(status: int, code: str, message: str, **details: Any) -> JSONResponse:
+    return JSONResponse({"error": {"code": code, "message": message, "details": details}}, status_code=status)
+
+
+def _where(loc: tuple[Any, ...]) -> str:
+    if not loc:
+        return "request"
+    if loc[0] == "body" and len(loc) == 1:
+        return "request body"
+    path = ".".join(str(part) for part in loc[1:]) or str(loc[0])
+    return f"{loc[0]} field {path!r}" if loc[0] in ("body", "query") else path
+
+
+def invalid_request(exc: RequestValidationError) -> InvalidParameterError:
+    """A schema failure as ``invalid_parameter``, naming the first bad field."""
+    errors = [{"loc": [str(p) if not isinstance(p, int) else p for p in e.get("loc", ())],
+               "msg": str(e.get("msg", "")), "type": str(e.get("type", ""))} for e in exc.errors()]
+    first = errors[0] if errors else {"loc": [], "msg": "invalid request"}
+    message = f"{_where(tuple(first['loc']))}: {first['msg']}; fix it and send the request again"
+    parameter = str(first["loc"][-1]) if first["loc"] else None
+    return InvalidParameterError(message, parameter=parameter, errors=errors)
+
+
+async def _service_error(request: Request, exc: Exception) -> JSONResponse:
+    assert isinstance(exc, ServiceError)
+    if status_of(exc) >= 500:
+        log.error("internal error on %s %s: %s", request.method, request.url.path, exc.message)
+    return error_response(exc)
+
+
+async def _validation_error(request: Request, exc: Exception) -> JSONResponse:
+    assert isinstance(exc, RequestValidationError)
+    return error_response(invalid_request(exc))
+
+
+async def _http_error(request: Request, exc: Exception) -> JSONResponse:
+    assert isinstance(exc, HTTPException)
+    if exc.status_code == 400:  # FastAPI could not parse the body (bad JSON or multipart)
+        return _envelope(422, "invalid_parameter", f"{exc.detail}; send well-formed JSON or multipart data")
+    code = _HTTP_CODES.get(exc.status_code, "http_error")
+    return JSONResponse({"error": {"code": code, "message": str(exc.detail), "details": {}}},
+                        status_code=exc.status_code, headers=exc.headers)
+
+
+async def _unexpected_error(request: Request, exc: Exception) -> JSONResponse:
+    log.error("unexpected error on %s %s", request.method, request.url.path, exc_info=exc)
+    return _envelope(500, "internal_error", "the server failed unexpectedly; the error was logged, "
+                     "please report it with the input that caused it")
+
+
+def install_error_handlers(app: FastAPI) -> None:
+    app.add_exception_handler(ServiceError, _service_error)
+    app.add_exception_handler(RequestValidationError, _validation_error)
+    app.add_exception_handler(HTTPException, _http_error)
+    app.add_exception_handler(Exception, _unexpected_error)

@@ -1,0 +1,33 @@
+"""Server configuration from the environment (``INERTIA_*``), read once per app."""
+
+from __future__ import annotations
+
+import os
+
+from pydantic import Field
+from pydantic_settings import BaseSettings, SettingsConfigDict
+
+__all__ = ["Settings", "MIB"]
+
+MIB = 1024 * 1024
+
+
+def _default_processes() -> int:
+    # one compute process per core: the work is CPU-bound numpy
+    return max(1, os.cpu_count() or 1)
+
+
+class Settings(BaseSettings):
+    """Limits and access control of one server process.
+
+    ``timeout_s`` bounds the compute of one request (one file of a batch),
+    and separately the wait for a free compute process.
+    """
+
+    model_config = SettingsConfigDict(env_prefix="INERTIA_", extra="ignore", frozen=True)
+
+    max_upload_bytes: int = Field(512 * MIB, gt=0, description="largest request body accepted [bytes]")
+    timeout_s: float = Field(120.0, gt=0, allow_inf_nan=False, description="compute limit per request [s]")
+    api_key: str | None = Field(None, description="when set, /v1/ needs the header X-API-Key with this value")
+    compute_processes: int = Field(default_factory=_default_processes, gt=0,
+                                   description="worker processes that run the analyses")
