@@ -296,3 +296,8 @@ def test_results_are_bit_identical_across_processes(tmp_path) -> None:  # noqa: 
     outs = {subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT, check=True).stdout
             for _ in range(2)}
     assert len(outs) == 1
+
+
+def test_single_point_mass_has_no_rotational_inertia() -> None:
+    with pytest.raises(InvalidParameterError):
+        mass_properties(PointBody(np.array([2.0]), np.array([[1.0, 2.0, 3.0]])))
