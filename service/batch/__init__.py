@@ -20,10 +20,10 @@ from typing import TYPE_CHECKING, Any
 if TYPE_CHECKING:
     from .runner import BatchSummary
 
-__all__ = ["run_batch", "run_batch_cli", "BatchSummary"]
+__all__ = ["BatchSummary", "run_batch", "run_batch_cli"]
 
 
-def run_batch(*args: Any, **kwargs: Any) -> "BatchSummary":
+def run_batch(*args: Any, **kwargs: Any) -> BatchSummary:
     """See :func:`service.batch.runner.run_batch`."""
     from .runner import run_batch as _run_batch
 

@@ -32,7 +32,7 @@ from .sinks import done_names, open_sink, output_format
 from .sources import Source, list_sources
 from .tasks import InternalError, analyze_sources
 
-__all__ = ["BatchSummary", "run_batch", "local_cluster", "connect"]
+__all__ = ["BatchSummary", "connect", "local_cluster", "run_batch"]
 
 # A task groups files until it holds this much input: ~0.1 s of analysis at
 # the pipeline's ~40 MB/s, far above Dask's ~1 ms of overhead per task.
@@ -120,15 +120,19 @@ def run_batch(
     done = done_names(out) if resume else set()
     pending = [s for s in sources if s.name not in done]
     skipped = len(sources) - len(pending)
-    owned = None
-    if client is None:
-        client, owned = connect(scheduler, workers)
-    try:
+    if not pending:  # nothing to do: no cluster, but the output exists as for any run
+        open_sink(out, resume).close()
+        errors = 0
+    elif client is not None:
         errors = _run(client, pending, options, out, resume, progress)
-    finally:
-        if owned is not None:
+    else:
+        client, cluster = connect(scheduler, workers)
+        try:
+            errors = _run(client, pending, options, out, resume, progress)
+        finally:
             client.close()
-            owned.close()
+            if cluster is not None:
+                cluster.close()
     return BatchSummary(len(pending), errors, skipped, time.perf_counter() - start, out)
 
 
@@ -177,7 +181,7 @@ def _rows(future: Any, group: list[Source], resubmit: Callable[[list[Source]], N
     try:
         rows: list[dict[str, Any]] = future.result()
         return rows
-    except Exception as exc:  # KilledWorker, a lost connection, ...: not the file's fault, usually
+    except Exception as exc:  # noqa: BLE001  KilledWorker, lost connection: rarely the file's fault
         if len(group) > 1:
             for src in group:
                 resubmit([src])
@@ -212,7 +216,7 @@ def _groups(sources: list[Source], threads: int) -> Iterator[list[Source]]:
 
 def _progress_bar(total: int, enabled: bool) -> Any:
     try:
-        from tqdm import tqdm
+        from tqdm import tqdm  # type: ignore[import-untyped,unused-ignore]
     except ImportError as exc:
         if enabled:
             raise InvalidParameterError(

@@ -23,7 +23,7 @@ from typing import IO, Any, Protocol
 from ..errors import InvalidParameterError
 from .rows import COLUMNS, FLOAT_COLUMNS, flat_row, row_name
 
-__all__ = ["Sink", "open_sink", "done_names", "OUTPUT_FORMATS"]
+__all__ = ["OUTPUT_FORMATS", "Sink", "done_names", "open_sink"]
 
 OUTPUT_FORMATS = {".jsonl": "jsonl", ".ndjson": "jsonl", ".csv": "csv", ".parquet": "parquet"}
 PARQUET_ROW_GROUP = 4096  # rows per Parquet row group: ~1 MB of columns, few enough groups to read fast
@@ -50,8 +50,8 @@ def output_format(path: str) -> str:
 
 def _pyarrow() -> Any:
     try:
-        import pyarrow
-        import pyarrow.parquet
+        import pyarrow  # type: ignore[import-untyped,unused-ignore]
+        import pyarrow.parquet  # type: ignore[import-untyped,unused-ignore]
     except ImportError as exc:
         raise InvalidParameterError(
             "Parquet output needs pyarrow: pip install 'inertia-service[parquet]'", parameter="out"
@@ -142,7 +142,7 @@ def open_sink(path: str, append: bool) -> Sink:
 
 class JsonlSink:
     def __init__(self, path: str, append: bool) -> None:
-        self._fh = open(path, "a" if append else "w", encoding="utf-8")
+        self._fh = open(path, "a" if append else "w", encoding="utf-8")  # noqa: SIM115  closed by close()
 
     def write(self, row: dict[str, Any]) -> None:
         # allow_nan=False: the contract never sends NaN, so one here is a bug to see
@@ -155,7 +155,7 @@ class JsonlSink:
 
 class CsvSink:
     def __init__(self, path: str, append: bool) -> None:
-        self._fh = open(path, "a" if append else "w", encoding="utf-8", newline="")
+        self._fh = open(path, "a" if append else "w", encoding="utf-8", newline="")  # noqa: SIM115
         self._writer = csv.DictWriter(self._fh, fieldnames=COLUMNS)
         if not append:
             self._writer.writeheader()

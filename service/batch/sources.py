@@ -37,13 +37,13 @@ from ..errors import InvalidParameterError, UnreadableFileError
 from ..load.sniff import FORMATS
 
 __all__ = [
-    "Source",
     "KNOWN_EXTENSIONS",
+    "Source",
     "is_known_file",
-    "list_sources",
-    "read_source",
     "iter_inputs",
     "iter_zip_bytes",
+    "list_sources",
+    "read_source",
 ]
 
 # mesh formats (points files are JSON/CSV, too generic to pick up from a folder)
@@ -98,7 +98,7 @@ def _is_url(path: str) -> bool:
 
 def _fs(url: str) -> tuple[Any, str]:
     try:
-        from fsspec.core import url_to_fs
+        from fsspec.core import url_to_fs  # type: ignore[import-untyped,unused-ignore]
     except ImportError as exc:
         raise InvalidParameterError(
             f"reading {url!r} needs fsspec: pip install 'inertia-service[batch]'", parameter="paths"

@@ -1,0 +1,88 @@
+"""Helpers of the batch tests: a generated part library and row comparisons."""
+
+from __future__ import annotations
+
+import json
+import struct
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+# Outward-wound box; vertex k has bits (x, y, z) = (k&1, k&2, k&4).
+BOX_FACES = np.array([[0, 2, 1], [1, 2, 3], [4, 5, 6], [5, 7, 6], [0, 1, 4], [1, 5, 4],
+                      [2, 6, 3], [3, 6, 7], [0, 4, 2], [2, 4, 6], [1, 3, 5], [3, 7, 5]])
+N_FILES = 50
+BROKEN = {"broken/truncated.stl": "unreadable_file", "broken/open_box.stl": "not_watertight",
+          "broken/garbage.stl": "unreadable_file"}
+
+
+def box(size: tuple[float, float, float], angle: float, offset: tuple[float, float, float]) -> np.ndarray:
+    """Triangles (n, 3, 3) of a box rotated by ``angle`` about (1, 1, 1) and moved by ``offset``."""
+    a, b, c = size
+    v = np.array([[(k & 1) * a, ((k >> 1) & 1) * b, ((k >> 2) & 1) * c] for k in range(8)])
+    axis = np.ones(3) / np.sqrt(3.0)
+    k = np.array([[0, -axis[2], axis[1]], [axis[2], 0, -axis[0]], [-axis[1], axis[0], 0]])
+    rot = np.eye(3) + np.sin(angle) * k + (1 - np.cos(angle)) * k @ k  # Rodrigues
+    return (v @ rot.T + np.asarray(offset))[BOX_FACES]
+
+
+def stl_bytes(tri: np.ndarray) -> bytes:
+    rec = np.zeros(len(tri), dtype=[("n", "<f4", (3,)), ("v", "<f4", (3, 3)), ("a", "<u2")])
+    rec["v"] = tri.astype("<f4")
+    return b"batch test".ljust(80, b" ") + struct.pack("<I", len(tri)) + rec.tobytes()
+
+
+def obj_text(tri: np.ndarray) -> str:
+    lines = [f"v {x!r} {y!r} {z!r}" for x, y, z in tri.reshape(-1, 3).tolist()]
+    lines += [f"f {3 * i + 1} {3 * i + 2} {3 * i + 3}" for i in range(len(tri))]
+    return "\n".join(lines) + "\n"
+
+
+def make_library(root: Path) -> dict[str, str | None]:
+    """Write 50 inputs under ``root``; returns name -> expected error code (None: fine)."""
+    rng = np.random.default_rng(7)
+    expected: dict[str, str | None] = {}
+    folders = ["", "a/", "b/c/", "objs/"]
+    for i in range(N_FILES - len(BROKEN)):
+        folder = folders[i % len(folders)]
+        size = tuple(float(x) for x in rng.uniform(0.01, 2.0, 3))
+        tri = box(size, float(rng.uniform(0, np.pi)), tuple(float(x) for x in rng.uniform(-50, 50, 3)))
+        name = f"{folder}part_{i:02d}." + ("obj" if folder == "objs/" else "stl")
+        path = root / name
+        path.parent.mkdir(parents=True, exist_ok=True)
+        if name.endswith(".obj"):
+            path.write_text(obj_text(tri))
+        else:
+            path.write_bytes(stl_bytes(tri))
+        expected[name] = None
+    (root / "broken").mkdir()
+    good = stl_bytes(box((1.0, 2.0, 3.0), 0.3, (0.0, 0.0, 0.0)))
+    (root / "broken/truncated.stl").write_bytes(good[: 84 + 50 * 6 + 17])
+    (root / "broken/open_box.stl").write_bytes(stl_bytes(box((1.0, 2.0, 3.0), 0.3, (0.0, 0.0, 0.0))[:10]))
+    (root / "broken/garbage.stl").write_bytes(rng.bytes(777))
+    expected.update(BROKEN)
+    # not inputs: unknown extension, hidden file, hidden folder, macOS resource fork
+    (root / "notes.txt").write_text("not a mesh")
+    (root / ".hidden.stl").write_bytes(good)
+    (root / ".cache").mkdir()
+    (root / ".cache/x.stl").write_bytes(good)
+    (root / "a/._part_01.stl").write_bytes(b"resource fork")
+    return expected
+
+
+def read_jsonl(path: Path) -> list[dict[str, Any]]:
+    return [json.loads(line) for line in path.read_text().splitlines()]
+
+
+def without_timing(row: dict[str, Any]) -> dict[str, Any]:
+    """A result row minus its run time, the one field that differs between runs."""
+    out = json.loads(json.dumps(row))
+    out.get("diagnostics", {}).pop("elapsed_s", None)
+    return out
+
+
+def by_name(rows: list[dict[str, Any]]) -> dict[str, dict[str, Any]]:
+    out = {r["source"]["filename"]: without_timing(r) for r in rows}
+    assert len(out) == len(rows), "duplicate names in the output"
+    return out

@@ -1,0 +1,148 @@
+"""Inputs and failures of ``inertia batch`` that need no cluster: naming, listing, errors, imports."""
+
+from __future__ import annotations
+
+import io
+import json
+import subprocess
+import sys
+import zipfile
+from pathlib import Path
+from typing import Any
+
+import pytest
+from batchlib import N_FILES, box, stl_bytes
+
+from service.batch import runner
+from service.batch.sources import Source, iter_inputs, iter_zip_bytes, list_sources, read_source
+from service.batch.tasks import analyze_source, analyze_sources
+from service.cli import main
+from service.errors import UnreadableFileError
+from service.pipeline import AnalysisOptions
+
+Library = tuple[Path, dict[str, "str | None"]]
+
+
+def test_a_folder_lists_known_files_by_relative_path(library: Library) -> None:
+    names = [s.name for s in list_sources([str(library[0])])]
+    assert sorted(names) == sorted(library[1])
+    assert len(names) == N_FILES
+
+
+def test_a_file_given_by_itself_is_named_by_its_base_name(library: Library) -> None:
+    (src,) = list_sources([str(library[0] / "b/c/part_02.stl")])
+    assert src.name == "part_02.stl" and src.member is None and src.size == 84 + 12 * 50
+
+
+def test_the_same_file_twice_is_one_input_and_clashing_names_stay_unique(library: Library, tmp_path: Path) -> None:
+    other = tmp_path / "part_02.stl"
+    other.write_bytes(stl_bytes(box((1.0, 1.0, 1.0), 0.0, (0.0, 0.0, 0.0))))
+    first = str(library[0] / "b/c/part_02.stl")
+    sources = list_sources([first, first, str(other)])
+    assert [s.name for s in sources] == ["part_02.stl", str(other)]
+
+
+def test_a_missing_path_fails_before_any_work(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    code = main(["batch", str(tmp_path / "nope"), "--out", str(tmp_path / "o.jsonl"), "--no-progress"])
+    assert code == 2
+    err = json.loads(capsys.readouterr().err)["error"]
+    assert err["code"] == "invalid_parameter" and "no such file or folder" in err["message"]
+
+
+def test_an_unknown_output_extension_is_invalid_parameter(library: Library, tmp_path: Path,
+                                                          capsys: pytest.CaptureFixture[str]) -> None:
+    code = main(["batch", str(library[0]), "--out", str(tmp_path / "o.xlsx"), "--no-progress"])
+    assert code == 2
+    assert ".jsonl, .csv or .parquet" in json.loads(capsys.readouterr().err)["error"]["message"]
+
+
+@pytest.mark.parametrize(("module", "out", "hint"), [
+    ("distributed", "o.jsonl", "pip install 'inertia-service[batch]'"),
+    ("pyarrow", "o.parquet", "pip install 'inertia-service[parquet]'"),
+])
+def test_a_missing_extra_says_what_to_install(module: str, out: str, hint: str, library: Library, tmp_path: Path,
+                                              monkeypatch: pytest.MonkeyPatch,
+                                              capsys: pytest.CaptureFixture[str]) -> None:
+    monkeypatch.setitem(sys.modules, module, None)  # import raises ImportError
+    code = main(["batch", str(library[0]), "--out", str(tmp_path / out), "--no-progress"])
+    assert code == 2
+    err = json.loads(capsys.readouterr().err)["error"]
+    assert err["code"] == "invalid_parameter" and hint in err["message"]
+
+
+def test_importing_the_service_and_the_sources_imports_no_dask() -> None:
+    code = ("import sys, service, service.cli, service.batch, service.batch.sources; "
+            "bad = [m for m in ('dask', 'distributed', 'tqdm', 'pyarrow', 'fsspec') if m in sys.modules]; "
+            "assert not bad, bad")
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=False)
+    assert done.returncode == 0, done.stderr
+
+
+def test_iter_inputs_yields_names_and_bytes(library: Library) -> None:
+    pairs = dict(iter_inputs([str(library[0])]))
+    assert len(pairs) == N_FILES
+    assert pairs["a/part_01.stl"] == (library[0] / "a/part_01.stl").read_bytes()
+
+
+def test_iter_zip_bytes_skips_folders_and_unknown_members() -> None:
+    buf = io.BytesIO()
+    with zipfile.ZipFile(buf, "w") as zf:
+        zf.writestr("x/box.stl", b"solid")
+        zf.writestr("x/readme.md", b"hi")
+        zf.writestr("__MACOSX/x/._box.stl", b"fork")
+    assert [n for n, _ in iter_zip_bytes(buf.getvalue(), "up.zip")] == ["up.zip/x/box.stl"]
+    with pytest.raises(UnreadableFileError):
+        list(iter_zip_bytes(b"not a zip"))
+
+
+def test_a_file_that_vanished_becomes_an_unreadable_row(tmp_path: Path) -> None:
+    with pytest.raises(UnreadableFileError):
+        read_source(Source("gone.stl", str(tmp_path / "gone.stl")))
+    row = analyze_source(Source("gone.stl", str(tmp_path / "gone.stl")), AnalysisOptions())
+    assert row["source"] == {"filename": "gone.stl"} and row["error"]["code"] == "unreadable_file"
+
+
+def test_a_broken_zip_in_a_folder_is_one_error_row(tmp_path: Path) -> None:
+    (tmp_path / "bad.zip").write_bytes(b"PK not really")
+    (src,) = list_sources([str(tmp_path)])
+    (row,) = analyze_sources([src], AnalysisOptions())
+    assert row["error"]["code"] == "unreadable_file" and "zip" in row["error"]["message"]
+
+
+def test_an_unexpected_exception_is_an_internal_error_row(monkeypatch: pytest.MonkeyPatch, tmp_path: Path) -> None:
+    path = tmp_path / "b.stl"
+    path.write_bytes(stl_bytes(box((1.0, 1.0, 1.0), 0.0, (0.0, 0.0, 0.0))))
+
+    def boom(*args: Any, **kwargs: Any) -> None:
+        raise ZeroDivisionError("oops")
+
+    monkeypatch.setattr("service.batch.tasks.analyze", boom)
+    rows = analyze_sources([Source("b.stl", str(path)), Source("c.stl", str(path))], AnalysisOptions())
+    assert [r["error"]["code"] for r in rows] == ["internal_error", "internal_error"]
+    assert "ZeroDivisionError" in rows[0]["error"]["message"]
+
+
+def test_groups_hold_many_small_files_or_one_large_one() -> None:
+    small = [Source(f"s{i}.stl", f"/s{i}", None, 1000) for i in range(1000)]
+    groups = list(runner._groups(small, threads=2))
+    assert all(len(g) == runner.TASK_FILES for g in groups[:-1])
+    assert sum(map(len, groups)) == 1000
+    few = [Source(f"s{i}.stl", f"/s{i}", None, 1000) for i in range(20)]
+    assert max(map(len, runner._groups(few, threads=2))) == 2  # enough tasks to keep both workers busy
+    large = [Source(f"l{i}.stl", f"/l{i}", None, runner.TASK_BYTES) for i in range(3)]
+    assert [len(g) for g in runner._groups(large, threads=2)] == [1, 1, 1]
+
+
+class _FailedFuture:
+    def result(self) -> None:
+        raise RuntimeError("KilledWorker: worker died")
+
+
+def test_a_task_whose_worker_died_is_split_into_single_files() -> None:
+    group = [Source("a.stl", "/a"), Source("b.stl", "/b")]
+    again: list[list[Source]] = []
+    assert runner._rows(_FailedFuture(), group, again.append) == []
+    assert again == [[group[0]], [group[1]]]
+    (row,) = runner._rows(_FailedFuture(), [group[0]], again.append)
+    assert row["source"] == {"filename": "a.stl"} and row["error"]["code"] == "internal_error"
+    assert "more memory" in row["error"]["message"]
