@@ -93,10 +93,12 @@ async def _validation_error(request: Request, exc: Exception) -> JSONResponse:
 
 async def _http_error(request: Request, exc: Exception) -> JSONResponse:
     assert isinstance(exc, HTTPException)
+    detail = str(exc.detail).rstrip(".")
     if exc.status_code == 400:  # FastAPI could not parse the body (bad JSON or multipart)
-        return _envelope(422, "invalid_parameter", f"{exc.detail}; send well-formed JSON or multipart data")
+        return _envelope(422, "invalid_parameter", f"{detail}; send well-formed JSON or multipart data")
     code = _HTTP_CODES.get(exc.status_code, "http_error")
-    return JSONResponse({"error": {"code": code, "message": str(exc.detail), "details": {}}},
+    message = f"{detail}: {request.method} {request.url.path}; see /docs for the endpoints"
+    return JSONResponse({"error": {"code": code, "message": message, "details": {}}},
                         status_code=exc.status_code, headers=exc.headers)
 
 
