@@ -1,0 +1,177 @@
+"""Correctness of the fast paths: float32 STL weld, packed sorts, union-find, SoA kernel.
+
+No timings here; ``benchmarks/mass.py`` measures speed.  Each test pins a
+property the optimisations could break: exact welding (-0.0 equals 0.0,
+distinct points never merge, also when every hash collides), identical
+topology on every sort path, scipy-equal components, and integration
+results that do not depend on the block size beyond the error estimate.
+"""
+
+from __future__ import annotations
+
+import struct
+
+import numpy as np
+import pytest
+
+import service.mass as mass
+import service.topology as topology
+from service.body import MeshBody
+from service.load.stl import read_stl
+
+from exact import exact_moments, relative_error
+
+
+def _binary_stl(triangles: np.ndarray) -> bytes:
+    rec = np.zeros(len(triangles), dtype=[("n", "<f4", (3,)), ("v", "<f4", (3, 3)), ("a", "<u2")])
+    rec["v"] = triangles
+    return b"\0" * 80 + struct.pack("<I", len(triangles)) + rec.tobytes()
+
+
+def _torus(nu: int, nv: int) -> tuple[np.ndarray, np.ndarray]:
+    u, v = np.meshgrid(2 * np.pi * np.arange(nu) / nu, 2 * np.pi * np.arange(nv) / nv, indexing="ij")
+    ring = 3.0 + np.cos(v)
+    pts = np.stack([ring * np.cos(u), ring * np.sin(u), np.sin(v)], -1).reshape(-1, 3).astype(np.float32)
+    i, j = np.meshgrid(np.arange(nu), np.arange(nv), indexing="ij")
+    a, b = i * nv + j, (i + 1) % nu * nv + j
+    c, d = (i + 1) % nu * nv + (j + 1) % nv, i * nv + (j + 1) % nv
+    faces = np.concatenate([np.stack([a, b, c], -1).reshape(-1, 3), np.stack([a, c, d], -1).reshape(-1, 3)])
+    return pts.astype(np.float64), faces
+
+
+TETRA = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]], dtype=np.float64)
+TETRA_FACES = np.array([[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]])
+
+
+def test_stl_weld_merges_negative_zero_with_zero() -> None:
+    tri = TETRA[TETRA_FACES].astype(np.float32)
+    tri[0, 0] = [-0.0, -0.0, 0.0]  # the origin, written once with negative zeros
+    tri[2, 0] = [0.0, -0.0, -0.0]
+    vertices, faces = read_stl(_binary_stl(tri))
+    assert vertices.shape == (4, 3)
+    np.testing.assert_array_equal(vertices[faces], TETRA[TETRA_FACES])
+    assert not np.any(np.signbit(vertices))
+
+
+def test_stl_weld_keeps_points_one_ulp_apart_and_numbers_by_first_appearance() -> None:
+    tri = TETRA[TETRA_FACES].astype(np.float32)
+    tri[3, 2, 2] = np.nextafter(np.float32(1.0), np.float32(2.0))  # a fifth, distinct point
+    vertices, faces = read_stl(_binary_stl(tri))
+    assert len(vertices) == 5
+    np.testing.assert_array_equal(vertices[faces], tri.astype(np.float64))
+    first = [int(np.flatnonzero(faces.ravel() == k)[0]) for k in range(len(vertices))]
+    assert first == sorted(first)
+
+
+@pytest.mark.parametrize("degraded_hash", [lambda h: h & np.uint64(0), lambda h: h & np.uint64(3)],
+                         ids=["every-row-collides", "two-bit-hash"])
+def test_row_ids_exact_when_hashes_collide(monkeypatch: pytest.MonkeyPatch, degraded_hash) -> None:
+    rng = np.random.default_rng(7)
+    rows = rng.integers(0, 5, size=(3000, 3)).astype(np.uint32)  # ~125 distinct rows, many repeats
+    cols = [rows[:, 0], rows[:, 1], rows[:, 2]]
+    honest = topology.row_ids(cols)
+    real_hash = topology._row_hash
+    monkeypatch.setattr(topology, "_row_hash", lambda c: degraded_hash(real_hash(c)))
+    ids, heads = topology.row_ids(cols)
+    _, first, inverse = np.unique(rows, axis=0, return_index=True, return_inverse=True)
+    expected_heads = np.sort(first)
+    renumber = np.argsort(np.argsort(first))  # groups numbered by first occurrence
+    np.testing.assert_array_equal(heads, expected_heads)
+    np.testing.assert_array_equal(ids, renumber[inverse.ravel()])
+    np.testing.assert_array_equal(ids, honest[0])
+    np.testing.assert_array_equal(rows[heads][ids], rows)
+
+
+def test_weld_of_welded_mesh_returns_the_same_arrays() -> None:
+    v, f = _torus(12, 8)
+    welded_v, welded_f = topology.weld(v, f)
+    assert welded_v is v and welded_f is f
+
+
+def test_weld_float64_merges_bit_identical_rows_only() -> None:
+    v, f = _torus(12, 8)
+    corners = v[f].reshape(-1, 3).copy()
+    corners[0] = -0.0 * corners[0] if not corners[0].any() else corners[0]
+    corners[5, 0] = np.nextafter(corners[5, 0], np.inf)
+    wv, wf = topology.weld(corners, np.arange(len(corners)).reshape(-1, 3))
+    np.testing.assert_array_equal(wv[wf].reshape(-1, 3), corners)
+    assert len(wv) == len(v) + 1
+
+
+@pytest.mark.parametrize("key_bits", [30, 60, 64])
+def test_edge_sort_paths_agree(key_bits: int) -> None:
+    """Packed sort, bucketed packed sort and the argsort fallback order edges alike."""
+    v, f = _torus(40, 25)
+    key, _ = topology._edge_keys(f, len(v))
+    reference = np.argsort(key, kind="stable")
+    order, starts = topology._edge_order(key.copy(), key_bits + 20)
+    np.testing.assert_array_equal(order, reference)
+    ks = key[reference]
+    np.testing.assert_array_equal(starts, np.flatnonzero(np.r_[True, ks[1:] != ks[:-1]]))
+
+
+def test_surface_topology_counts_open_and_flipped_edges() -> None:
+    v, f = _torus(10, 6)
+    closed = topology.surface_topology(f, len(v))
+    assert (closed.open_edges, closed.unbalanced_edges, closed.nonmanifold_edges) == (0, 0, 0)
+    assert len(closed.edge_faces) == 3 * len(f) // 2 and not closed.edge_same_direction.any()
+    flipped = f.copy()
+    flipped[5] = flipped[5, [0, 2, 1]]  # face 0 keeps its winding, so only face 5 flips back
+    topo = topology.surface_topology(flipped, len(v))
+    assert (topo.open_edges, topo.unbalanced_edges, int(topo.edge_same_direction.sum())) == (0, 3, 3)
+    repaired, count = topology.orient_consistently(flipped, topo)
+    assert count == 1 and topology.surface_topology(repaired, len(v)).closed
+    opened = topology.surface_topology(f[1:], len(v))
+    assert opened.open_edges == 3
+
+
+def test_components_match_scipy_labels() -> None:
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    rng = np.random.default_rng(3)
+    n = 2000
+    a, b = rng.integers(0, n, 1500), rng.integers(0, n, 1500)
+    count, label = topology._components(n, a, b)
+    graph = coo_matrix((np.ones(len(a), dtype=np.int8), (a, b)), shape=(n, n))
+    ref_count, ref_label = connected_components(graph, directed=False)
+    assert count == ref_count
+    np.testing.assert_array_equal(label, ref_label)
+
+
+def _sums(points: np.ndarray, faces: np.ndarray) -> mass._Sums:
+    return mass._integrate(points - mass._local_origin(points), faces, "apex", None)
+
+
+def test_integration_independent_of_block_size_within_estimate(monkeypatch: pytest.MonkeyPatch) -> None:
+    v, f = _torus(60, 30)
+    body = MeshBody(v, f)
+    default = mass.mass_properties(body, density=1.0)
+    assert np.array_equal(default.principal_moments, mass.mass_properties(body, density=1.0).principal_moments)
+    for chunk in (1, 7, 1 << 10):
+        monkeypatch.setattr(mass, "CHUNK", chunk)
+        other = mass.mass_properties(body, density=1.0)
+        rel = np.abs(other.principal_moments - default.principal_moments) / default.principal_moments
+        assert rel.max() <= default.relative_error_estimate + other.relative_error_estimate
+
+
+def test_apex_kernel_equals_generic_block_terms() -> None:
+    v, f = _torus(30, 20)
+    x = v - mass._local_origin(v)
+    fast = _sums(v, f)
+    terms = mass._block_terms(x[f], "apex", None)
+    slow = mass._sums_from_rows(terms.sum(axis=1), np.abs(terms).sum(axis=1), len(f))
+    scale = np.abs(slow.abs_m2).max()
+    assert abs(fast.m0 - slow.m0) <= 8 * mass.EPS * slow.abs_m0
+    assert np.abs(fast.m2 - slow.m2).max() <= 8 * mass.EPS * scale
+    np.testing.assert_allclose(fast.element_err, slow.element_err, rtol=1e-12)
+    assert fast.noise == pytest.approx(slow.noise, rel=1e-12)
+
+
+def test_torus_moments_within_estimate_of_exact_polyhedron() -> None:
+    v, f = _torus(16, 10)
+    props = mass.mass_properties(MeshBody(v, f), density=1.0)
+    exact = exact_moments(v, f)
+    ours = np.sort(props.principal_moments)
+    worst = max(relative_error(float(m), e) for m, e in zip(ours, exact))
+    assert worst <= props.relative_error_estimate
