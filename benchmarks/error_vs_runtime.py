@@ -50,7 +50,7 @@ HORIZONS = (10.0, 1e3, 1e5)
 CHECKS = 64  # reference times per horizon (mpmath is slow)
 SAMPLES = 1025  # output samples of every method (CHECKS divides SAMPLES - 1)
 TIMING_SAMPLES = 100_001  # exact method, per-sample cost
-BUDGET_S = 40.0  # skip a configuration whose run time, extrapolated from T = 1e3, exceeds this
+BUDGET_S = 60.0  # keeps the whole run to ~4 minutes; skip a configuration whose run time, extrapolated from T = 1e3, exceeds this
 DOP853_RTOLS = (1e-4, 1e-6, 1e-8, 1e-10, 1e-12, 1e-13)
 RK45_RTOLS = (1e-4, 1e-6, 1e-8)
 SPLITTING_STEPS = (0.1, 0.03, 0.01)
@@ -164,6 +164,7 @@ def run_all() -> tuple[list[Run], dict[float, float]]:
     per_sample: dict[float, float] = {}
     cost_at_1e3: dict[tuple[str, str], float] = {}
     problem = _problem()
+    integrate_scipy(problem, np.linspace(0.0, 1.0, 3), "dop853", 1e-6, ATOL_REL, 10**9)  # warm-up: import and caches
     for horizon in HORIZONS:
         t_checks = np.linspace(0.0, horizon, SAMPLES)[:: (SAMPLES - 1) // CHECKS]
         ref = reference(t_checks)
@@ -384,6 +385,12 @@ def write_doc(runs: list[Run], per_sample: dict[float, float], meshes: list[tupl
         "- The exact method's cost per sample does not depend on the horizon: the elliptic argument is reduced "
         "modulo the half period before the Landen chain and Carlson's R_J, and whole half periods are added "
         "with the complete integral. Its error grows only as the rounding of the phase, ~EPS x rate x t.",
+        f"- Splitting steps are at most h *and* at most the sample spacing (T / {SAMPLES - 1}), so at T = 10 s "
+        "all three settings run with the spacing, 0.0098 s, and coincide.",
+        "- The exact method's error at T = 1e5 s (~3e-12 in Omega, ~2e-11 in R) is the rounding of its phase, "
+        "not of the elliptic functions: u = lambda t ~ 6e4 and phi ~ 3e5 rad carry ~1e-16 relative error "
+        "(lambda itself is correctly rounded), i.e. ~1e-11 absolute; the same holds for any double-precision "
+        "method at this horizon. Energy and |M| are kept to ~1e-15 at every horizon regardless.",
         "- The integrators' errors grow with the horizon (phase error accumulates); the splitting method keeps "
         "|M| to rounding and the energy bounded, with a phase error ~(h Omega)^2 per unit time.",
         "- DOP853 below rtol ~1e-12 stops improving: its local error control cannot beat the accumulation of "

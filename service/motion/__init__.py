@@ -178,7 +178,8 @@ def _parse_times(duration: float | None, samples: int | None) -> Array | None:
     if duration is None or samples is None:
         missing = "duration" if duration is None else "samples"
         raise InvalidParameterError(f"a trajectory needs both duration and samples; give {missing} too", parameter=missing)
-    if not (isinstance(duration, (int, float, np.floating, np.integer)) and np.isfinite(duration) and duration > 0):
+    number = isinstance(duration, (int, float, np.floating, np.integer)) and not isinstance(duration, bool)
+    if not (number and np.isfinite(duration) and duration > 0):
         raise InvalidParameterError(f"duration must be a finite number of seconds > 0, got {duration!r}", parameter="duration")
     if isinstance(samples, bool) or not isinstance(samples, (int, np.integer)) or not 2 <= samples <= MAX_SAMPLES:
         raise InvalidParameterError(
