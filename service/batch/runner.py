@@ -167,6 +167,7 @@ def _run(client: Any, pending: list[Source], options: AnalysisOptions, out: str,
                 sink.write(row)
                 errors += "error" in row
                 bar.update(1)
+            sink.flush()
             future.release()
             for group in _take(tasks, 1):
                 submit(group, ac)

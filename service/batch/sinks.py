@@ -1,8 +1,9 @@
 """Where batch rows go: JSONL, CSV or Parquet, chosen by the output's extension.
 
-JSONL and CSV rows are written and flushed one by one as files complete, so an
-interrupted run keeps every finished row and ``--resume`` carries on.  A line
-cut short by a crash is removed before appending (its file is analysed again).
+JSONL and CSV rows are written as their task completes and flushed after each
+task (one file, or a few small ones), so an interrupted run keeps every
+finished row and ``--resume`` carries on.  A line cut short by a crash is
+removed before appending (its file is analysed again).
 
 Parquet cannot grow row by row: rows are written in row groups to
 ``<out>.partial`` and that file replaces ``<out>`` when the run ends (also on
@@ -31,6 +32,9 @@ PARQUET_ROW_GROUP = 4096  # rows per Parquet row group: ~1 MB of columns, few en
 
 class Sink(Protocol):
     def write(self, row: dict[str, Any]) -> None: ...
+    def flush(self) -> None:
+        """Make the rows written so far durable (called after each finished task)."""
+
     def close(self) -> None: ...
 
 
@@ -147,6 +151,8 @@ class JsonlSink:
     def write(self, row: dict[str, Any]) -> None:
         # allow_nan=False: the contract never sends NaN, so one here is a bug to see
         self._fh.write(json.dumps(row, allow_nan=False) + "\n")
+
+    def flush(self) -> None:
         self._fh.flush()
 
     def close(self) -> None:
@@ -163,6 +169,8 @@ class CsvSink:
     def write(self, row: dict[str, Any]) -> None:
         # csv writes floats with repr(): they read back bit for bit
         self._writer.writerow(flat_row(row))
+
+    def flush(self) -> None:
         self._fh.flush()
 
     def close(self) -> None:
@@ -192,6 +200,9 @@ class ParquetSink:
         self._buffer.append(flat_row(row))
         if len(self._buffer) >= PARQUET_ROW_GROUP:
             self._flush()
+
+    def flush(self) -> None:
+        """Row groups are written every PARQUET_ROW_GROUP rows; the file is whole only at close()."""
 
     def _flush(self) -> None:
         if self._buffer:

@@ -1,0 +1,356 @@
+"""Batch throughput: ``inertia batch`` on local Dask workers against a plain serial trimesh loop.
+
+    python -m benchmarks.batch            # full run (~5 min on 2 cores), writes docs/batch.md
+    python -m benchmarks.batch --quick    # smaller sizes, a minute or so
+
+Generates its inputs (binary STL) into a temporary folder, then times, in the
+same run and on the same files:
+
+- ``trimesh loop``: ``trimesh.load(path).mass_properties`` per file, serially;
+- ``analyze loop``: ``service.pipeline.analyze(path)`` per file, serially
+  (our exact pipeline without Dask: separates the pipeline's cost from scaling);
+- ``inertia batch``: ``run_batch`` on the local default (a ``LocalCluster`` of
+  ``--workers`` single-threaded processes, as ``inertia batch DIR --out
+  rows.jsonl --workers N`` starts), cluster start-up included, writing JSONL.
+
+While the batch runs, a second client samples every worker's resident memory;
+at the end each worker reports its peak (``ru_maxrss``).  The data sets:
+
+- tiny: 1,000 closed boxes of 12 triangles (the per-file overhead bound);
+- small: 1,000 ellipsoids of 960 to 3,968 triangles (a part library);
+- large: 20 ellipsoids of 1,001,112 triangles (50 MB each).
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import platform
+import shutil
+import statistics
+import struct
+import sys
+import tempfile
+import threading
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+DOC = ROOT / "docs" / "batch.md"
+SAMPLE_EVERY_S = 0.2  # worker memory sampling period: many samples even for a 5 s run
+
+
+# ---------------------------------------------------------------------------
+# inputs
+
+
+def uv_sphere(nlat: int, nlon: int) -> tuple[np.ndarray, np.ndarray]:
+    """Closed, outward-wound UV sphere of radius 1: 2 nlon (nlat - 1) triangles."""
+    theta = np.linspace(0.0, np.pi, nlat + 1)[1:-1]
+    phi = np.linspace(0.0, 2 * np.pi, nlon, endpoint=False)
+    t, p = np.meshgrid(theta, phi, indexing="ij")
+    ring = np.stack([np.sin(t) * np.cos(p), np.sin(t) * np.sin(p), np.cos(t)], -1).reshape(-1, 3)
+    v = np.vstack([[0.0, 0.0, 1.0], ring, [0.0, 0.0, -1.0]])
+    south = len(v) - 1
+    j = np.arange(nlon)
+
+    def idx(i: int | np.ndarray, jj: np.ndarray) -> np.ndarray:
+        return 1 + np.asarray(i) * nlon + (jj % nlon)
+
+    i = np.arange(nlat - 2)[:, None]
+    a, b, c, d = idx(i, j), idx(i, j + 1), idx(i + 1, j), idx(i + 1, j + 1)
+    bands = np.concatenate([np.stack([a, c, b], -1), np.stack([b, c, d], -1)], axis=1).reshape(-1, 3)
+    north = np.stack([np.zeros(nlon, dtype=int), idx(0, j), idx(0, j + 1)], -1)
+    bottom = np.stack([np.full(nlon, south), idx(nlat - 2, j + 1), idx(nlat - 2, j)], -1)
+    return v, np.vstack([north, bands, bottom])
+
+
+BOX = (np.array([[(k & 1), (k >> 1) & 1, (k >> 2) & 1] for k in range(8)], dtype=float),
+       np.array([[0, 2, 1], [1, 2, 3], [4, 5, 6], [5, 7, 6], [0, 1, 4], [1, 5, 4],
+                 [2, 6, 3], [3, 6, 7], [0, 4, 2], [2, 4, 6], [1, 3, 5], [3, 7, 5]]))
+
+
+def write_stl(path: Path, triangles: np.ndarray) -> None:
+    rec = np.zeros(len(triangles), dtype=[("n", "<f4", (3,)), ("v", "<f4", (3, 3)), ("a", "<u2")])
+    rec["v"] = triangles
+    with open(path, "wb") as fh:
+        fh.write(b"inertia batch benchmark".ljust(80, b" ") + struct.pack("<I", len(triangles)))
+        fh.write(rec.tobytes())
+
+
+def generate(folder: Path, count: int, shape: Callable[[np.random.Generator], tuple[np.ndarray, np.ndarray]],
+             seed: int) -> int:
+    """``count`` STL files of random scale and offset; returns the number of triangles."""
+    folder.mkdir(parents=True)
+    rng = np.random.default_rng(seed)
+    total = 0
+    for i in range(count):
+        v, f = shape(rng)
+        scaled = v * rng.uniform(0.01, 0.1, 3) + rng.uniform(-1.0, 1.0, 3)
+        write_stl(folder / f"part_{i:05d}.stl", scaled[f])
+        total += len(f)
+    return total
+
+
+def datasets(quick: bool) -> list[tuple[str, int, Callable[[np.random.Generator], Any], str]]:
+    small_cache: dict[int, tuple[np.ndarray, np.ndarray]] = {}
+
+    def small(rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
+        n = int(rng.integers(16, 33))
+        if n not in small_cache:
+            small_cache[n] = uv_sphere(n, 2 * n)
+        return small_cache[n]
+
+    big_n = 300 if quick else 708  # 2*708*707 = 1,001,112 triangles
+    big = uv_sphere(big_n, big_n)
+    return [
+        ("tiny", 200 if quick else 1000, lambda rng: BOX, "closed boxes, 12 triangles"),
+        ("small", 200 if quick else 1000, small, "ellipsoids, 960 to 3,968 triangles"),
+        ("large", 4 if quick else 20, lambda rng: big, f"ellipsoids, {len(big[1]):,} triangles"),
+    ]
+
+
+# ---------------------------------------------------------------------------
+# the three contenders
+
+
+def trimesh_loop(files: list[Path]) -> float:
+    import trimesh
+
+    start = time.perf_counter()
+    for path in files:
+        mesh = trimesh.load(str(path))
+        props = mesh.mass_properties
+        _ = (props["mass"], props["center_mass"], props["inertia"])
+    return time.perf_counter() - start
+
+
+def analyze_loop(files: list[Path]) -> float:
+    from service.pipeline import analyze
+
+    start = time.perf_counter()
+    for path in files:
+        analyze(path).as_dict()
+    return time.perf_counter() - start
+
+
+def _rss() -> int:
+    import psutil
+
+    return int(psutil.Process().memory_info().rss)
+
+
+def _peak_rss() -> int:
+    import resource
+
+    return int(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss) * 1024  # Linux: KiB
+
+
+@dataclass
+class MemoryLog:
+    """RSS of each worker over time, sampled by a second client."""
+
+    samples: list[tuple[float, dict[str, int]]] = field(default_factory=list)
+    peaks: dict[str, int] = field(default_factory=dict)
+
+
+def _sample(address: str, log: MemoryLog, stop: threading.Event, t0: float) -> None:
+    from distributed import Client
+
+    with Client(address, timeout="30s") as client:
+        while not stop.is_set():
+            try:
+                log.samples.append((time.perf_counter() - t0, client.run(_rss)))
+            except Exception:  # noqa: BLE001  a sample lost at shutdown is no result
+                pass
+            stop.wait(SAMPLE_EVERY_S)
+
+
+def batch_run(folder: Path, out: Path, workers: int) -> tuple[float, float, MemoryLog]:
+    """(wall s incl. cluster start, cluster start s, memory log) of the local default."""
+    from service.batch.runner import connect, run_batch
+
+    t0 = time.perf_counter()
+    client, cluster = connect(None, workers)
+    startup = time.perf_counter() - t0
+    log = MemoryLog()
+    stop = threading.Event()
+    sampler = threading.Thread(target=_sample, args=(cluster.scheduler_address, log, stop, t0), daemon=True)
+    sampler.start()
+    try:
+        summary = run_batch([str(folder)], str(out), client=client, progress=False)
+        wall = time.perf_counter() - t0
+        assert summary.errors == 0, f"{summary.errors} files failed"
+        log.peaks = client.run(_peak_rss)
+    finally:
+        stop.set()
+        sampler.join()
+        client.close()
+        cluster.close()
+    return wall, startup, log
+
+
+# ---------------------------------------------------------------------------
+# report
+
+
+@dataclass
+class Row:
+    dataset: str
+    files: int
+    triangles: int
+    description: str
+    megabytes: float
+    trimesh_s: float
+    analyze_s: float
+    batch_s: float
+    startup_s: float
+    memory: MemoryLog
+
+
+def _mb(x: float) -> str:
+    return f"{x / 2**20:.0f}"
+
+
+def memory_table(rows: list[Row]) -> list[str]:
+    lines = ["| data set | worker | RSS, first quarter (MiB) | RSS, last quarter (MiB) | median (MiB) | "
+             "peak RSS, ru_maxrss (MiB) | samples |", "|---|---|---:|---:|---:|---:|---:|"]
+    for row in rows:
+        log = row.memory
+        if not log.samples:
+            continue
+        t_end = log.samples[-1][0]
+        workers = sorted({w for _, s in log.samples for w in s})
+        for k, worker in enumerate(workers):
+            series = [(t, s[worker]) for t, s in log.samples if worker in s]
+            first = [r for t, r in series if t <= t_end / 4] or [series[0][1]]
+            last = [r for t, r in series if t >= 3 * t_end / 4] or [series[-1][1]]
+            lines.append(f"| {row.dataset} | {k + 1} | {_mb(max(first))} | {_mb(max(last))} | "
+                         f"{_mb(statistics.median(r for _, r in series))} | {_mb(log.peaks.get(worker, 0))} | "
+                         f"{len(series)} |")
+    return lines
+
+
+def render(rows: list[Row], workers: int, quick: bool, command: str) -> str:
+    import dask
+    import trimesh
+
+    cpu = _cpu_model()
+    lines = [
+        "# Batch throughput",
+        "",
+        f"Measured by `{command}` on {_today()}: {cpu}, {os.cpu_count()} cores, Python "
+        f"{platform.python_version()}, dask {dask.__version__}, trimesh {trimesh.__version__}.",
+        "All three contenders read the same binary STL files from the page cache in the same run.",
+        "",
+        "- **trimesh loop**: `trimesh.load(path).mass_properties` per file, one process, one after the other.",
+        "- **analyze loop**: `service.pipeline.analyze(path).as_dict()` per file, serially: our exact",
+        "  pipeline (watertightness check, compensated two-pass sums, Jacobi frame) without Dask.",
+        f"- **inertia batch**: the local default with `--workers {workers}` (a `LocalCluster` of {workers} "
+        "single-threaded",
+        "  worker processes), writing JSONL, *cluster start-up included* (the start-up alone is given too).",
+        "",
+        "| data set | files | triangles | input (MB) | contender | wall (s) | files/s | triangles/s | vs trimesh loop |",
+        "|---|---:|---:|---:|---|---:|---:|---:|---:|",
+    ]
+    for row in rows:
+        for name, secs in (("trimesh loop", row.trimesh_s), ("analyze loop", row.analyze_s),
+                           (f"inertia batch, {workers} workers", row.batch_s)):
+            lines.append(f"| {row.dataset}: {row.description} | {row.files:,} | {row.triangles:,} | "
+                         f"{row.megabytes:.0f} | {name} | {secs:.2f} | {row.files / secs:,.1f} | "
+                         f"{row.triangles / secs:,.0f} | {row.trimesh_s / secs:.2f}x |")
+    lines += ["", "Cluster start-up (included above): " +
+              ", ".join(f"{r.dataset} {r.startup_s:.1f} s" for r in rows) + ".", ""]
+    small = next((r for r in rows if r.dataset == "small"), None)
+    if small is not None:
+        ratio = small.trimesh_s / small.batch_s
+        verdict = "met" if ratio >= 1.8 else "NOT met"
+        lines += [f"Target (issue 7): with {workers} local workers at least 1.8x the serial loop's files per second "
+                  f"on small files: **{ratio:.2f}x, {verdict}**"
+                  + (" (quick run: sizes too small to judge)" if quick else "") + ".", ""]
+    lines += [
+        "## Memory per worker",
+        "",
+        f"Resident set size of each worker process, sampled every {SAMPLE_EVERY_S} s by a second client",
+        "(`client.run(psutil.Process().memory_info().rss)`) over the batch run, and the peak the worker",
+        "reports at the end (`ru_maxrss`, which also catches peaks between samples). Flat means the last",
+        "quarter of the run holds no more than the first: memory does not grow with the number of files.",
+        "",
+        *memory_table(rows),
+        "",
+        "## Notes",
+        "",
+        "- Tasks group small files (up to 32 files or 4 MiB of input per task) and at most 4 tasks per",
+        "  worker thread are in flight; each worker reads its own files. Rows are written as tasks complete.",
+        "- On tiny files our pipeline itself costs about twice what trimesh does per file (the exact",
+        "  two-pass integration and watertightness check have a fixed cost), so the speed-up there is",
+        "  bounded by the pipeline, not by Dask; compare the analyze loop with the batch row for the scaling.",
+        "- With 2 cores, the client (writing rows) and the scheduler share the cores with the 2 workers.",
+        "",
+        f"Regenerate: `{command}` (from the repository root; needs the `batch` extra and psutil).",
+        "",
+    ]
+    return "\n".join(lines)
+
+
+def _cpu_model() -> str:
+    try:
+        with open("/proc/cpuinfo") as fh:
+            for line in fh:
+                if line.startswith("model name"):
+                    return line.split(":", 1)[1].strip()
+    except OSError:
+        pass
+    return platform.processor() or platform.machine()
+
+
+def _today() -> str:
+    return time.strftime("%Y-%m-%d")
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(prog="python -m benchmarks.batch", description=__doc__.split("\n")[0])
+    parser.add_argument("--quick", action="store_true", help="200 small files and 4 of 180k triangles")
+    parser.add_argument("--workers", type=int, default=2, help="local worker processes (default 2)")
+    parser.add_argument("--out", type=Path, default=DOC, help=f"Markdown report (default {DOC.relative_to(ROOT)})")
+    parser.add_argument("--only", choices=("tiny", "small", "large"), action="append", help="run only these sets")
+    args = parser.parse_args(argv)
+    command = "python -m benchmarks.batch" + (" --quick" if args.quick else "") + (
+        f" --workers {args.workers}" if args.workers != 2 else "")
+    work = Path(tempfile.mkdtemp(prefix="inertia-batch-bench-"))
+    rows: list[Row] = []
+    try:
+        for seed, (name, count, shape, description) in enumerate(datasets(args.quick)):
+            if args.only and name not in args.only:
+                continue
+            folder = work / name
+            t = time.perf_counter()
+            triangles = generate(folder, count, shape, seed)
+            files = sorted(folder.glob("*.stl"))
+            megabytes = sum(p.stat().st_size for p in files) / 1e6
+            print(f"[{name}] generated {count} files, {triangles:,} triangles, {megabytes:.0f} MB in "
+                  f"{time.perf_counter() - t:.1f} s", file=sys.stderr)
+            tri_s = trimesh_loop(files)
+            print(f"[{name}] trimesh loop {tri_s:.2f} s", file=sys.stderr)
+            ana_s = analyze_loop(files)
+            print(f"[{name}] analyze loop {ana_s:.2f} s", file=sys.stderr)
+            batch_s, startup, memory = batch_run(folder, work / f"{name}.jsonl", args.workers)
+            print(f"[{name}] inertia batch {batch_s:.2f} s (start-up {startup:.1f} s)", file=sys.stderr)
+            rows.append(Row(name, count, triangles, description, megabytes, tri_s, ana_s, batch_s, startup, memory))
+            shutil.rmtree(folder)
+    finally:
+        shutil.rmtree(work, ignore_errors=True)
+    text = render(rows, args.workers, args.quick, command)
+    args.out.parent.mkdir(parents=True, exist_ok=True)
+    args.out.write_text(text)
+    print(text)
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
