@@ -132,8 +132,17 @@ class ComputePool:
         self._idle: list[_Worker] = []
         self._lock = threading.Lock()
         self._slots: tuple[asyncio.AbstractEventLoop, asyncio.Semaphore] | None = None
-        # one thread per job in flight blocks on its pipe; extra room for spawns and killed jobs' threads
-        self._threads = ThreadPoolExecutor(max_workers=2 * size + 2, thread_name_prefix="inertia-pipe")
+        self._executor: ThreadPoolExecutor | None = None
+
+    @property
+    def _threads(self) -> ThreadPoolExecutor:
+        # one thread per job in flight blocks on its pipe; extra room for spawns and killed jobs' threads.
+        # Made on first use, so a pool that was closed (end of a lifespan) can serve again.
+        with self._lock:
+            if self._executor is None:
+                self._executor = ThreadPoolExecutor(max_workers=2 * self.size + 2,
+                                                    thread_name_prefix="inertia-pipe")
+            return self._executor
 
     async def warm_up(self) -> None:
         """Start the fork server and one process, so the first request does not wait for imports."""
@@ -196,9 +205,12 @@ class ComputePool:
             self._idle.append(worker)
 
     def close(self) -> None:
+        """Stop the idle processes; jobs still running end with their requests."""
         with self._lock:
             idle, self._idle = self._idle, []
+            executor, self._executor = self._executor, None
         for worker in idle:
             worker.conn.close()
             worker.kill()
-        self._threads.shutdown(wait=False, cancel_futures=True)
+        if executor is not None:
+            executor.shutdown(wait=False)

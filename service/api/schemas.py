@@ -25,6 +25,10 @@ __all__ = [
 Method = Literal["exact", "dop853", "rk45", "splitting"]
 assert set(METHODS) == set(Method.__args__)  # type: ignore[attr-defined]
 
+# a trajectory of this many samples is ~2.3 MB of JSON and under a second of compute;
+# longer ones belong to the CLI or the library, not to one HTTP response
+MAX_SAMPLES = 10_000
+
 Vector = Annotated[list[float], Field(min_length=3, max_length=3)]
 Tensor = Annotated[list[Vector], Field(min_length=3, max_length=3)]
 Quaternion = Annotated[list[float], Field(min_length=4, max_length=4)]
@@ -84,7 +88,8 @@ class MeshQuery(_Request):
     omega: str | None = Field(None, description="'wx,wy,wz' initial angular velocity [rad/s], input frame: "
                               "adds precession", examples=["0,0.1,1"])
     duration: float | None = Field(None, gt=0, description="with omega: seconds to predict [s]")
-    samples: int | None = Field(None, ge=1, le=1_000_000, description="with omega: number of time samples")
+    samples: int | None = Field(None, ge=1, le=MAX_SAMPLES,
+                                description="with omega: number of time samples (at most 10000)")
     method: Method = Field("exact", description="with omega: exact, dop853, rk45 or splitting")
     densities: str | None = Field(None, description="JSON object: part name -> density [kg/m^3]",
                                   examples=['{"bracket": 7850}'])
@@ -120,7 +125,8 @@ class PointsRequest(_Request):
     reference: Vector | None = Field(None, description="also report the tensor about this point [units]")
     omega: Vector | None = Field(None, description="initial angular velocity [rad/s]: adds precession")
     duration: float | None = Field(None, gt=0, description="with omega: seconds to predict [s]")
-    samples: int | None = Field(None, ge=1, le=1_000_000, description="with omega: number of time samples")
+    samples: int | None = Field(None, ge=1, le=MAX_SAMPLES,
+                                description="with omega: number of time samples (at most 10000)")
     method: Method = Field("exact", description="with omega: exact, dop853, rk45 or splitting")
 
     def records(self) -> list[dict[str, Any]]:
@@ -147,7 +153,8 @@ class PrecessionRequest(_Request):
     omega: Vector = Field(description="initial angular velocity [rad/s], input frame")
     tolerance: float = Field(1e-6, gt=0, lt=1, description="relative tolerance for equal principal moments")
     duration: float | None = Field(None, gt=0, description="seconds to predict [s]")
-    samples: int | None = Field(None, ge=1, le=1_000_000, description="number of time samples")
+    samples: int | None = Field(None, ge=1, le=MAX_SAMPLES,
+                                description="number of time samples (at most 10000)")
     method: Method = Field("exact", description="exact, dop853, rk45 or splitting")
 
     def arguments(self) -> dict[str, Any]:
