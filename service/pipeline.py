@@ -180,7 +180,7 @@ def analyze_loaded(loaded: Loaded, options: AnalysisOptions, start: float | None
         motion = _motion(frame, cls, options)
         warnings.extend(motion.warnings)
     return AnalysisResult(
-        source=_source(loaded, props),
+        source=_source(loaded, part_results),
         props=props,
         frame=frame,
         classification=cls,
@@ -259,20 +259,21 @@ def _motion(frame: PrincipalFrame, cls: Classification, options: AnalysisOptions
     )
 
 
-def _source(loaded: Loaded, props: MassProperties) -> dict[str, Any]:
-    out: dict[str, Any] = {"filename": loaded.filename, "format": loaded.format, "kind": loaded.kind,
-                           "units": loaded.units, "units_from": loaded.units_from}
-    if loaded.filename is None:
-        del out["filename"]
+def _source(loaded: Loaded, parts: Sequence[PartResult]) -> dict[str, Any]:
+    """The ``source`` section: what was read, and how many elements it had."""
     from .body import MeshBody, PointBody, VolumeBody
 
+    out: dict[str, Any] = {"format": loaded.format, "kind": loaded.kind,
+                           "units": loaded.units, "units_from": loaded.units_from}
+    if loaded.filename is not None:
+        out = {"filename": loaded.filename, **out}
     bodies = [p.body for p in loaded.parts]
     if loaded.kind == "mesh":
         meshes = [b for b in bodies if isinstance(b, MeshBody)]
-        out["vertices"] = int(sum(len(b.vertices) for b in meshes)) if props.mesh_vertices is None else props.mesh_vertices
+        closed = [_surface_counts(b, r.props) for b, r in zip(meshes, parts)]
+        out["vertices"] = int(sum(n for n, _ in closed))
         out["triangles"] = int(sum(len(b.faces) for b in meshes))
-        if props.volume is not None:
-            out["watertight"] = True
+        out["watertight"] = all(w for _, w in closed)
     elif loaded.kind == "volume":
         vols = [b for b in bodies if isinstance(b, VolumeBody)]
         out["points"] = int(len(vols[0].points))
@@ -282,6 +283,20 @@ def _source(loaded: Loaded, props: MassProperties) -> dict[str, Any]:
     if loaded.is_assembly:
         out["parts"] = len(loaded.parts)
     return out
+
+
+def _surface_counts(body: Any, props: MassProperties) -> tuple[int, bool]:
+    """Distinct vertices and closedness of a surface.
+
+    A solid was welded and found closed by ``mass_properties``; a shell is
+    checked here, since a shell's integral does not need it.
+    """
+    if props.mesh_vertices is not None:
+        return props.mesh_vertices, True
+    from .topology import surface_topology, weld
+
+    vertices, faces = weld(body.vertices, body.faces)
+    return len(vertices), surface_topology(faces, len(vertices)).closed
 
 
 @dataclass(frozen=True, slots=True)

@@ -60,10 +60,10 @@ def analysis_dict(result: "AnalysisResult") -> dict[str, Any]:
     """The analysis result of the contract (API.md, "The analysis result")."""
     p = result.props
     out: dict[str, Any] = {"source": dict(result.source), "mass": p.mass}
-    if p.volume is not None:
+    if p.volume is not None:  # volume and density: solids only (API.md)
         out["volume"] = p.volume
-    if p.density is not None:
-        out["density"] = p.density
+        if p.density is not None:
+            out["density"] = p.density
     if p.area is not None:
         out["area"] = p.area
     out["center_of_mass"] = _list(p.center_of_mass)
