@@ -184,3 +184,10 @@ def test_unknown_extension_is_unsupported() -> None:
 def test_content_sniffing_without_a_name() -> None:
     doc = analyze(export(box_mesh(), "stl_ascii")).as_dict()
     assert doc["source"]["format"] == "stl"
+
+
+def test_gltf_with_external_buffers_is_refused_with_advice() -> None:
+    data = trimesh.Scene(box_mesh()).export(file_type="gltf")["model.gltf"]
+    with pytest.raises(UnreadableFileError) as err:
+        analyze(data, filename="part.gltf")
+    assert ".glb" in err.value.message and "external buffer" in err.value.message

@@ -38,6 +38,8 @@ def read_trimesh_parts(data: bytes, fmt: str, length_scale: float) -> tuple[list
     """Parts of a surface file (one per scene node) and the unit it declares."""
     import trimesh
 
+    if fmt == "gltf":
+        _check_gltf_self_contained(data)
     extra = {"split_objects": True, "split_groups": True, "group_material": False} if fmt == "obj" else {}
     try:
         scene = trimesh.load_scene(
@@ -61,6 +63,25 @@ def read_trimesh_parts(data: bytes, fmt: str, length_scale: float) -> tuple[list
     if not parts:
         raise EmptyGeometryError(f"the {fmt.upper()} file holds no triangles")
     return parts, _declared_unit(scene, fmt)
+
+
+def _check_gltf_self_contained(data: bytes) -> None:
+    """A .gltf upload must carry its buffers; external files are never read."""
+    import json
+
+    try:
+        doc = json.loads(data)
+    except (UnicodeDecodeError, json.JSONDecodeError) as exc:
+        raise UnreadableFileError(f"the glTF file is not valid JSON ({exc})", format="gltf") from exc
+    buffers = doc.get("buffers", []) if isinstance(doc, dict) else []
+    external = [b.get("uri") for b in buffers if isinstance(b, dict) and b.get("uri")
+                and not str(b.get("uri")).startswith("data:")]
+    if external:
+        raise UnreadableFileError(
+            f"the glTF file refers to external buffer files ({', '.join(map(str, external))}); "
+            "upload a .glb, or a .gltf with embedded (data URI) buffers",
+            format="gltf",
+        )
 
 
 def _declared_unit(scene: Any, fmt: str) -> str | None:
