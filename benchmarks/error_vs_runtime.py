@@ -26,6 +26,7 @@ V (R^2 + 3 r^2 / 4), across V (R^2 / 2 + 5 r^2 / 8), V = 2 pi^2 R r^2).
 from __future__ import annotations
 
 import math
+import os
 import platform
 import sys
 import time
@@ -332,7 +333,9 @@ def write_doc(runs: list[Run], per_sample: dict[float, float], meshes: list[tupl
         "```",
         "",
         f"Machine: {platform.machine()}, {platform.processor() or 'cpu'}; Python {platform.python_version()}, "
-        f"numpy {np.__version__}, scipy {scipy.__version__}, mpmath {mp.__version__}; single thread, wall clock.",
+        f"numpy {np.__version__}, scipy {scipy.__version__}, mpmath {mp.__version__}; single thread, wall clock; "
+        f"load average at the end of the run {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores "
+        "(a shared machine inflates every time alike; ratios are from the same run).",
         "",
         "Problem: generic asymmetric top, I = (1, 2, 3) kg m^2, Omega0 = (0.3, 0.2, 1.0) rad/s (period "
         f"{AsymmetricTop.from_initial(MOMENTS, OMEGA0, 1e-15).period:.4f} s). Reference: L&L §37 in mpmath at 30 digits "
