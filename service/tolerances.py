@@ -33,5 +33,31 @@ class Tolerances:
     jacobi_max_sweeps: int = 30
     """Cyclic Jacobi converges quadratically; 30 sweeps is far beyond need."""
 
+    permanent_rotation_rel: float = 16 * EPS
+    """Omega is along a principal axis when its other principal components are at
+    most this times |Omega|: the rounding noise of ``axes @ omega``.  Anything
+    larger is a real (if tiny) tilt whose motion, e.g. a flip, is predicted."""
+
+    separatrix_rel: float = 16 * EPS
+    """The asymmetric top is on the separatrix when |M^2 - 2 E I2| is at most this
+    times I3 (I3 - I2) W3^2 + I1 (I2 - I1) W1^2, the two terms whose difference
+    it is: below that the sign of the difference is rounding noise."""
+
+    integrator_rtol: float = 1e-10
+    """Default rtol of the dop853/rk45 methods: about the accuracy users expect
+    of a cross-check, at a few thousand steps per hundred rotations."""
+
+    integrator_atol_rel: float = 1e-14
+    """atol of dop853/rk45, times |Omega| for Omega and times 1 for the
+    quaternion: keeps the relative test meaningful when a component crosses 0."""
+
+    splitting_step_angle: float = 1e-3
+    """Default step of the splitting method, as the largest body rotation (rad)
+    per step; its second-order error is then ~1e-7 per radian turned."""
+
+    max_integration_steps: int = 2_000_000
+    """Cap on steps of the numerical methods (a pure-Python loop for splitting):
+    beyond it predict_motion refuses and points to method='exact'."""
+
 
 DEFAULT_TOLERANCES = Tolerances()
