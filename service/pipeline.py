@@ -253,8 +253,13 @@ def _combined(parts: Sequence[PartResult], options: AnalysisOptions) -> MassProp
 def _motion(frame: PrincipalFrame, cls: Classification, options: AnalysisOptions) -> "FreeMotion":
     from .motion import predict_motion
 
+    omega = np.asarray(options.omega, dtype=np.float64)
+    # 2E <= I3 |omega|^2 and |M| <= I3 |omega|: past float64 the motion cannot be computed at all
+    if not math.isfinite(float(frame.moments[-1]) * float(omega @ omega)):
+        raise InvalidParameterError("omega and the moments of inertia are so large that the kinetic energy "
+                                    "overflows float64; rescale them (other units)", parameter="omega")
     return predict_motion(
-        frame, cls, np.asarray(options.omega), duration=options.duration, samples=options.samples,
+        frame, cls, omega, duration=options.duration, samples=options.samples,
         method=options.method,
     )
 
