@@ -1,0 +1,871 @@
+"""Numerical stability report: extreme bodies and motions, our error beside the peers'.
+
+    python -m benchmarks.stability            # full battery, writes docs/stability.md
+    python -m benchmarks.stability --quick    # skips the largest cases (1e6+ triangles/points)
+
+Reference values never come from the service: the exact principal moments of
+the polyhedron *as stored* (the float64 vertices every tool receives) come from
+rational integration with Python integers and 50-digit eigenvalues
+(``tests/exact.py``); motion references are mpmath closed forms (Jacobi
+elliptic functions, L&L §37; the symmetric top, L&L §33) at 40 digits.
+
+Peers get the same arrays: trimesh (``Trimesh(process=False)``), numpy-stl
+(its ``Mesh`` stores float32, so its input is already a different polyhedron:
+reported as is, against the float64 polyhedron's exact value), MuJoCo (MjSpec
+mesh with ``inertia="exact"``, density 1; ``body_inertia`` are its principal
+moments), scipy ``solve_ivp`` DOP853 at rtol 1e-12 on Euler's equations plus
+the quaternion kinematics.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import sys
+import time
+from concurrent.futures import ProcessPoolExecutor
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Callable, Sequence
+
+import mpmath
+import numpy as np
+from numpy.typing import NDArray
+from scipy.spatial.transform import Rotation
+
+ROOT = Path(__file__).resolve().parents[1]
+if str(ROOT) not in sys.path:
+    sys.path.insert(0, str(ROOT))
+
+from service.body import MeshBody, PointBody, VolumeBody  # noqa: E402
+from service.classify import RotorClass, classify  # noqa: E402
+from service.mass import mass_properties  # noqa: E402
+from service.principal import principal_frame  # noqa: E402
+from tests.exact import (exact_eigenvalues, exact_points, exact_solid, exact_tetrahedra,  # noqa: E402
+                         relative_error)
+
+__all__ = ["GENERIC", "BOUND_EXACT", "BOUND_THIN", "BOUND_INVARIANT", "box", "uv_sphere", "prism",
+           "two_material_boxes", "log_uniform_points", "MeshCase", "geometry_cases", "measure_mesh",
+           "MotionCase", "motion_cases", "measure_motion", "tessellation_rows", "near_symmetric_flip",
+           "point_case", "two_material_case", "main"]
+
+Array = NDArray[np.float64]
+
+GENERIC = Rotation.from_euler("zyx", [0.3, 0.7, 1.1]).as_matrix()
+"""A rotation with no special angle: every coordinate of a rotated box is inexact."""
+DIRECTION = np.array([1.0, -0.6180339887, 0.4142135623])
+"""Offset direction: irrational-looking components so no coordinate stays a round number."""
+
+BOUND_EXACT = 1e-12  # issue 6 / API Accuracy: every principal moment of an exact polyhedron
+BOUND_THIN = 1e-9  # the smallest moment of needles and plates up to aspect 1e6
+BOUND_INVARIANT = 1e-12  # energy and |M| of the exact motion over 1e5 time units
+HORIZON = 1e5  # time units of every motion case
+SCIPY_RTOL = 1e-12
+SCIPY_MAX_ANGLE = 1e6
+"""scipy runs the full horizon only when |Omega| T is at most this many radians;
+beyond, it runs 1e5 rad and the cell says so (1e11 rad would need ~1e10 steps)."""
+
+BOX_FACES = np.array([[0, 2, 1], [1, 2, 3], [4, 5, 6], [5, 7, 6], [0, 1, 4], [1, 5, 4],
+                      [2, 6, 3], [3, 6, 7], [0, 4, 2], [2, 4, 6], [1, 3, 5], [3, 7, 5]])
+HEX_TETS = np.array([[0, 1, 3, 7], [0, 1, 7, 5], [0, 5, 7, 4], [0, 3, 2, 7], [0, 2, 6, 7], [0, 6, 4, 7]])
+"""Kuhn split of a hexahedron (vertex k has bits x, y, z) into six tetrahedra along 0-7."""
+
+
+# -- bodies ------------------------------------------------------------------------------
+
+
+def box(a: float, b: float, c: float, centred: bool = True) -> tuple[Array, NDArray[np.int64]]:
+    """a x b x c box, outward winding; vertex k has bits (x, y, z) = (k&1, k&2, k&4)."""
+    v = np.array([[(k & 1) * a, ((k >> 1) & 1) * b, ((k >> 2) & 1) * c] for k in range(8)], dtype=float)
+    if centred:
+        v -= np.array([a, b, c]) / 2
+    return v, BOX_FACES.copy()
+
+
+def uv_sphere(n_lat: int, n_lon: int, radius: float = 1.0) -> tuple[Array, NDArray[np.int64]]:
+    """Latitude-longitude sphere: 2 n_lon (n_lat - 1) triangles, single-vertex poles."""
+    theta = np.pi * np.arange(1, n_lat) / n_lat
+    phi = 2 * np.pi * np.arange(n_lon) / n_lon
+    ring = np.stack([np.outer(np.sin(theta), np.cos(phi)), np.outer(np.sin(theta), np.sin(phi)),
+                     np.repeat(np.cos(theta)[:, None], n_lon, axis=1)], axis=-1).reshape(-1, 3)
+    v = radius * np.vstack([[0.0, 0.0, 1.0], ring, [0.0, 0.0, -1.0]])
+    south = len(v) - 1
+    idx = 1 + np.arange((n_lat - 1) * n_lon).reshape(n_lat - 1, n_lon)
+    nxt = np.roll(idx, -1, axis=1)
+    top = np.stack([np.zeros(n_lon, dtype=np.int64), idx[0], nxt[0]], axis=1)
+    bottom = np.stack([np.full(n_lon, south), nxt[-1], idx[-1]], axis=1)
+    a, b, c, d = idx[:-1], nxt[:-1], idx[1:], nxt[1:]
+    quads = np.concatenate([np.stack([a, c, d], -1).reshape(-1, 3), np.stack([a, d, b], -1).reshape(-1, 3)])
+    return v, np.vstack([top, quads, bottom]).astype(np.int64)
+
+
+def sphere_with_triangles(n: int) -> tuple[Array, NDArray[np.int64]]:
+    """A UV sphere of about ``n`` triangles (n_lon = 2 n_lat)."""
+    k = max(3, int(round(math.sqrt(n / 4))))
+    return uv_sphere(k, 2 * k)
+
+
+def prism(n: int, radius: float, height: float) -> tuple[Array, NDArray[np.int64]]:
+    """Regular n-gon prism (a tessellated cylinder), axis z, centred."""
+    ang = 2 * np.pi * np.arange(n) / n
+    ring = np.stack([radius * np.cos(ang), radius * np.sin(ang)], axis=1)
+    h = height / 2
+    v = np.vstack([np.c_[ring, np.full(n, -h)], np.c_[ring, np.full(n, h)], [[0, 0, -h], [0, 0, h]]])
+    faces = []
+    for i in range(n):
+        j = (i + 1) % n
+        faces += [[i, j, n + j], [i, n + j, n + i], [2 * n, j, i], [2 * n + 1, n + i, n + j]]
+    return v, np.array(faces, dtype=np.int64)
+
+
+def placed(v: Array, rotation: Array = GENERIC, offset: float | Array = 0.0) -> Array:
+    """v rotated then translated, rounded to float64 once per coordinate: the stored polyhedron."""
+    return np.asarray(v @ rotation.T + offset, dtype=np.float64)
+
+
+def two_material_boxes(ratio: float) -> tuple[Array, NDArray[np.int64], Array]:
+    """Two unit cubes side by side along x as 12 tetrahedra; densities 1 and ``ratio``."""
+    pts = np.array([[x, y, z] for z in (0, 1) for y in (0, 1) for x in (0, 1, 2)], dtype=float) - [1.0, 0.5, 0.5]
+    tets, rho = [], []
+    for x0, density in ((0, 1.0), (1, ratio)):
+        hexa = [(x0 + (k & 1)) + 3 * ((k >> 1) & 1) + 6 * ((k >> 2) & 1) for k in range(8)]
+        for t in HEX_TETS:
+            tets.append([hexa[i] for i in t])
+            rho.append(density)
+    return pts, np.array(tets, dtype=np.int64), np.array(rho)
+
+
+def boundary_faces(tets: NDArray[np.int64], points: Array) -> NDArray[np.int64]:
+    """Faces used by one tetrahedron only, wound outward: the surface of the same polyhedron."""
+    faces: dict[tuple[int, ...], list[list[int]]] = {}
+    for t in tets.tolist():
+        for skip in range(4):
+            face = [t[i] for i in range(4) if i != skip]
+            a, b, c = (points[i] for i in face)
+            if np.dot(np.cross(b - a, c - a), points[t[skip]] - a) > 0:  # normal must point away
+                face = [face[0], face[2], face[1]]
+            faces.setdefault(tuple(sorted(face)), []).append(face)
+    return np.array([fs[0] for fs in faces.values() if len(fs) == 1], dtype=np.int64)
+
+
+def log_uniform_points(n: int, lo: float = 1e-12, hi: float = 1e12, seed: int = 6) -> tuple[Array, Array]:
+    """n point masses log-uniform in [lo, hi] kg at standard-normal positions [m]."""
+    rng = np.random.default_rng(seed)
+    masses = np.exp(rng.uniform(math.log(lo), math.log(hi), n))
+    masses[:2] = lo, hi  # the extremes are present
+    return masses, rng.standard_normal((n, 3))
+
+
+# -- peers -------------------------------------------------------------------------------
+
+
+def _peer(fn: Callable[[], Array]) -> Array | str:
+    """A peer's ascending principal moments, or the text of what went wrong."""
+    try:
+        out = np.sort(np.asarray(fn(), dtype=np.float64))
+    except Exception as exc:  # a peer that raises gets that text in its cell
+        return f"raises {type(exc).__name__}: {str(exc).splitlines()[0][:60]}"
+    if not np.all(np.isfinite(out)):
+        return "returns NaN/inf"
+    return out
+
+
+def trimesh_moments(v: Array, f: NDArray[np.int64]) -> Array | str:
+    import trimesh
+
+    return _peer(lambda: trimesh.Trimesh(v, f, process=False).principal_inertia_components)
+
+
+def numpy_stl_moments(v: Array, f: NDArray[np.int64]) -> Array | str:
+    from stl import mesh as stl_mesh
+
+    def run() -> Array:
+        m = stl_mesh.Mesh(np.zeros(len(f), dtype=stl_mesh.Mesh.dtype))
+        m.vectors[:] = v[f]  # float32 storage: this is where numpy-stl's input is rounded
+        _, _, inertia = m.get_mass_properties()
+        return np.linalg.eigvalsh(np.asarray(inertia, dtype=np.float64))
+
+    return _peer(run)
+
+
+def mujoco_moments(parts: Sequence[tuple[Array, NDArray[np.int64], float]]) -> Array | str:
+    """Principal moments of one MuJoCo body made of mesh geoms (vertices, faces, density)."""
+    import mujoco
+
+    def run() -> Array:
+        spec = mujoco.MjSpec()
+        body = spec.worldbody.add_body(name="b")
+        body.add_freejoint()
+        for k, (v, f, rho) in enumerate(parts):
+            mesh = spec.add_mesh(name=f"m{k}")
+            mesh.uservert = v.ravel().tolist()
+            mesh.userface = f.ravel().tolist()
+            mesh.inertia = mujoco.mjtMeshInertia.mjMESH_INERTIA_EXACT
+            body.add_geom(type=mujoco.mjtGeom.mjGEOM_MESH, meshname=f"m{k}", density=rho, contype=0, conaffinity=0)
+        return np.array(spec.compile().body_inertia[1])
+
+    return _peer(run)
+
+
+# -- geometry rows ------------------------------------------------------------------------
+
+
+@dataclass
+class Row:
+    """One line of a table.  ``errors``: relative error per cell name, or the text for the cell."""
+
+    group: str
+    case: str
+    exact: str
+    ours: float
+    estimate: float | None
+    peers: dict[str, float | str]
+    bound: float
+    bound_text: str
+    passed: bool
+    estimate_ok: bool = True
+    note: str = ""
+    seconds: float = 0.0
+    extra: dict[str, object] = field(default_factory=dict)
+
+
+@dataclass(frozen=True)
+class MeshCase:
+    """A closed triangle mesh as stored, and the bound each principal moment must meet."""
+
+    name: str
+    vertices: Array
+    faces: NDArray[np.int64]
+    thin: bool = False  # smallest moment held to BOUND_THIN (needles, plates)
+    peers: tuple[str, ...] = ("trimesh", "numpy-stl", "mujoco")
+    note: str = ""
+
+
+def moment_errors(values: Array, exact: Sequence[mpmath.mpf]) -> list[float]:
+    return [relative_error(float(x), e) for x, e in zip(np.sort(values), exact)]
+
+
+def _bounds(thin: bool) -> list[float]:
+    return [BOUND_THIN if thin else BOUND_EXACT, BOUND_EXACT, BOUND_EXACT]
+
+
+def _worst(errors: Sequence[float], bounds: Sequence[float]) -> float:
+    """The error that matters most: the largest ratio to its bound, reported as the error."""
+    k = int(np.argmax([e / b for e, b in zip(errors, bounds)]))
+    return float(errors[k])
+
+
+def measure_mesh(case: MeshCase, exact: Sequence[mpmath.mpf] | None = None) -> Row:
+    """Our error and each peer's on one mesh, against its exact principal moments."""
+    start = time.perf_counter()
+    if exact is None:
+        exact = exact_eigenvalues(exact_solid(case.vertices, case.faces)[2])
+    t0 = time.perf_counter()
+    props = mass_properties(MeshBody(case.vertices, case.faces), density=1.0)
+    ours_s = time.perf_counter() - t0
+    ours = np.sort(props.principal_moments)
+    bounds = _bounds(case.thin)
+    finite = bool(np.all(np.isfinite(props.principal_moments)) and np.isfinite(props.relative_error_estimate))
+    errors = moment_errors(ours, exact) if finite else [math.inf] * 3
+    peers: dict[str, float | str] = {}
+    runners = {"trimesh": lambda: trimesh_moments(case.vertices, case.faces),
+               "numpy-stl": lambda: numpy_stl_moments(case.vertices, case.faces),
+               "mujoco": lambda: mujoco_moments([(case.vertices, case.faces, 1.0)])}
+    for name, run in runners.items():
+        if name not in case.peers:
+            continue
+        result = run()
+        peers[name] = result if isinstance(result, str) else _worst(moment_errors(result, exact), bounds)
+    estimate = float(props.relative_error_estimate)
+    passed = finite and all(e <= b for e, b in zip(errors, bounds)) and all(e <= estimate for e in errors)
+    return Row("geometry", case.name, _fmt_moments(exact), _worst(errors, bounds), estimate, peers, max(bounds),
+               _bound_text(case.thin), passed, estimate <= max(bounds), case.note, time.perf_counter() - start,
+               {"errors": errors, "ours_s": ours_s})
+
+
+def _fmt_moments(exact: Sequence[mpmath.mpf]) -> str:
+    return "(" + ", ".join(f"{float(x):.4g}" for x in exact) + ")"
+
+
+def _bound_text(thin: bool) -> str:
+    return "I1 1e-9, I2 I3 1e-12" if thin else "1e-12"
+
+
+def geometry_cases(quick: bool) -> list[MeshCase]:
+    """The issue's geometry battery (meshes; points and two materials are separate)."""
+    cases = [MeshCase("box 1x2x3, generic rotation", placed(box(1, 2, 3)[0]), BOX_FACES)]
+    for sizes in (1e3, 1e6, 1e8):
+        v = placed(box(1, 2, 3)[0], offset=sizes * 3.0 * DIRECTION)
+        cases.append(MeshCase(f"box 1x2x3 rotated, offset {sizes:.0e} sizes", v, BOX_FACES))
+    for thin in (1e-3, 1e-6):
+        v = placed(box(1, thin, thin)[0], offset=np.array([0.25, -1.5, 2.0]))
+        cases.append(MeshCase(f"needle 1 x {thin:.0e} x {thin:.0e}, rotated", v, BOX_FACES, thin=True))
+    cases.append(MeshCase("plate 1 x 1 x 1e-6, rotated", placed(box(1, 1, 1e-6)[0]), BOX_FACES, thin=True))
+    for scale in (1e-9, 1e9):
+        cases.append(MeshCase(f"box 1x2x3 m x {scale:.0e}, rotated", placed(box(scale, 2 * scale, 3 * scale)[0]),
+                              BOX_FACES))
+    return cases
+
+
+def summation_cases(quick: bool) -> list[tuple[int, MeshCase]]:
+    """UV spheres of 1e2 .. 1e7 triangles, rotated, 100 radii from the origin."""
+    sizes = [100, 1_000, 10_000, 100_000] + ([] if quick else [1_000_000, 10_000_000])
+    out = []
+    for n in sizes:
+        v, f = sphere_with_triangles(n)
+        peers = ("trimesh", "numpy-stl", "mujoco") if n <= 1_000_000 else ("trimesh",)
+        note = "" if n <= 1_000_000 else "numpy-stl and MuJoCo not run at 1e7 (see notes)"
+        out.append((n, MeshCase(f"UV sphere {len(f):.2g} triangles, rotated, offset 100 r",
+                                placed(v, offset=100.0 * DIRECTION), f, peers=peers, note=note)))
+    return out
+
+
+def two_material_case(ratio: float = 1e6, offset: float = 1e3) -> Row:
+    """Two unit cubes of densities 1 and ``ratio`` (tetrahedra), rotated and moved ``offset`` sizes."""
+    start = time.perf_counter()
+    pts, tets, rho = two_material_boxes(ratio)
+    pts = placed(pts, offset=offset * 2.0 * DIRECTION)
+    mass, _, tensor = exact_tetrahedra(pts, tets, rho)
+    exact = exact_eigenvalues(tensor)
+    props = mass_properties(VolumeBody(pts, tets, cell_density=rho))
+    errors = moment_errors(props.principal_moments, exact)
+    parts = []
+    for k in (0, 1):
+        sel = tets[6 * k: 6 * k + 6]
+        parts.append((pts, boundary_faces(sel, pts), float(rho[6 * k])))
+    mj = mujoco_moments(parts)
+    peers: dict[str, float | str] = {
+        "trimesh": "n/a: one density per mesh",
+        "numpy-stl": "n/a: one density per mesh",
+        "mujoco": mj if isinstance(mj, str) else _worst(moment_errors(mj, exact), _bounds(False)),
+    }
+    estimate = float(props.relative_error_estimate)
+    worst = max(errors)
+    passed = all(np.isfinite(errors)) and worst <= BOUND_EXACT and worst <= estimate
+    return Row("geometry", f"two materials, densities 1 and {ratio:.0e}, rotated, offset {offset:.0e} sizes",
+               _fmt_moments(exact), worst, estimate, peers, BOUND_EXACT, "1e-12", passed,
+               estimate <= BOUND_EXACT, "VolumeBody cell_density; MuJoCo: two mesh geoms",
+               time.perf_counter() - start, {"errors": errors})
+
+
+def point_case(n: int) -> Row:
+    """n point masses spanning 1e-12 .. 1e12 kg: exact integer sums vs ours and naive float64."""
+    start = time.perf_counter()
+    masses, positions = log_uniform_points(n)
+    _, _, tensor = exact_points(masses, positions)
+    exact = exact_eigenvalues(tensor)
+    props = mass_properties(PointBody(masses, positions))
+    errors = moment_errors(props.principal_moments, exact)
+    naive = _naive_points(masses, positions)
+    naive_err = max(moment_errors(naive, exact))
+    estimate = float(props.relative_error_estimate)
+    worst = max(errors)
+    passed = all(np.isfinite(errors)) and worst <= BOUND_EXACT and worst <= estimate
+    peers: dict[str, float | str] = {k: "n/a: meshes only" for k in ("trimesh", "numpy-stl", "mujoco")}
+    return Row("geometry", f"{n:.0e} point masses, 1e-12 .. 1e12 kg", _fmt_moments(exact), worst, estimate, peers,
+               BOUND_EXACT, "1e-12", passed, estimate <= BOUND_EXACT,
+               f"naive float64 (sum about origin, then shift): {naive_err:.1e}", time.perf_counter() - start,
+               {"errors": errors})
+
+
+def _naive_points(masses: Array, x: Array) -> Array:
+    m = masses.sum()
+    c = (masses[:, None] * x).sum(axis=0) / m
+    second = np.einsum("n,ni,nj->ij", masses, x, x) - m * np.outer(c, c)
+    return np.linalg.eigvalsh(np.trace(second) * np.eye(3) - second)
+
+
+# -- classification rows --------------------------------------------------------------------
+
+
+def near_symmetric_flip(eps: float = 1e-9) -> dict[str, object]:
+    """Box 1 x 1 x (1 + eps), rotated: the exact tolerance at which its class flips, and ours.
+
+    Its exact moments are I1 < I2 = I3 up to rounding (a square cross-section):
+    prolate symmetric below the flip, spherical at or above gap / I3.
+    """
+    v = placed(box(1.0, 1.0, 1.0 + eps)[0])
+    exact = exact_eigenvalues(exact_solid(v, BOX_FACES)[2])
+    with mpmath.workdps(50):
+        flip = float((exact[2] - exact[0]) / exact[2])
+        pair = float((exact[2] - exact[1]) / exact[2])
+    props = mass_properties(MeshBody(v, BOX_FACES), density=1.0)
+    frame = principal_frame(props)
+    ours = np.sort(props.principal_moments)
+    ours_flip = (ours[2] - ours[0]) / ours[2]
+    below = classify(frame, tolerance=flip * (1 - 1e-2)).rotor
+    above = classify(frame, tolerance=flip * (1 + 1e-2)).rotor
+    peers: dict[str, float | str] = {}
+    for name, result in (("trimesh", trimesh_moments(v, BOX_FACES)), ("numpy-stl", numpy_stl_moments(v, BOX_FACES)),
+                         ("mujoco", mujoco_moments([(v, BOX_FACES, 1.0)]))):
+        peers[name] = result if isinstance(result, str) else abs((result[2] - result[0]) / result[2] - flip) / flip
+    return {"flip": flip, "pair": pair, "ours_flip": ours_flip, "flip_error": abs(ours_flip - flip) / flip,
+            "below": below, "above": above, "peers": peers, "estimate": float(props.relative_error_estimate),
+            "passed": below is RotorClass.SYMMETRIC_PROLATE and above is RotorClass.SPHERICAL}
+
+
+def smallest_true_tolerance(moments: Array, true: RotorClass) -> float:
+    """Smallest tolerance (to 1%) at which ``classify`` calls these moments ``true`` (inf: none)."""
+    from service.principal import PrincipalFrame
+
+    frame = PrincipalFrame.from_eigen(np.asarray(moments), np.eye(3))
+    grid = 10.0 ** np.arange(-17.0, 0.0, 0.25)
+    hits = [k for k, tol in enumerate(grid) if classify(frame, tolerance=float(tol)).rotor is true]
+    if not hits:
+        return math.inf
+    hi = float(grid[hits[0]])
+    lo = float(grid[hits[0] - 1]) if hits[0] > 0 else hi / 10
+    while hi / lo > 1.01:
+        mid = math.sqrt(lo * hi)
+        if classify(frame, tolerance=mid).rotor is true:
+            hi = mid
+        else:
+            lo = mid
+    return hi
+
+
+def tessellation_rows() -> list[dict[str, object]]:
+    """Where tessellation noise meets the tolerance: UV spheres and n-gon cylinders."""
+    rows = []
+    specs: list[tuple[str, Array, NDArray[np.int64], RotorClass, str]] = []
+    for n_lat in (8, 16, 32, 64, 128):
+        v, f = uv_sphere(n_lat, 2 * n_lat)
+        specs.append((f"UV sphere {n_lat} x {2 * n_lat} ({len(f)} tri)", v, f, RotorClass.SPHERICAL,
+                      f"(pi/{2 * n_lat})^2 / 3 = {(math.pi / (2 * n_lat)) ** 2 / 3:.1e}"))
+    for n in (16, 32, 64, 128):
+        v, f = prism(n, 1.0, math.sqrt(3.0))
+        specs.append((f"{n}-gon cylinder, h = sqrt(3) r (ideal: spherical)", v, f, RotorClass.SPHERICAL,
+                      f"(pi/{n})^2 / 3 = {(math.pi / n) ** 2 / 3:.1e}"))
+    v, f = prism(32, 1.0, 2.0)
+    specs.append(("32-gon cylinder, h = 2 r (ideal: prolate... oblate)", v, f, RotorClass.SYMMETRIC_PROLATE, ""))
+    for name, v, f, true, scale in specs:
+        v = placed(v)
+        exact = exact_eigenvalues(exact_solid(v, f)[2])
+        props = mass_properties(MeshBody(v, f), density=1.0)
+        ours = np.sort(props.principal_moments)
+        with mpmath.workdps(50):
+            spread = float((exact[2] - exact[0]) / exact[2]) if true is RotorClass.SPHERICAL else \
+                float(min(exact[1] - exact[0], exact[2] - exact[1]) / exact[2])
+        if true is not RotorClass.SPHERICAL:
+            true = RotorClass.SYMMETRIC_PROLATE if exact[1] - exact[0] > exact[2] - exact[1] else RotorClass.SYMMETRIC_OBLATE
+        rows.append({"case": name.replace("(ideal: prolate... oblate)", f"(ideal: {true.value})"), "spread": spread,
+                     "scale": scale, "true": true, "tol_ours": smallest_true_tolerance(ours, true),
+                     "tol_exact_moments": smallest_true_tolerance(np.array([float(x) for x in exact]), true),
+                     "default_ok": classify(principal_frame(props)).rotor is true})
+    return rows
+
+
+# -- motion rows ------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class MotionCase:
+    name: str
+    moments: tuple[float, float, float]
+    omega: tuple[float, float, float]
+    tolerance: float = 1e-6
+    note: str = ""
+
+
+def motion_cases() -> list[MotionCase]:
+    """The precession issue's extreme cases, each over 1e5 time units."""
+    i = (1.0, 2.0, 3.0)
+    cases = [MotionCase("asymmetric (1, 2, 3), generic Omega", i, (0.6, 0.3, 0.8))]
+    for eps, side in ((1e-12, "above"), (-1e-12, "below")):
+        # I1 (I1 - I2) w1^2 + I3 (I3 - I2) w3^2 = M^2 - 2 E I2 = eps M^2, with w2 = 0.5, w3 = 1
+        m2 = 3.0 + 4 * 0.25 + 9.0 + 0.0
+        cases.append(MotionCase(f"separatrix, M^2 - 2EI2 = {eps:+.0e} M^2 ({side})", i,
+                                (math.sqrt(3.0 - eps * m2), 0.5, 1.0)))
+    cases += [
+        MotionCase("1e-9 off the intermediate axis", i, (1e-9, 1.0, 1e-9)),
+        MotionCase("nearly linear I = (1e-9, 1, 1)", (1e-9, 1.0, 1.0), (0.3, 1.0, 0.5), tolerance=1e-12,
+                   note="tolerance 1e-12: modelled as the prolate top it is (at 1e-6 it is a linear rotator)"),
+        MotionCase("nearly symmetric I = (1, 1, 1 + 1e-12)", (1.0, 1.0, 1.0 + 1e-12), (0.6, 0.3, 0.8),
+                   tolerance=1e-15, note="tolerance 1e-15: modelled as the oblate top it is"),
+        MotionCase("‖Ω‖ = 1e6, slow asymmetry I = (1, 1 + 1e-6, 2)", (1.0, 1.0 + 1e-6, 2.0),
+                   (6e5, 3e5, 7.4e5), tolerance=1e-9),
+        MotionCase("moments x 1e-30", (1e-30, 2e-30, 3e-30), (0.6, 0.3, 0.8)),
+        MotionCase("moments x 1e30", (1e30, 2e30, 3e30), (0.6, 0.3, 0.8)),
+    ]
+    return cases
+
+
+def invariant_drift(moments: Array, omega_body: Array, quaternion: Array, axes: Array) -> tuple[float, float]:
+    """Max relative drift of E and of M in the fixed frame, computed here (not by the service)."""
+    energy = 0.5 * np.sum(moments * omega_body**2, axis=1)
+    m_body = (moments * omega_body) @ axes  # principal -> input components at t = 0
+    m_fixed = Rotation.from_quat(quaternion, scalar_first=True).apply(m_body)
+    e_drift = float(np.max(np.abs(energy - energy[0])) / energy[0])
+    m_drift = float(np.max(np.linalg.norm(m_fixed - m_fixed[0], axis=1)) / np.linalg.norm(m_fixed[0]))
+    return e_drift, m_drift
+
+
+def scipy_motion(moments: Array, omega: Array, t: Array) -> tuple[Array, Array]:
+    """Euler's equations + quaternion kinematics by scipy's DOP853 at rtol 1e-12 (principal frame).
+
+    ``scipy.integrate.ode("dop853")`` is Hairer's Fortran DOP853; it gives what
+    ``solve_ivp(method="DOP853")`` gives, about 3x faster (no Python step loop).
+    """
+    from scipy.integrate import ode
+
+    i1, i2, i3 = (float(x) for x in moments)
+    a, b, c = (i2 - i3) / i1, (i3 - i1) / i2, (i1 - i2) / i3  # Euler's equations, L&L eq. (36.5)
+
+    def rhs(_: float, y: Sequence[float]) -> list[float]:
+        w1, w2, w3, q0, q1, q2, q3 = y
+        return [a * w2 * w3, b * w3 * w1, c * w1 * w2,  # quaternion: dq/dt = q (0, Omega_body) / 2
+                0.5 * (-q1 * w1 - q2 * w2 - q3 * w3), 0.5 * (q0 * w1 + q2 * w3 - q3 * w2),
+                0.5 * (q0 * w2 + q3 * w1 - q1 * w3), 0.5 * (q0 * w3 + q1 * w2 - q2 * w1)]
+
+    scale = float(np.linalg.norm(omega))
+    atol = np.r_[np.full(3, 1e-15 * scale), np.full(4, 1e-15)]
+    solver = ode(rhs).set_integrator("dop853", rtol=SCIPY_RTOL, atol=atol, nsteps=10**9)
+    solver.set_initial_value(np.r_[omega, 1.0, 0.0, 0.0, 0.0], 0.0)
+    out = [np.r_[omega, 1.0, 0.0, 0.0, 0.0]]
+    for tt in t[1:]:
+        out.append(np.array(solver.integrate(tt)))
+        if not solver.successful():
+            raise RuntimeError(f"dop853 stopped at t = {solver.t:.3g} (code {solver.get_return_code()})")
+    y = np.array(out)
+    return y[:, :3], y[:, 3:]
+
+
+def reference_omega(moments: Sequence[float], omega: Sequence[float], t: Array, digits: int = 40) -> Array:
+    """Omega(t) in the principal frame from the closed forms, at ``digits`` digits.
+
+    Symmetric top (two equal moments): the perpendicular part turns at the
+    body precession rate (I_s - I_p) / I_p Omega_s (L&L §33).  Asymmetric top:
+    Jacobi elliptic functions (L&L §37, eq. 37.10 and its 1 <-> 3 variant below
+    the separatrix), phase from Omega(0), signs fixed by Euler's equations.
+    """
+    with mpmath.workdps(digits):
+        I = [mpmath.mpf(x) for x in moments]
+        w = [mpmath.mpf(x) for x in omega]
+        if I[0] == I[1] or I[1] == I[2]:
+            return _symmetric_reference(I, w, t)
+        return _elliptic_reference(I, w, t)
+
+
+def _symmetric_reference(I: list[mpmath.mpf], w: list[mpmath.mpf], t: Array) -> Array:
+    s = 2 if I[0] == I[1] else 0
+    p, q = [k for k in range(3) if k != s]
+    rate = (I[s] - I[p]) / I[p] * w[s]  # d(w_p + i w_q)/dt = i * rate * (w_p + i w_q), sign from Euler
+    sign = 1 if (s, p, q) in ((2, 0, 1), (0, 1, 2)) else -1
+    out = np.empty((len(t), 3))
+    for n, tt in enumerate(t):
+        ang = sign * rate * mpmath.mpf(float(tt))
+        c, sn = mpmath.cos(ang), mpmath.sin(ang)
+        out[n, s] = float(w[s])
+        out[n, p] = float(w[p] * c - w[q] * sn)
+        out[n, q] = float(w[p] * sn + w[q] * c)
+    return out
+
+
+def _elliptic_reference(I: list[mpmath.mpf], w: list[mpmath.mpf], t: Array) -> Array:
+    E2 = sum(i * x * x for i, x in zip(I, w))  # 2E
+    M2 = sum((i * x) ** 2 for i, x in zip(I, w))
+    # above the separatrix Omega_3 keeps its sign (dn), below Omega_1 does
+    d, c = (2, 0) if M2 > E2 * I[1] else (0, 2)
+    i1, i2, i3 = I
+    if d == 2:
+        amp = [mpmath.sqrt((E2 * i3 - M2) / (i1 * (i3 - i1))), mpmath.sqrt((E2 * i3 - M2) / (i2 * (i3 - i2))),
+               mpmath.sqrt((M2 - E2 * i1) / (i3 * (i3 - i1)))]
+        rate = mpmath.sqrt((i3 - i2) * (M2 - E2 * i1) / (i1 * i2 * i3))
+        m = (i2 - i1) * (E2 * i3 - M2) / ((i3 - i2) * (M2 - E2 * i1))
+    else:
+        amp = [mpmath.sqrt((E2 * i3 - M2) / (i1 * (i3 - i1))), mpmath.sqrt((M2 - E2 * i1) / (i2 * (i2 - i1))),
+               mpmath.sqrt((M2 - E2 * i1) / (i3 * (i3 - i1)))]
+        rate = mpmath.sqrt((i2 - i1) * (E2 * i3 - M2) / (i1 * i2 * i3))
+        m = (i3 - i2) * (M2 - E2 * i1) / ((i2 - i1) * (E2 * i3 - M2))
+    sd = 1 if w[d] > 0 else -1
+    best = None
+    for sigma in (1, -1):
+        phi0 = mpmath.atan2(w[1] / (sigma * amp[1]), w[c] / amp[c])
+        tau0 = mpmath.ellipf(phi0, m)
+
+        def at(tau: mpmath.mpf, sigma: int = sigma) -> list[mpmath.mpf]:
+            sn, cn, dn = (mpmath.ellipfun(k, tau, m=m) for k in ("sn", "cn", "dn"))
+            out = [mpmath.mpf(0)] * 3
+            out[c], out[1], out[d] = amp[c] * cn, sigma * amp[1] * sn, sd * amp[d] * dn
+            return out
+
+        h = mpmath.mpf(10) ** -15
+        plus, minus = at(tau0 + rate * h), at(tau0 - rate * h)
+        deriv = [(a - b) / (2 * h) for a, b in zip(plus, minus)]
+        euler = [(i2 - i3) / i1 * w[1] * w[2], (i3 - i1) / i2 * w[2] * w[0], (i1 - i2) / i3 * w[0] * w[1]]
+        mismatch = max(abs(a - b) for a, b in zip(deriv, euler)) + max(abs(a - b) for a, b in zip(at(tau0), w))
+        if best is None or mismatch < best[0]:
+            best = (mismatch, at, tau0)
+    assert best is not None
+    _, at, tau0 = best
+    return np.array([[float(x) for x in at(tau0 + rate * mpmath.mpf(float(tt)))] for tt in t])
+
+
+def measure_motion(case: MotionCase, samples: int = 2001, reference_samples: int = 41,
+                   run_scipy: bool = True) -> dict[str, object]:
+    """Invariant drift of our exact method (and scipy DOP853) over 1e5 time units; Omega error vs mpmath."""
+    from service.pipeline import precession
+
+    start = time.perf_counter()
+    result = precession(case.omega, principal_moments=case.moments, tolerance=case.tolerance,
+                        duration=HORIZON, samples=samples, method="exact")
+    traj = result.motion.trajectory
+    assert traj is not None
+    frame = result.frame
+    moments = np.asarray(frame.moments)
+    effective = _effective_moments(moments, result.classification.rotor)
+    e_drift, m_drift = invariant_drift(effective, np.asarray(traj.omega_body), np.asarray(traj.quaternion),
+                                       np.asarray(frame.axes))
+    finite = all(np.all(np.isfinite(np.asarray(a))) for a in (traj.omega_body, traj.quaternion, traj.omega))
+    omega_body0 = np.asarray(frame.axes) @ np.asarray(case.omega)
+    pick = np.linspace(0, samples - 1, reference_samples).astype(int)
+    ref = reference_omega(effective, omega_body0, np.asarray(traj.t)[pick])
+    scale = float(np.linalg.norm(omega_body0))
+    ours_err = float(np.max(np.linalg.norm(np.asarray(traj.omega_body)[pick] - ref, axis=1)) / scale)
+    out: dict[str, object] = {
+        "case": case.name, "note": case.note, "regime": result.motion.regime.value,
+        "energy_drift": e_drift, "momentum_drift": m_drift, "omega_error": ours_err, "finite": finite,
+        "service_drift": (result.motion.diagnostics.energy_drift, result.motion.diagnostics.momentum_drift),
+        "passed": finite and e_drift <= BOUND_INVARIANT and m_drift <= BOUND_INVARIANT,
+    }
+    out["scipy"] = _scipy_cell(case, effective, omega_body0, frame, run_scipy)
+    out["seconds"] = time.perf_counter() - start
+    return out
+
+
+def _effective_moments(moments: Array, rotor: RotorClass) -> Array:
+    """The moments the exact motion is computed with (service.motion's ideal top)."""
+    ideal = moments.copy()
+    if rotor is RotorClass.SPHERICAL:
+        ideal[:] = moments.mean()
+    elif rotor is RotorClass.SYMMETRIC_OBLATE:
+        ideal[:2] = moments[:2].mean()
+    elif rotor in (RotorClass.SYMMETRIC_PROLATE, RotorClass.LINEAR):
+        ideal[1:] = moments[1:].mean()
+    if rotor is RotorClass.LINEAR:
+        ideal[0] = 0.0
+    return ideal
+
+
+def _scipy_cell(case: MotionCase, moments: Array, omega_body0: Array, frame: object, run: bool) -> dict[str, object]:
+    rate = float(np.linalg.norm(omega_body0))
+    horizon = HORIZON if rate * HORIZON <= SCIPY_MAX_ANGLE else 1e5 / rate
+    if not run:
+        return {"skipped": "skipped (--quick)"}
+    t = np.linspace(0.0, horizon, 2001)
+    start = time.perf_counter()
+    try:
+        w, q = scipy_motion(moments, omega_body0, t)
+    except Exception as exc:  # a peer that fails gets that text in its cell
+        return {"skipped": f"raises {type(exc).__name__}: {exc}"}
+    e_drift, m_drift = invariant_drift(moments, w, q, np.eye(3))
+    pick = np.linspace(0, len(t) - 1, 41).astype(int)
+    ref = reference_omega(moments, omega_body0, t[pick])
+    err = float(np.max(np.linalg.norm(w[pick] - ref, axis=1)) / rate)
+    return {"energy_drift": e_drift, "momentum_drift": m_drift, "omega_error": err, "horizon": horizon,
+            "seconds": time.perf_counter() - start}
+
+
+# -- report -----------------------------------------------------------------------------------
+
+
+def _cell(x: float | str | None) -> str:
+    if x is None:
+        return "—"
+    if isinstance(x, str):
+        return x
+    if not math.isfinite(x):
+        return "inf"
+    return "0" if x == 0 else f"{x:.1e}"
+
+
+def _tol(x: object) -> str:
+    """A smallest tolerance; at the bottom of the scan the moments are equal floats."""
+    assert isinstance(x, float)
+    return "any (equal in float64)" if x <= 1.01e-17 else _cell(x)
+
+
+def _mark(row: Row) -> str:
+    if not row.passed:
+        return "**FAIL**"
+    return "pass" if row.estimate_ok else "pass\\*"
+
+
+def geometry_table(rows: list[Row]) -> list[str]:
+    lines = ["| case | exact principal moments (unit density) | ours rel. err | our estimate | trimesh | "
+             "numpy-stl | MuJoCo | bound | pass |", "|---|---|---|---|---|---|---|---|---|"]
+    for r in rows:
+        peers = [_cell(r.peers.get(k, "—")) for k in ("trimesh", "numpy-stl", "mujoco")]
+        case = r.case + (f" ({r.note})" if r.note else "")
+        lines.append(f"| {case} | {r.exact} | {_cell(r.ours)} | {_cell(r.estimate)} | " + " | ".join(peers)
+                     + f" | {r.bound_text} | {_mark(r)} |")
+    return lines
+
+
+def render(geometry: list[Row], growth: list[Row], flip: dict[str, object], tess: list[dict[str, object]],
+           motion: list[dict[str, object]], quick: bool, elapsed: float, timings: dict[str, tuple[float, float]]) -> str:
+    failures = [r for r in geometry + growth if not r.passed] + [m for m in motion if not m["passed"]]
+    over = [r for r in geometry + growth if r.passed and not r.estimate_ok]
+    out = [
+        "# Numerical stability report",
+        "",
+        "Generated by `python -m benchmarks.stability` "
+        + ("with `--quick` (largest cases skipped)" if quick else "(full battery)")
+        + f" in {elapsed:.0f} s. Regenerate with that command; `--quick` skips the 1e6 and 1e7 cases. "
+        "Every row's bound is also asserted by `tests/test_stability.py`.",
+        "",
+        f"**Summary:** {len(geometry) + len(growth) + len(motion) + 1} rows; "
+        + (f"{len(failures)} fail their bound" if failures else "every row meets its bound")
+        + (f"; {len(over)} row(s) meet it but our `relative_error_estimate` is above the API's promised 1e-12 "
+           "(marked pass\\*, see the note under the table)" if over else "")
+        + ". No NaN or infinity from the service anywhere in the battery.",
+        "",
+        "Errors are relative, per principal moment against its own exact value; a cell shows the worst moment "
+        "(for needles and plates, the one nearest its bound). **Exact** values come from rational integration "
+        "of the float64 vertices as stored (after rotation and translation) and 50-digit eigenvalues, never "
+        "from our code (`tests/exact.py`). Pass = our error within the bound and within our own "
+        "`relative_error_estimate`.",
+        "",
+        "## Geometry",
+        "",
+    ]
+    out += geometry_table(geometry)
+    out += ["", "### Summation error growth (meshes of 1e2 to 1e7 triangles)", ""]
+    out += geometry_table(growth)
+    out += [
+        "",
+        "Wall time per row, ours / whole row (exact reference + all tools): "
+        + ", ".join(f"{k}: {a:.1f} s / {b:.1f} s" for k, (a, b) in timings.items()) + ".",
+        "",
+        "Notes:",
+        "",
+        "- numpy-stl stores vertices as float32, so it integrates a different polyhedron (coordinates moved by up "
+        "to 6e-8 relative; at an offset of 1e8 sizes the box collapses). Its column is its error against the "
+        "float64 polyhedron every other tool gets, as the issue asks: it measures what a user gets, not its "
+        "arithmetic. MuJoCo also keeps mesh vertices in float32 and rejects tiny volumes/areas (its cells say so).",
+        "- trimesh integrates about the file's origin and shifts to the centre of mass afterwards, so its error "
+        "grows with the offset squared; its eigen-solver's error is relative to the largest moment, which is "
+        "why the needle's smallest moment suffers.",
+        "- pass\\*: our error is within the bound, but `relative_error_estimate` exceeds the API's promise "
+        "(estimate <= 1e-12 up to 1e8 sizes). The estimate grows linearly with the triangle count because each "
+        "apex tetrahedron's determinant is bounded by sum |a_i b_j c_k|, which for a fine mesh is ~n times its "
+        "volume; see the report to the team for the fix.",
+        "",
+        "## Classification",
+        "",
+    ]
+    out += _flip_lines(flip)
+    out += ["", "### Tessellation noise against the tolerance", "",
+            "| body (rotated) | true class | spread of moments that should be equal | chord-error scale | "
+            "smallest tolerance giving the true class | default 1e-6 gives it |", "|---|---|---|---|---|---|"]
+    for t in tess:
+        out.append(f"| {t['case']} | {t['true'].value} | {_cell(t['spread'])} | {t['scale'] or '—'} | "  # type: ignore[union-attr]
+                   f"{_tol(t['tol_ours'])} (exact moments: {_tol(t['tol_exact_moments'])}) | "
+                   f"{'yes' if t['default_ok'] else 'no'} |")
+    out += ["", *TOLERANCE_ADVICE, "", "## Motion (each over 1e5 time units)", ""]
+    out += _motion_lines(motion)
+    if failures:
+        out += ["", "## Failures", ""]
+        for r in failures:
+            if isinstance(r, Row):
+                out.append(f"- {r.case}: error {r.ours:.2e}, estimate {r.estimate:.2e}, bound {r.bound_text}")
+            else:
+                out.append(f"- motion {r['case']}: energy drift {r['energy_drift']:.2e}, |M| drift "
+                           f"{r['momentum_drift']:.2e}, bound 1e-12")
+    return "\n".join(out) + "\n"
+
+
+TOLERANCE_ADVICE = [
+    "**What tolerance to pass for tessellated CAD parts.** The default `tolerance=1e-6` is for exact geometry: "
+    "our moments of the stored polyhedron are good to ~1e-15, so 1e-6 separates only deliberately different "
+    "moments. A tessellated part is a different solid from the designed one, and the table shows by how much: "
+    "moments the design makes equal differ by (pi/n)^2 / 3, n the number of segments per full circle (the "
+    "chord error: the sagitta of a segment is r (pi/n)^2 / 2), for n-gon cylinders and for UV spheres alike "
+    "(n = segments around the equator). At 1e-6 such a part is classified by its tessellation, not its "
+    "design. Pass **tolerance = (pi/n)^2** for the coarsest round feature, three times the spread, i.e. "
+    "**1e-2 for 32 segments per circle, 3e-3 for 64, 1e-3 for 128**; if the export is specified by chord "
+    "height h instead, tolerance = 2 h / r. Moments that the tessellation itself keeps symmetric (the "
+    "in-plane pair of a regular n-gon, the equatorial pair of a UV sphere) stay equal to rounding (~1e-16) "
+    "and need no such allowance.",
+]
+
+
+def _flip_lines(flip: dict[str, object]) -> list[str]:
+    peers = flip["peers"]
+    assert isinstance(peers, dict)
+    return [
+        "| case | exact flip tolerance (I3 - I1)/I3 | our rel. err of it | trimesh | numpy-stl | MuJoCo | "
+        "our class at 0.99 x / 1.01 x flip | pass |",
+        "|---|---|---|---|---|---|---|---|",
+        f"| box 1 x 1 x (1 + 1e-9), rotated | {flip['flip']:.6e} | {_cell(flip['flip_error'])} | "  # type: ignore[str-format]
+        + " | ".join(_cell(peers[k]) for k in ("trimesh", "numpy-stl", "mujoco"))
+        + f" | {flip['below'].value} / {flip['above'].value} | "  # type: ignore[union-attr]
+        + ("pass" if flip["passed"] else "**FAIL**") + " |",
+        "",
+        f"The equal pair differs by {flip['pair']:.1e} of I3 (rounding of the rotated vertices), so the class "
+        "is prolate symmetric for tolerances from there up to the flip, spherical above it. Peer columns are "
+        "their relative error of the flip tolerance: a value near 1 means the peer cannot place the flip.",
+    ]
+
+
+def _motion_lines(motion: list[dict[str, object]]) -> list[str]:
+    lines = ["| case | regime | ours (exact): E drift | \\|M\\| drift | Omega err | scipy DOP853 rtol 1e-12: "
+             "E drift | \\|M\\| drift | Omega err | bound (ours) | pass |", "|---|---|---|---|---|---|---|---|---|---|"]
+    for m in motion:
+        s = m["scipy"]
+        assert isinstance(s, dict)
+        if "skipped" in s:
+            sc = [str(s["skipped"]), "", ""]
+        else:
+            horizon = "" if s["horizon"] == HORIZON else f" (over {s['horizon']:.0e} s = 1e5 rad)"
+            sc = [_cell(s["energy_drift"]) + horizon, _cell(s["momentum_drift"]), _cell(s["omega_error"])]  # type: ignore[arg-type]
+        case = str(m["case"]) + (f" ({m['note']})" if m["note"] else "")
+        lines.append(f"| {case} | {m['regime']} | {_cell(m['energy_drift'])} | {_cell(m['momentum_drift'])} | "  # type: ignore[arg-type]
+                     f"{_cell(m['omega_error'])} | " + " | ".join(sc)  # type: ignore[arg-type]
+                     + f" | 1e-12 | {'pass' if m['passed'] else '**FAIL**'} |")
+    lines += [
+        "",
+        "Drifts are max over 2001 samples of |E(t) - E(0)|/E(0) and |M(t) - M(0)|/|M(0)| with M in the fixed "
+        "frame, recomputed here from the trajectory (Omega_body and the attitude quaternion), not taken from the "
+        "service's diagnostics. Omega err is max |Omega(t) - Omega_ref(t)| / |Omega| at 41 times against the "
+        "mpmath closed form at 40 digits; for the exact method it is the phase error of rounding the "
+        "frequency (~ t x rate x 1e-16, so up to ~1e-11 at 1e5 time units; near the separatrix the phase is "
+        "exponentially sensitive and any float64 method loses it). No bound is claimed on Omega err.",
+    ]
+    return lines
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--quick", action="store_true", help="skip the 1e6/1e7 meshes and points and scipy runs")
+    parser.add_argument("--output", type=Path, default=ROOT / "docs" / "stability.md")
+    args = parser.parse_args(argv)
+    started = time.perf_counter()
+    # the motion cases (scipy at rtol 1e-12 over 1e5 rad is the slow part) run on the second core
+    pool = ProcessPoolExecutor(max_workers=2)
+    futures = [pool.submit(measure_motion, c, run_scipy=not args.quick) for c in motion_cases()]
+    geometry = [measure_mesh(c) for c in geometry_cases(args.quick)]
+    geometry.append(two_material_case())
+    geometry.append(point_case(100_000 if args.quick else 1_000_000))
+    growth: list[Row] = []
+    timings: dict[str, tuple[float, float]] = {}
+    for n, case in summation_cases(args.quick):
+        t0 = time.perf_counter()
+        growth.append(measure_mesh(case))
+        timings[f"{len(case.faces):.1e} triangles"] = (growth[-1].extra["ours_s"], time.perf_counter() - t0)
+        print(f"  {case.name}: {growth[-1].seconds:.1f} s", file=sys.stderr)
+    flip = near_symmetric_flip()
+    tess = tessellation_rows()
+    motion = [f.result() for f in futures]
+    pool.shutdown()
+    for m in motion:
+        print(f"  {m['case']}: {m['seconds']:.1f} s", file=sys.stderr)
+    text = render(geometry, growth, flip, tess, motion, args.quick, time.perf_counter() - started, timings)
+    args.output.parent.mkdir(parents=True, exist_ok=True)
+    args.output.write_text(text)
+    print(text)
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
