@@ -270,7 +270,7 @@ def _verdict(row: Row, workers: int, quick: bool) -> list[str]:
 
 
 def _notes(rows: list[Row], workers: int) -> list[str]:
-    out = ["## Notes", ""]
+    out = ["### Notes", ""]
     for row in rows:
         pipeline = row.trimesh_s / row.analyze_s
         scaling = row.analyze_s / (row.batch_s - row.startup_s)
@@ -293,7 +293,7 @@ def render(rows: list[Row], workers: int, quick: bool, command: str, loads: list
     import trimesh
 
     lines = [
-        "# Batch throughput",
+        "## Throughput",
         "",
         (f"Measured by `{command}` on {_today()}: {_cpu_model()}, {os.cpu_count()} cores, Python "
         f"{platform.python_version()}, dask {dask.__version__}, trimesh {trimesh.__version__}. "
@@ -326,7 +326,7 @@ def render(rows: list[Row], workers: int, quick: bool, command: str, loads: list
     if small is not None:
         lines += _verdict(small, workers, quick)
     lines += [
-        "## Memory per worker",
+        "### Memory per worker",
         "",
         f"Resident set size of each worker process, sampled every {SAMPLE_EVERY_S} s by a second client",
         "(`client.run(psutil.Process().memory_info().rss)`) during the best batch round, and the peak the",
@@ -340,6 +340,21 @@ def render(rows: list[Row], workers: int, quick: bool, command: str, loads: list
         "",
     ]
     return "\n".join(lines)
+
+
+START, END = "<!-- benchmark:start -->", "<!-- benchmark:end -->"
+
+
+def write_section(path: Path, text: str) -> None:
+    """Replace the benchmark section of ``path`` (between the markers), or write the file."""
+    section = f"{START}\n{text.rstrip()}\n{END}"
+    old = path.read_text() if path.exists() else ""
+    if START in old and END in old:
+        new = old[: old.index(START)] + section + old[old.index(END) + len(END):]
+    else:
+        new = old + ("\n" if old else "") + section + "\n"
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text(new)
 
 
 def _cpu_model() -> str:
@@ -403,8 +418,7 @@ def main(argv: list[str] | None = None) -> int:
     finally:
         shutil.rmtree(work, ignore_errors=True)
     text = render(rows, args.workers, args.quick, command, loads)
-    args.out.parent.mkdir(parents=True, exist_ok=True)
-    args.out.write_text(text)
+    write_section(args.out, text)
     print(text)
     return 0
 

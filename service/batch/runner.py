@@ -102,6 +102,7 @@ def local_cluster(workers: int | None = None) -> Any:
     with dask.config.set(settings):
         return distributed.LocalCluster(
             n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None, silence_logs=logging.ERROR,
+            preload=["service.batch.tasks"],  # import the pipeline at start-up, not in the first task
         )
 
 
