@@ -191,7 +191,8 @@ def machine_info() -> dict[str, str]:
     return {"CPU": cpu, "cores (os.cpu_count)": str(os.cpu_count()), "memory": mem,
             "OS": platform.platform(), "Python": platform.python_version(),
             **{k: v for k, v in versions.items()},
-            "OPENBLAS_CORETYPE": os.environ.get("OPENBLAS_CORETYPE", "(unset)")}
+            "OPENBLAS_CORETYPE": os.environ.get("OPENBLAS_CORETYPE", "(unset)"),
+            "load average at the end (1, 5, 15 min)": ", ".join(f"{x:.2f}" for x in os.getloadavg())}
 
 
 def _rel(a: np.ndarray, b: np.ndarray) -> float:
@@ -241,7 +242,9 @@ def report(results: dict[str, dict[str, Any]], stages: dict[str, dict[str, float
         lines.append(f"| {r['triangles']:,} | {', '.join(f'{x:.12g}' for x in ours)} "
                      f"| {_rel(r['trimesh']['moments'], ours):.1e} | {_rel(r['numpy-stl']['moments'], ours):.1e} "
                      f"| {r['inertia']['estimate']:.1e} |")
-    lines += ["", "## Machine", ""] + [f"- {k}: {v}" for k, v in machine_info().items()] + [""]
+    lines += ["", "## Machine", "",
+              "Wall times are only comparable within one run: a load average above the core count means",
+              "other work shared the CPUs, which slows every tool (peak memory is unaffected).", ""] + [f"- {k}: {v}" for k, v in machine_info().items()] + [""]
     return "\n".join(lines)
 
 
