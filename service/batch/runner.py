@@ -137,6 +137,9 @@ def run_batch(
     on a local cluster of ``workers`` processes started for this run.
     """
     start = time.perf_counter()
+    if scheduler is not None and workers is not None:
+        raise InvalidParameterError("give --workers (a local cluster) or --scheduler (an existing one), not both",
+                                    parameter="workers")
     output_format(out)  # fail on a bad --out before any work
     sources = list_sources([_absolute(p) for p in paths])
     done = done_names(out) if resume else set()

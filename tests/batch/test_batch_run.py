@@ -223,3 +223,50 @@ def test_progress_bar_shows_rate_on_stderr(library: Library, cluster: Any, tmp_p
     captured = capsys.readouterr()
     assert captured.out == ""
     assert "file/s" in captured.err and "100%" in captured.err
+
+
+class _CountingClient:
+    """A real client that records how many tasks are in flight at once."""
+
+    def __init__(self, client: Any) -> None:
+        self._client = client
+        self.outstanding = 0
+        self.most = 0
+        self.submitted = 0
+
+    def nthreads(self) -> dict[str, int]:
+        return dict(self._client.nthreads())
+
+    def submit(self, *args: Any, **kwargs: Any) -> Any:
+        future = self._client.submit(*args, **kwargs)
+        self.submitted += 1
+        self.outstanding += 1
+        self.most = max(self.most, self.outstanding)
+        future.add_done_callback(self._done)
+        return future
+
+    def _done(self, future: Any) -> None:
+        self.outstanding -= 1
+
+
+def test_tasks_in_flight_stay_within_the_window(library: Library, cluster: Any, tmp_path: Path,
+                                                monkeypatch: pytest.MonkeyPatch) -> None:
+    from distributed import Client
+
+    from service.batch import runner
+
+    monkeypatch.setattr(runner, "TASK_FILES", 1)  # one file per task: 50 tasks through a window of 2 x 2
+    monkeypatch.setattr(runner, "WINDOW_PER_THREAD", 2)
+    with Client(cluster) as client:
+        counting = _CountingClient(client)
+        summary = runner.run_batch([str(library[0])], str(tmp_path / "rows.jsonl"), client=counting, progress=False)
+    assert summary.analysed == N_FILES and summary.errors == len(BROKEN)
+    assert counting.submitted == N_FILES
+    assert counting.most <= 2 * 2
+
+
+def test_workers_and_scheduler_together_are_refused(library: Library, tmp_path: Path,
+                                                    capsys: pytest.CaptureFixture[str]) -> None:
+    code = batch(str(library[0]), "--out", str(tmp_path / "o.jsonl"), "--workers", "2", "--scheduler", "tcp://x:1")
+    assert code == 2
+    assert "not both" in json.loads(capsys.readouterr().err)["error"]["message"]
