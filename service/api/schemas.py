@@ -29,7 +29,14 @@ assert set(METHODS) == set(Method.__args__)  # type: ignore[attr-defined]
 # longer ones belong to the CLI or the library, not to one HTTP response
 MAX_SAMPLES = 10_000
 
+# request numbers beyond 1e100 in magnitude are refused: products of a few of them (m r^2,
+# I omega^2) would leave float64, and no body in SI units comes near
+MAX_MAGNITUDE = 1e100
+
+Real = Annotated[float, Field(ge=-MAX_MAGNITUDE, le=MAX_MAGNITUDE)]
 Vector = Annotated[list[float], Field(min_length=3, max_length=3)]
+RealVector = Annotated[list[Real], Field(min_length=3, max_length=3)]
+RealTensor = Annotated[list[RealVector], Field(min_length=3, max_length=3)]
 Tensor = Annotated[list[Vector], Field(min_length=3, max_length=3)]
 Quaternion = Annotated[list[float], Field(min_length=4, max_length=4)]
 
@@ -77,17 +84,17 @@ class MeshQuery(_Request):
                                "...); inferred from the file name when absent", examples=["stl"])
     units: str | None = Field(None, description="length unit of the file: m, cm, mm, um, in, ft (default m)",
                               examples=["m"])
-    density: float | None = Field(None, gt=0, description="density [kg/m^3] (default 1000); exclusive with mass")
-    mass: float | None = Field(None, gt=0, description="total mass [kg]; the density is then derived")
+    density: float | None = Field(None, gt=0, le=MAX_MAGNITUDE, description="density [kg/m^3] (default 1000); exclusive with mass")
+    mass: float | None = Field(None, gt=0, le=MAX_MAGNITUDE, description="total mass [kg]; the density is then derived")
     model: Literal["solid", "shell"] = Field("solid", description="solid (closed surface or volume mesh) or "
                                              "shell (thin surface, needs thickness)")
-    thickness: float | None = Field(None, gt=0, description="shell wall thickness [file units]")
+    thickness: float | None = Field(None, gt=0, le=MAX_MAGNITUDE, description="shell wall thickness [file units]")
     tolerance: float = Field(1e-6, gt=0, lt=1, description="relative tolerance for equal principal moments")
     reference: str | None = Field(None, description="'x,y,z' point [file units]: also report the tensor about it",
                                   examples=["0,0,0"])
     omega: str | None = Field(None, description="'wx,wy,wz' initial angular velocity [rad/s], input frame: "
                               "adds precession", examples=["0,0.1,1"])
-    duration: float | None = Field(None, gt=0, description="with omega: seconds to predict [s]")
+    duration: float | None = Field(None, gt=0, le=MAX_MAGNITUDE, description="with omega: seconds to predict [s]")
     samples: int | None = Field(None, ge=1, le=MAX_SAMPLES,
                                 description="with omega: number of time samples (at most 10000)")
     method: Method = Field("exact", description="with omega: exact, dop853, rk45 or splitting")
@@ -103,8 +110,8 @@ class MeshQuery(_Request):
 
 
 class PointIn(_Request):
-    mass: float = Field(gt=0, description="point mass [kg]")
-    position: Vector = Field(description="position [units of the request]")
+    mass: float = Field(gt=0, le=MAX_MAGNITUDE, description="point mass [kg]")
+    position: RealVector = Field(description="position [units of the request]")
 
 
 _POINTS_EXAMPLE = {
@@ -122,9 +129,9 @@ class PointsRequest(_Request):
     points: list[PointIn] = Field(min_length=1, description="point masses")
     units: str | None = Field(None, description="length unit of the positions: m, cm, mm, um, in, ft (default m)")
     tolerance: float = Field(1e-6, gt=0, lt=1, description="relative tolerance for equal principal moments")
-    reference: Vector | None = Field(None, description="also report the tensor about this point [units]")
-    omega: Vector | None = Field(None, description="initial angular velocity [rad/s]: adds precession")
-    duration: float | None = Field(None, gt=0, description="with omega: seconds to predict [s]")
+    reference: RealVector | None = Field(None, description="also report the tensor about this point [units]")
+    omega: RealVector | None = Field(None, description="initial angular velocity [rad/s]: adds precession")
+    duration: float | None = Field(None, gt=0, le=MAX_MAGNITUDE, description="with omega: seconds to predict [s]")
     samples: int | None = Field(None, ge=1, le=MAX_SAMPLES,
                                 description="with omega: number of time samples (at most 10000)")
     method: Method = Field("exact", description="with omega: exact, dop853, rk45 or splitting")
@@ -147,12 +154,12 @@ class PrecessionRequest(_Request):
         {"inertia_tensor": [[2.0, 0, 0], [0, 3.0, 0], [0, 0, 4.0]], "omega": [1.0, 0.01, 0.0]},
     ]})
 
-    inertia_tensor: Tensor | None = Field(None, description="inertia about the centre of mass [kg m^2]")
-    principal_moments: Vector | None = Field(None, description="principal moments [kg m^2]; the input frame "
+    inertia_tensor: RealTensor | None = Field(None, description="inertia about the centre of mass [kg m^2]")
+    principal_moments: RealVector | None = Field(None, description="principal moments [kg m^2]; the input frame "
                                              "is then the principal frame")
-    omega: Vector = Field(description="initial angular velocity [rad/s], input frame")
+    omega: RealVector = Field(description="initial angular velocity [rad/s], input frame")
     tolerance: float = Field(1e-6, gt=0, lt=1, description="relative tolerance for equal principal moments")
-    duration: float | None = Field(None, gt=0, description="seconds to predict [s]")
+    duration: float | None = Field(None, gt=0, le=MAX_MAGNITUDE, description="seconds to predict [s]")
     samples: int | None = Field(None, ge=1, le=MAX_SAMPLES,
                                 description="number of time samples (at most 10000)")
     method: Method = Field("exact", description="exact, dop853, rk45 or splitting")
