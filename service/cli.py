@@ -124,6 +124,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     except ServiceError as exc:
         print(json.dumps(exc.as_dict()), file=sys.stderr)
         return EXIT_CODES.get(exc.code, EXIT_INTERNAL)
+    except BrokenPipeError:  # output piped into head & co.: not an error of ours
+        sys.stderr.close()
+        return 0
 
 
 def _analyze(args: argparse.Namespace) -> int:

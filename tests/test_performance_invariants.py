@@ -14,9 +14,11 @@ import struct
 import numpy as np
 import pytest
 
+import service.integrals as integrals
 import service.mass as mass
 import service.topology as topology
 from service.body import MeshBody
+from service.tolerances import EPS
 from service.load.stl import read_stl
 
 from exact import exact_moments, relative_error
@@ -139,8 +141,8 @@ def test_components_match_scipy_labels() -> None:
     np.testing.assert_array_equal(label, ref_label)
 
 
-def _sums(points: np.ndarray, faces: np.ndarray) -> mass._Sums:
-    return mass._integrate(points - mass._local_origin(points), faces, "apex", None)
+def _sums(points: np.ndarray, faces: np.ndarray) -> integrals.Sums:
+    return integrals.simplex_sums(points - integrals.local_origin(points), faces, "apex", None)
 
 
 def test_integration_independent_of_block_size_within_estimate(monkeypatch: pytest.MonkeyPatch) -> None:
@@ -149,7 +151,7 @@ def test_integration_independent_of_block_size_within_estimate(monkeypatch: pyte
     default = mass.mass_properties(body, density=1.0)
     assert np.array_equal(default.principal_moments, mass.mass_properties(body, density=1.0).principal_moments)
     for chunk in (1, 7, 1 << 10):
-        monkeypatch.setattr(mass, "CHUNK", chunk)
+        monkeypatch.setattr(integrals, "CHUNK", chunk)
         other = mass.mass_properties(body, density=1.0)
         rel = np.abs(other.principal_moments - default.principal_moments) / default.principal_moments
         assert rel.max() <= default.relative_error_estimate + other.relative_error_estimate
@@ -157,13 +159,13 @@ def test_integration_independent_of_block_size_within_estimate(monkeypatch: pyte
 
 def test_apex_kernel_equals_generic_block_terms() -> None:
     v, f = _torus(30, 20)
-    x = v - mass._local_origin(v)
+    x = v - integrals.local_origin(v)
     fast = _sums(v, f)
-    terms = mass._block_terms(x[f], "apex", None)
-    slow = mass._sums_from_rows(terms.sum(axis=1), np.abs(terms).sum(axis=1), len(f))
+    terms = integrals._block_terms(x[f], "apex", None)
+    slow = integrals._sums_from_rows(terms.sum(axis=1), np.abs(terms).sum(axis=1), len(f))
     scale = np.abs(slow.abs_m2).max()
-    assert abs(fast.m0 - slow.m0) <= 8 * mass.EPS * slow.abs_m0
-    assert np.abs(fast.m2 - slow.m2).max() <= 8 * mass.EPS * scale
+    assert abs(fast.m0 - slow.m0) <= 8 * EPS * slow.abs_m0
+    assert np.abs(fast.m2 - slow.m2).max() <= 8 * EPS * scale
     np.testing.assert_allclose(fast.element_err, slow.element_err, rtol=1e-12)
     assert fast.noise == pytest.approx(slow.noise, rel=1e-12)
 

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import mmap
 import os
 from dataclasses import dataclass
 
@@ -49,16 +50,35 @@ def load_body(
     if isinstance(source, (str, os.PathLike)):
         path = os.fspath(source)
         filename = filename or os.path.basename(path)
-        try:
-            with open(path, "rb") as fh:
-                data = fh.read()
-        except OSError as exc:
-            raise UnreadableFileError(f"cannot open {path!r}: {exc.strerror}") from exc
-    else:
-        data = bytes(source) if not isinstance(source, bytes) else source
-    if not data:
+        return _load_path(path, filename, format, units)
+    data = source if isinstance(source, bytes) else bytes(source)
+    return _load_bytes(data, filename, format, units)
+
+
+def _load_path(path: str, filename: str, format: str | None, units: str | None) -> Loaded:
+    """A file on disk; a binary STL is mapped, not copied, so memory stays near its size."""
+    try:
+        fh = open(path, "rb")
+    except OSError as exc:
+        raise UnreadableFileError(f"cannot open {path!r}: {exc.strerror}") from exc
+    with fh:
+        head = fh.read(512)
+        fmt = sniff_format(filename, format, head) if head else None
+        if fmt != "stl":
+            fh.seek(0)
+            return _load_bytes(fh.read(), filename, format, units)
+        with mmap.mmap(fh.fileno(), 0, access=mmap.ACCESS_READ) as mapped:
+            view = memoryview(mapped)
+            try:
+                return _load_bytes(view, filename, format, units)
+            finally:
+                view.release()
+
+
+def _load_bytes(data: bytes | memoryview, filename: str | None, format: str | None, units: str | None) -> Loaded:
+    if not len(data):
         raise EmptyGeometryError("the file is empty; send a mesh with geometry", filename=filename)
-    fmt = sniff_format(filename, format, data[:512])
+    fmt = sniff_format(filename, format, bytes(data[:512]))
     requested = None if units is None else (units, length_scale(units))
     scale = requested[1] if requested else 1.0
 

@@ -53,16 +53,16 @@ def _binary(buf: memoryview, count: int) -> tuple[NDArray[np.float64], NDArray[n
 
 
 def _ascii(data: bytes) -> tuple[NDArray[np.float64], NDArray[np.int64]]:
-    tokens = data.split()
-    idx = [i for i, tok in enumerate(tokens) if tok == b"vertex"]
-    if not idx:
+    tokens = np.array(data.split())
+    idx = np.flatnonzero(tokens == b"vertex")
+    if len(idx) == 0:
         if b"facet" in data:
             raise UnreadableFileError("the ASCII STL file has facets without vertices; it is corrupt")
         raise EmptyGeometryError("the STL file holds no triangles")
-    if len(idx) % 3:
+    if len(idx) % 3 or idx[-1] + 3 >= len(tokens):
         raise UnreadableFileError("the ASCII STL file has a facet without exactly three vertices")
     try:
-        coords = np.array([[float(tokens[i + k]) for k in (1, 2, 3)] for i in idx], dtype=np.float64)
-    except (ValueError, IndexError) as exc:
+        coords = tokens[idx[:, None] + np.arange(1, 4)].astype(np.float64)
+    except ValueError as exc:
         raise UnreadableFileError(f"the ASCII STL file has a malformed vertex line ({exc})") from exc
     return coords, np.arange(len(idx), dtype=np.int64).reshape(-1, 3)
