@@ -182,34 +182,50 @@ def surface_topology(faces: NDArray[np.int64], n_vertices: int) -> SurfaceTopolo
     del forward
     balance = 2 * np.add.reduceat(fwd, starts, dtype=np.int64) - counts
     del fwd
-    first = starts[counts == 2]
-    face_a = order[first] // 3
-    face_b = order[first + 1] // 3
-    edge_faces = np.stack([np.minimum(face_a, face_b), np.maximum(face_a, face_b)], axis=1)
-    same = balance[counts == 2] != 0
+    pair = counts == 2
+    open_edges = int(np.count_nonzero(counts == 1))
+    nonmanifold = int(np.count_nonzero(counts > 2))
+    unbalanced = int(np.count_nonzero(balance))
+    same = balance[pair] != 0
+    del balance, counts
+    first = starts[pair]
+    del starts, pair
+    # the two faces of each manifold edge, smaller index first; built in place to bound memory
+    face_a = order[first]
+    first += 1
+    face_b = order[first]
+    del first, order
+    face_a //= 3
+    face_b //= 3
+    edge_faces = np.empty((len(face_a), 2), dtype=np.int64)
+    np.minimum(face_a, face_b, out=edge_faces[:, 0])
+    np.maximum(face_a, face_b, out=edge_faces[:, 1])
     return SurfaceTopology(
-        open_edges=int(np.count_nonzero(counts == 1)),
-        unbalanced_edges=int(np.count_nonzero(balance)),
-        nonmanifold_edges=int(np.count_nonzero(counts > 2)),
+        open_edges=open_edges,
+        unbalanced_edges=unbalanced,
+        nonmanifold_edges=nonmanifold,
         edge_faces=edge_faces,
         edge_same_direction=same,
     )
 
 
 def _edge_keys(faces: NDArray[np.int64], n_vertices: int) -> tuple[NDArray[np.uint64], NDArray[np.bool_]]:
-    """Undirected key lo * n + hi of each half-edge (face-major) and whether it runs lo -> hi."""
-    u = faces.reshape(-1)
-    v = np.empty_like(faces)
-    v[:, :2] = faces[:, 1:]
-    v[:, 2] = faces[:, 0]
-    v = v.reshape(-1)
-    forward = u < v
-    lo = np.minimum(u, v)
-    np.maximum(u, v, out=v)
-    key = lo.view(np.uint64)
-    key *= np.uint64(n_vertices)
-    key += v.view(np.uint64)
-    return key, forward
+    """Undirected key lo * n + hi of each half-edge (face-major) and whether it runs lo -> hi.
+
+    Built one corner column at a time into the output, so the only full-size
+    arrays are the keys and the direction flags.
+    """
+    n = len(faces)
+    key = np.empty((n, 3), dtype=np.uint64)
+    forward = np.empty((n, 3), dtype=bool)
+    for k in range(3):
+        u, v = faces[:, k], faces[:, (k + 1) % 3]
+        np.less(u, v, out=forward[:, k])
+        lo = np.minimum(u, v).view(np.uint64)
+        lo *= np.uint64(n_vertices)
+        lo += np.maximum(u, v).view(np.uint64)
+        key[:, k] = lo
+    return key.reshape(-1), forward.reshape(-1)
 
 
 def _edge_order(key: NDArray[np.uint64], key_bits: int) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
@@ -259,7 +275,9 @@ def _components(n: int, a: NDArray[np.int64], b: NDArray[np.int64]) -> tuple[int
     until no edge joins two roots.  Labels are numbered by the smallest node
     of each component, as a breadth-first search from node 0 upwards would.
     """
-    parent = np.arange(n, dtype=np.int64)
+    index = np.int32 if n < 2**31 else np.int64  # half the memory of every temporary below
+    parent = np.arange(n, dtype=index)
+    a, b = a.astype(index), b.astype(index)
     while True:
         ra, rb = parent[a], parent[b]
         join = ra != rb
@@ -273,8 +291,8 @@ def _components(n: int, a: NDArray[np.int64], b: NDArray[np.int64]) -> tuple[int
                 break
             parent = grand
         a, b = a[join], b[join]
-    roots = parent == np.arange(n)
-    rank = np.cumsum(roots) - 1
+    roots = parent == np.arange(n, dtype=index)
+    rank = np.cumsum(roots, dtype=np.int64) - 1
     return int(rank[-1] + 1) if n else 0, rank[parent]
 
 

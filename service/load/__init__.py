@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import mmap
 import os
 from dataclasses import dataclass
 
@@ -56,7 +55,7 @@ def load_body(
 
 
 def _load_path(path: str, filename: str, format: str | None, units: str | None) -> Loaded:
-    """A file on disk; a binary STL is mapped, not copied, so memory stays near its size."""
+    """A file on disk; a binary STL is read in blocks, never held whole beside its vertices."""
     try:
         fh = open(path, "rb")
     except OSError as exc:
@@ -67,12 +66,14 @@ def _load_path(path: str, filename: str, format: str | None, units: str | None) 
         if fmt != "stl":
             fh.seek(0)
             return _load_bytes(fh.read(), filename, format, units)
-        with mmap.mmap(fh.fileno(), 0, access=mmap.ACCESS_READ) as mapped:
-            view = memoryview(mapped)
-            try:
-                return _load_bytes(view, filename, format, units)
-            finally:
-                view.release()
+        from .stl import read_stl_file
+
+        fh.seek(0)
+        vertices, faces = read_stl_file(fh, os.fstat(fh.fileno()).st_size)
+    scale = 1.0 if units is None else length_scale(units)
+    name = _stem(filename)
+    parts = (Part(name, MeshBody(vertices, faces, scale, name)),)
+    return Loaded(parts, filename, "stl", "mesh", units or "m", "request" if units else "default")
 
 
 def _load_bytes(data: bytes | memoryview, filename: str | None, format: str | None, units: str | None) -> Loaded:

@@ -13,14 +13,17 @@ are returned unwelded (3 per triangle); ``topology.weld`` merges them.
 
 from __future__ import annotations
 
+from typing import BinaryIO
+
 import numpy as np
 from numpy.typing import NDArray
 
 from ..errors import EmptyGeometryError, UnreadableFileError
 from ..topology import row_ids
 
-__all__ = ["read_stl"]
+__all__ = ["read_stl", "read_stl_file"]
 
+_READ_BLOCK = 1 << 16  # records per read: 3.2 MB of file at a time
 _RECORD = np.dtype([("normal", "<f4", (3,)), ("vertices", "<f4", (3, 3)), ("attr", "<u2")])
 
 
@@ -40,11 +43,37 @@ def read_stl(data: bytes | memoryview) -> tuple[NDArray[np.float64], NDArray[np.
     )
 
 
+def read_stl_file(fh: BinaryIO, size: int) -> tuple[NDArray[np.float64], NDArray[np.int64]]:
+    """Like ``read_stl`` for an open file of ``size`` bytes.
+
+    A binary file is read in blocks of records straight into the corner
+    array, so the file's bytes are never all in memory next to it.
+    """
+    header = fh.read(84)
+    if len(header) == 84:
+        count = int(np.frombuffer(header[80:84], dtype="<u4")[0])
+        if 84 + 50 * count == size:
+            if count == 0:
+                raise EmptyGeometryError("the STL file holds no triangles")
+            corners = np.empty((count, 3, 3), dtype=np.float32)
+            for start in range(0, count, _READ_BLOCK):
+                block = np.fromfile(fh, dtype=_RECORD, count=min(_READ_BLOCK, count - start))
+                corners[start : start + len(block)] = block["vertices"]
+            return _welded(corners)
+    fh.seek(0)
+    return read_stl(fh.read())
+
+
 def _binary(buf: memoryview, count: int) -> tuple[NDArray[np.float64], NDArray[np.int64]]:
     if count == 0:
         raise EmptyGeometryError("the STL file holds no triangles")
     records = np.frombuffer(buf, dtype=_RECORD, count=count, offset=84)
-    corners = records["vertices"] + np.float32(0.0)  # contiguous copy; -0.0 + 0.0 is +0.0
+    return _welded(records["vertices"].copy())
+
+
+def _welded(corners: NDArray[np.float32]) -> tuple[NDArray[np.float64], NDArray[np.int64]]:
+    """Distinct vertices (first-appearance order, widened exactly) and face indices."""
+    corners += np.float32(0.0)  # -0.0 + 0.0 is +0.0, so both weld together
     bits = corners.reshape(-1, 3).view(np.uint32)
     ids, heads = row_ids([bits[:, 0], bits[:, 1], bits[:, 2]])
     del bits
