@@ -61,8 +61,9 @@ async def formats() -> FormatsOut:
     """The readable formats, and which hold surfaces, volume cells, or scenes of several parts."""
     kinds = [(f, "surface") for f in SURFACE_FORMATS] + [(f, "volume") for f in VOLUME_FORMATS]
     kinds += [(f, "points") for f in POINT_FORMATS]
-    return FormatsOut(formats=[FormatOut(format=f, kind=k, parts=f in SCENE_FORMATS) for f, k in kinds],  # type: ignore[arg-type]
-                      surface=list(SURFACE_FORMATS), volume=list(VOLUME_FORMATS), scene=list(SCENE_FORMATS),
+    table = [FormatOut(format=f, kind=k, parts=f in SCENE_FORMATS)  # type: ignore[arg-type]
+             for f, k in kinds]
+    return FormatsOut(formats=table, surface=list(SURFACE_FORMATS), volume=list(VOLUME_FORMATS), scene=list(SCENE_FORMATS),
                       points=list(POINT_FORMATS))
 
 

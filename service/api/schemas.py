@@ -84,7 +84,8 @@ class MeshQuery(_Request):
                                "...); inferred from the file name when absent", examples=["stl"])
     units: str | None = Field(None, description="length unit of the file: m, cm, mm, um, in, ft (default m)",
                               examples=["m"])
-    density: float | None = Field(None, gt=0, le=MAX_MAGNITUDE, description="density [kg/m^3] (default 1000); exclusive with mass")
+    density: float | None = Field(None, gt=0, le=MAX_MAGNITUDE,
+                                  description="density [kg/m^3] (default 1000); exclusive with mass")
     mass: float | None = Field(None, gt=0, le=MAX_MAGNITUDE, description="total mass [kg]; the density is then derived")
     model: Literal["solid", "shell"] = Field("solid", description="solid (closed surface or volume mesh) or "
                                              "shell (thin surface, needs thickness)")
@@ -142,7 +143,8 @@ class PointsRequest(_Request):
     def as_options(self) -> AnalysisOptions:
         return AnalysisOptions(
             units=self.units, tolerance=self.tolerance, method=self.method, duration=self.duration,
-            samples=self.samples, reference=None if self.reference is None else tuple(self.reference),  # type: ignore[arg-type]
+            samples=self.samples,
+            reference=None if self.reference is None else tuple(self.reference),  # type: ignore[arg-type]
             omega=None if self.omega is None else tuple(self.omega))  # type: ignore[arg-type]
 
 

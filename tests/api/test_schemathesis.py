@@ -35,8 +35,11 @@ CHECKS = [
 schema = schemathesis.openapi.from_asgi("/openapi.json", app)
 
 
-@schema.parametrize()
 # CI runs 25 examples per operation; a deeper local hunt: INERTIA_SCHEMATHESIS_EXAMPLES=500
-@settings(max_examples=int(os.environ.get("INERTIA_SCHEMATHESIS_EXAMPLES", "25")), deadline=None, suppress_health_check=list(HealthCheck))
+EXAMPLES = int(os.environ.get("INERTIA_SCHEMATHESIS_EXAMPLES", "25"))
+
+
+@schema.parametrize()
+@settings(max_examples=EXAMPLES, deadline=None, suppress_health_check=list(HealthCheck))
 def test_api_conforms_to_its_schema(case: schemathesis.Case) -> None:
     case.call_and_validate(checks=CHECKS)
