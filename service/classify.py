@@ -78,7 +78,8 @@ def ray_asymmetry(moments: NDArray[np.float64]) -> float:
     That form (kappa multiplied through by I1 I2 I3) uses only moment gaps,
     so it does not lose digits when moments are nearly equal.
     """
-    i1, i2, i3 = (float(x) for x in moments)
+    top = float(moments[2])
+    i1, i2, i3 = (float(x) / top for x in moments)  # kappa is scale-free; this keeps products in range
     return (i3 * (i1 - i2) + i1 * (i3 - i2)) / (i2 * (i3 - i1))
 
 

@@ -144,7 +144,9 @@ def _analyze(args: argparse.Namespace) -> int:
 def _serve(args: argparse.Namespace) -> int:
     import uvicorn
 
-    uvicorn.run("service.app:app", host=args.host, port=args.port, workers=args.workers, log_level=args.log_level)
+    # the service writes its own structured access line (service.api.access)
+    uvicorn.run("service.app:app", host=args.host, port=args.port, workers=args.workers,
+                log_level=args.log_level, access_log=False)
     return 0
 
 

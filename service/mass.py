@@ -134,14 +134,19 @@ class _Geometry:
         return len(self.points)
 
     def sums(self, origin: NDArray[np.float64], rotation: NDArray[np.float64] | None) -> Sums:
-        if rotation is None:
-            x = self.points - origin
-        else:
-            x = rotated(self.points, origin, rotation)
-        if self.kind == "points":
-            assert self.weight is not None
-            return point_sums(self.weight, x)
-        return simplex_sums(x, self.cells, self.kind, self.weight)
+        """The integrals about ``origin`` in the frame ``rotation`` (columns), or raise on overflow."""
+        try:
+            with np.errstate(over="raise", invalid="raise"):
+                x = self.points - origin if rotation is None else rotated(self.points, origin, rotation)
+                if self.kind == "points":
+                    assert self.weight is not None
+                    return point_sums(self.weight, x)
+                return simplex_sums(x, self.cells, self.kind, self.weight)
+        except FloatingPointError as exc:
+            raise InvalidParameterError(
+                "the coordinates or masses are so large that the inertia integrals overflow floating point; "
+                "express the input in other units"
+            ) from exc
 
 
 def _refine(geometry: _Geometry, tolerances: Tolerances) -> tuple[Sums, NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], float]:
@@ -288,6 +293,7 @@ def mass_properties(
     total_mass = s.m0 * to_mass
     inertia_scale = measure_to_mass * L**length_power
     moments_si = moments * inertia_scale
+    _check_finite_results(total_mass, com * L, tensor * inertia_scale)
     return MassProperties(
         mass=float(total_mass),
         center_of_mass=com * L,
@@ -301,6 +307,15 @@ def mass_properties(
         warnings=body.warnings + warnings,
         mesh_vertices=geometry.referenced_points if geometry.kind == "apex" else None,
     )
+
+
+def _check_finite_results(mass: float, com: NDArray[np.float64], tensor: NDArray[np.float64]) -> None:
+    """Coordinates or masses near the float64 limits overflow the squares of the integrals."""
+    if not (math.isfinite(mass) and np.all(np.isfinite(com)) and np.all(np.isfinite(tensor))):
+        raise InvalidParameterError(
+            "the coordinates or masses are so large (or so small) that the inertia overflows floating point; "
+            "express the input in other units"
+        )
 
 
 def _unweighted_volume(geometry: _Geometry) -> float:

@@ -7,8 +7,9 @@ from pathlib import Path
 
 import pytest
 
-ROOT = Path(__file__).resolve().parents[1]
-SAMPLES = ROOT / "sample_meshes"
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from paths import SAMPLES  # noqa: E402
+
 sys.path.insert(0, str(SAMPLES))
 
 

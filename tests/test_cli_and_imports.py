@@ -8,7 +8,7 @@ import sys
 
 import pytest
 
-from conftest import ROOT, SAMPLES
+from paths import ROOT, SAMPLES
 
 
 def run(*args: str) -> subprocess.CompletedProcess[str]:

@@ -208,7 +208,7 @@ def test_reference_tensor_follows_parallel_axis_theorem() -> None:
 def test_two_material_volume_mesh_matches_composite_box() -> None:
     from generate import write_two_density_vtu  # noqa: F401  (same geometry as the sample)
     from service.load import load_body
-    from conftest import SAMPLES
+    from paths import SAMPLES
 
     loaded = load_body(SAMPLES / "two_density.vtu")
     props = mass_properties(loaded.body)
@@ -291,7 +291,7 @@ def test_results_are_bit_identical_across_processes(tmp_path) -> None:  # noqa: 
         "v, f = l_bracket(2.0); v = v @ R.from_euler('xyz', [.1, .2, .3]).as_matrix().T + 1e5;"
         "p = mass_properties(MeshBody(v, f)); print(p.inertia.matrix.tobytes().hex(), p.center_of_mass.tobytes().hex())"
     )
-    from conftest import ROOT
+    from paths import ROOT
 
     outs = {subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT, check=True).stdout
             for _ in range(2)}
