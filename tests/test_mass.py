@@ -301,3 +301,8 @@ def test_results_are_bit_identical_across_processes(tmp_path) -> None:  # noqa: 
 def test_single_point_mass_has_no_rotational_inertia() -> None:
     with pytest.raises(InvalidParameterError):
         mass_properties(PointBody(np.array([2.0]), np.array([[1.0, 2.0, 3.0]])))
+
+
+def test_overflowing_coordinates_are_invalid_not_infinite() -> None:
+    with pytest.raises(InvalidParameterError):
+        mass_properties(PointBody(np.array([1.0, 1.0]), np.array([[1e254, 0, 0], [0, 1e254, 0]])))

@@ -112,3 +112,11 @@ def test_tolerance_decides_near_symmetric_box() -> None:
 def test_unphysical_tensors_are_rejected(tensor: np.ndarray) -> None:
     with pytest.raises(InvalidParameterError):
         PrincipalFrame.from_tensor(tensor)
+
+
+@pytest.mark.parametrize("scale", [1e-300, 1.0, 1e300])
+def test_kappa_does_not_depend_on_scale(scale: float) -> None:
+    i1, i2, i3 = 1.0, 2.0, 3.0
+    a, b, c = 1 / i1, 1 / i2, 1 / i3
+    expected = (2 * b - a - c) / (a - c)
+    assert ray_asymmetry(np.array([i1, i2, i3]) * scale) == pytest.approx(expected, rel=1e-14)
