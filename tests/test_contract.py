@@ -1685,3 +1685,184 @@ def test_size_limit_applies_to_chunked_and_json_bodies():
         assert_error(r, 413, "payload_too_large")
         pts = {"points": [{"mass": 1.0, "position": [i, 0, 0]} for i in range(2000)]}
         assert_error(c.post("/v1/analyze/points", json=pts), 413, "payload_too_large")
+
+
+# ----------------------------------------------------------------------------------------
+# harder corners
+# ----------------------------------------------------------------------------------------
+
+def test_every_error_uses_the_envelope_even_for_unknown_routes_and_bad_bodies(client):
+    for r in (client.get("/v1/no-such-endpoint"), client.get("/v1/analyze/mesh"),
+              client.post("/v1/analyze/mesh", content=b"garbage",
+                          headers={"content-type": "multipart/form-data; boundary=zzz"}),
+              client.post("/v1/batch")):
+        assert 400 <= r.status_code < 600
+        body = r.json()
+        assert set(body) == {"error"} and set(body["error"]) >= {"code", "message", "details"}
+        assert body["error"]["code"].replace("_", "").isalpha() and body["error"]["code"].islower()
+    for r in (client.post("/v1/analyze/points", content=b"[1, 2]", headers={"content-type": "application/json"}),
+              client.post("/v1/precession", content=b"hello", headers={"content-type": "application/json"})):
+        assert_error(r, 422, "invalid_parameter")
+
+
+def test_random_convex_body_far_from_the_origin_within_the_estimate(client):
+    from scipy.spatial import ConvexHull
+
+    rng = np.random.default_rng(7)
+    local = rng.normal(size=(40, 3)) * [1.0, 0.6, 0.3]
+    hull = ConvexHull(local)
+    faces = hull.simplices.copy()
+    centre = local[hull.vertices].mean(axis=0)
+    for t in faces:  # outward winding
+        a, b, c = local[t]
+        if np.cross(b - a, c - a) @ (a - centre) < 0:
+            t[1], t[2] = t[2], t[1]
+    v = local @ rotation([3, 1, -2], 2.0).T + [3e7, -4e7, 5e7]
+    data = obj_bytes([(None, v, faces)])
+    res = analyze(client, "hull.obj", data)
+    mass, com, inertia, _ = exact_mass_properties(v[faces])
+    est = res["diagnostics"]["relative_error_estimate"]
+    assert est <= 1e-12
+    assert res["mass"] == pytest.approx(float(mass), rel=1e-13)
+    for got, want in zip(res["principal"]["moments"], exact_moments(inertia)):
+        assert abs(got - want) <= max(est, 2.3e-16) * want, (got, want, est)
+    check_principal(res)
+
+
+def test_nearly_symmetric_mesh_reports_momentum_and_energy_of_its_own_tensor(client):
+    """hex_prism.stl is symmetric only within the tolerance (moments 1.4e-8 apart).  M = I Ω and
+    E = ½ Ω·I Ω are properties of the initial state of the body whose tensor is reported; the
+    moments are not to be rounded (cf. 'asymmetry ... is not rounded to ±1')."""
+    omega = [0.3, 0.2, 1.0]
+    res = analyze(client, "hex_prism.stl", omega="0.3,0.2,1", duration=20, samples=5)
+    I = np.asarray(res["inertia_tensor"], float)
+    pre = res["precession"]
+    assert pre["regime"] == "regular_precession"
+    check_invariants(pre, I, omega)
+    # the idealised symmetric motion stays within ~gap * |Ω| t of the real one
+    check_trajectory(pre, res["principal"]["moments"], res["principal"]["axes"], omega, 20.0, 5, I, tol=1e-5)
+
+
+def test_exact_motion_over_many_periods(client):
+    moments, omega = [1.0, 2.0, 3.0], [0.3, 0.8, 0.5]
+    T = ll_asymmetric_period(moments, omega)
+    duration = 60 * T
+    res = precession_ok(client, {"principal_moments": moments, "omega": omega, "duration": duration,
+                                 "samples": 9})
+    check_trajectory(res["precession"], moments, res["principal"]["axes"], omega, duration, 9,
+                     np.diag(moments), tol=1e-7)
+
+
+@pytest.mark.parametrize("eps", [1e-3, -1e-3, 1e-5, -1e-5])
+def test_period_near_the_separatrix(client, eps):
+    moments = [1.0, 2.0, 3.0]
+    omega = [0.1 * math.sqrt(3) * (1 + eps), 1.0, 0.1]
+    pre = precession_ok(client, {"principal_moments": moments, "omega": omega})["precession"]
+    T = ll_asymmetric_period(moments, omega)
+    assert pre["period"] == pytest.approx(T, rel=1e-9)
+    assert pre["stable"] is False
+    assert pre["flip_interval"] == pytest.approx(T / 2, rel=1e-9)
+
+
+def test_separatrix_of_a_mesh_body(client):
+    # box.stl: I = 2500, 5000, 6500 (axes z, y, x); 2E I2 = |M|² when 2500² Ωz² = 6500·1500 Ωx²
+    wx = 0.1
+    wz = wx * math.sqrt(6500 * 1500) / 2500
+    res = analyze(client, "box.stl", omega=f"{wx!r},1.0,{wz!r}")
+    pre = res["precession"]
+    assert pre["regime"] == "asymmetric" and "period" not in pre
+    assert list(res.get("warnings", [])) + list(pre.get("warnings", []))
+
+
+@pytest.mark.parametrize("omega", [[0.3, -0.4, -1.2], [-0.7, 0.1, 0.05], [0.0, 0.5, -2.0]])
+def test_symmetric_top_signs_follow_the_reported_symmetry_axis(client, omega):
+    moments = [2.0, 2.0, 3.0]
+    res = precession_ok(client, {"principal_moments": moments, "omega": omega, "duration": 2, "samples": 5})
+    n = res["classification"]["symmetry_axis"]
+    check_symmetric_rates(res["precession"], 2.0, 3.0, n, omega)
+    check_trajectory(res["precession"], moments, res["principal"]["axes"], omega, 2.0, 5, np.diag(moments))
+
+
+def test_parts_carry_their_own_frames_consistently(client):
+    scene, _ = two_box_scene()
+    res = analyze(client, "scene.glb", scene.export(file_type="glb"))
+    for p in res["parts"]:
+        assert_no_nulls(p)
+        if "principal" in p:
+            check_principal(p, np.asarray(p["inertia_tensor"], float))
+
+
+# ----------------------------------------------------------------------------------------
+# command line: entry point, batch outputs, serve
+# ----------------------------------------------------------------------------------------
+
+def test_inertia_console_script_runs_analyze():
+    import shutil
+
+    exe = shutil.which("inertia", path=str(Path(sys.executable).parent)) or shutil.which("inertia")
+    assert exe, "the `inertia` command must be installed"
+    p = subprocess.run([exe, "analyze", "tetrahedron.stl", "--json"], cwd=SAMPLES, capture_output=True,
+                       text=True, timeout=60)
+    assert p.returncode == 0, p.stderr
+    res = json.loads(p.stdout)
+    assert res["mass"] == pytest.approx(1000 / 6, rel=1e-14)
+    assert res["classification"]["kind"] == "symmetric_top"
+
+
+@pytest.mark.parametrize("suffix", [".csv", ".parquet"])
+def test_cli_batch_tabular_outputs_have_one_row_per_file(tmp_path, suffix):
+    buf = io.BytesIO()
+    with zipfile.ZipFile(buf, "w") as z:
+        for name in ("box.stl", "open_box.stl", "l_bracket.stl"):
+            z.writestr(name, (SAMPLES / name).read_bytes())
+    (tmp_path / "m.zip").write_bytes(buf.getvalue())
+    out = tmp_path / f"results{suffix}"
+    p = run_cli("batch", "m.zip", "--out", str(out), "--workers", "2", cwd=tmp_path)
+    assert out.exists(), p.stderr
+    if suffix == ".csv":
+        import csv
+
+        rows = list(csv.DictReader(out.open()))
+    else:
+        import pyarrow.parquet as pq
+
+        rows = pq.read_table(out).to_pylist()
+    assert len(rows) == 3
+    text = json.dumps(rows, default=str)
+    assert "not_watertight" in text
+    assert "6000" in text and "12000" in text
+
+
+def test_inertia_serve_starts_the_http_service(tmp_path):
+    import socket
+    import time
+
+    import httpx
+
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        port = s.getsockname()[1]
+    env = {k: v for k, v in os.environ.items() if not k.startswith("INERTIA_")}
+    env["INERTIA_COMPUTE_PROCESSES"] = "1"
+    proc = subprocess.Popen([sys.executable, "-m", "service", "serve", "--host", "127.0.0.1", "--port", str(port)],
+                            cwd=tmp_path, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    try:
+        deadline = time.monotonic() + 30
+        while True:
+            try:
+                r = httpx.get(f"http://127.0.0.1:{port}/healthz", timeout=1)
+                break
+            except httpx.TransportError:
+                assert proc.poll() is None and time.monotonic() < deadline, "server did not start"
+                time.sleep(0.1)
+        assert r.json() == {"status": "ok"}
+        r = httpx.post(f"http://127.0.0.1:{port}/v1/analyze/mesh",
+                       files={"file": ("box.stl", (SAMPLES / "box.stl").read_bytes())}, timeout=30)
+        assert r.status_code == 200 and r.json()["mass"] == pytest.approx(6000, rel=1e-14)
+    finally:
+        proc.terminate()
+        try:
+            proc.wait(10)
+        except subprocess.TimeoutExpired:
+            proc.kill()
+            proc.wait()
