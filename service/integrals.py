@@ -35,9 +35,10 @@ class Sums:
     """Integrals over the body about the local origin (unit density or weights).
 
     m0 : int dm.  m1 : (3,) int x dm.  m2 : (3, 3) int x x^T dm.
-    abs_m2 : (3, 3) sums of |contribution|, the scale of rounding errors.
-    noise : rounding scale of m0 (sum of |a||b||c| / 6 for surfaces).
-    terms : number of elements summed.
+    abs_m0, abs_m2 : sums of |contribution|, the scale of summation errors.
+    noise : rounding scale of m0 (the determinants' condition, see ``_det_condition``).
+    element_err : (3,) rounding scale of each element's own terms of the m2 diagonal.
+    terms, blocks : elements summed, and the blocks they were summed in.
     """
 
     m0: float
@@ -46,106 +47,91 @@ class Sums:
     abs_m0: float
     abs_m2: NDArray[np.float64]
     noise: float
+    element_err: NDArray[np.float64]
     terms: int
-    element_err: NDArray[np.float64]  # (3,) per-element rounding scale of m2 diagonal
+    blocks: int
 
 
 _IJ = ((0, 0), (1, 1), (2, 2), (0, 1), (0, 2), (1, 2))
-# rows of a block: m0, m1 x3, m2 x6 (xx yy zz xy xz yz), det noise, error scale of xx yy zz
+# rows of a block's sums: m0, m1 (x y z), m2 (xx yy zz xy xz yz), det noise, error scale of xx yy zz
 ROWS = 14
+_NOISE, _ERR = 10, 11
+# a simplex's measure dm, and the factors of its first and second moments (int x = f1 S, ...)
+_FACTORS = {"apex": (1 / 6, 1 / 4, 1 / 20), "tet": (1 / 6, 1 / 4, 1 / 20), "tri": (1 / 2, 1 / 3, 1 / 12)}
+
+Vec = list[NDArray[np.float64]]  # the three components of a block of vectors, each contiguous (n,)
 
 
-def _block_terms(p: NDArray[np.float64], kind: str, weight: NDArray[np.float64] | None) -> NDArray[np.float64]:
-    """Per-element [m0, m1 (3), m2 (6), noise] for one block of simplices."""
-    if kind == "apex":  # tetrahedron (0, a, b, c) of a closed surface
-        a, b, c = p[:, 0], p[:, 1], p[:, 2]
-        cross = np.cross(b, c)
-        dm = np.einsum("ij,ij->i", a, cross) / 6.0
-        s = a + b + c
-        f1, f2 = dm / 4.0, dm / 20.0
-        noise = _det_condition(a, b, c) / 6.0
-        verts = (a, b, c)
-    elif kind == "tet":  # volume cell
-        e1, e2, e3 = p[:, 1] - p[:, 0], p[:, 2] - p[:, 0], p[:, 3] - p[:, 0]
-        cross = np.cross(e2, e3)
-        dm = np.abs(np.einsum("ij,ij->i", e1, cross)) / 6.0
-        s = p[:, 0] + p[:, 1] + p[:, 2] + p[:, 3]
-        f1, f2 = dm / 4.0, dm / 20.0
-        noise = _det_condition(e1, e2, e3) / 6.0
-        verts = (p[:, 0], p[:, 1], p[:, 2], p[:, 3])
-    else:  # "tri": thin shell, area measure
-        a, b, c = p[:, 0], p[:, 1], p[:, 2]
-        dm = 0.5 * np.linalg.norm(np.cross(b - a, c - a), axis=1)
-        s = a + b + c
-        f1, f2 = dm / 3.0, dm / 12.0
-        noise = dm
-        verts = (a, b, c)
-    if weight is not None:
-        dm, f1, f2 = dm * weight, f1 * weight, f2 * weight
-    out = np.empty((ROWS, len(p)))
-    out[0] = dm
-    out[1:4] = (f1[:, None] * s).T
-    for row, (i, j) in enumerate(_IJ, start=4):
-        acc = s[:, i] * s[:, j]
-        for v in verts:
-            acc += v[:, i] * v[:, j]
-        out[row] = f2 * acc
-        if row < 7:  # diagonal: error of this element's term, |dm| + det noise
-            out[row + 7] = acc * (np.abs(f2) + noise * (1.0 / 20.0 if weight is None else np.abs(weight) / 20.0))
-    out[10] = noise if weight is None else noise * np.abs(weight)
-    return out
+def _cross(u: Vec, v: Vec) -> Vec:
+    return [u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]]
 
 
-def _det_condition(a: NDArray[np.float64], b: NDArray[np.float64], c: NDArray[np.float64]) -> NDArray[np.float64]:
-    """sum over permutations of |a_i b_j c_k|: rounding of a . (b x c) is a few eps times this."""
-    i, j = [1, 2, 0], [2, 0, 1]
-    abs_cross = np.abs(b[:, i] * c[:, j]) + np.abs(b[:, j] * c[:, i])
-    return np.einsum("ij,ij->i", np.abs(a), abs_cross)
+def _det_condition(a: Vec, u: Vec, v: Vec) -> NDArray[np.float64]:
+    """sum over permutations of |a_i u_j v_k|: the rounding of a . (u x v) is a few eps times this."""
+    return (np.abs(a[0]) * (np.abs(u[1] * v[2]) + np.abs(u[2] * v[1]))
+            + np.abs(a[1]) * (np.abs(u[2] * v[0]) + np.abs(u[0] * v[2]))
+            + np.abs(a[2]) * (np.abs(u[0] * v[1]) + np.abs(u[1] * v[0])))
 
 
-def _apex_block_sums(xyz: list[NDArray[np.float64]], cells: NDArray[np.int64],
-                     total: NDArray[np.float64], total_abs: NDArray[np.float64]) -> None:
-    """Add the row sums of ``_block_terms(points[cells], "apex", None)`` to total, total_abs.
+def _measure(corners: list[Vec], kind: str) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Twice-or-six-times the measure of each simplex (before ``_FACTORS``) and its rounding scale.
 
-    The same terms with the same arithmetic, element by element, on
-    contiguous (n,) component arrays: no (n, 3) strided views, no np.cross or
-    einsum dispatch, and each row is summed as soon as it is formed (numpy's
-    pairwise sum over a contiguous row, as ``terms.sum(axis=1)`` does).
+    A face's tetrahedron with the origin uses a . ((b - a) x (c - a)), equal to
+    a . (b x c) but formed from the short edges: b x c of two long, nearly
+    parallel position vectors cancels to ~1/n of its terms on a fine mesh, the
+    edge form does not, so each determinant keeps its relative precision.
     """
-    idx = [cells[:, k] for k in range(3)]
-    a, b, c = ([x.take(i) for x in xyz] for i in idx)  # a[k]: component k of the first corners
-    crx = b[1] * c[2] - b[2] * c[1]  # b x c, as np.cross forms it
-    cry = b[2] * c[0] - b[0] * c[2]
-    crz = b[0] * c[1] - b[1] * c[0]
-    dm = (a[0] * crx + a[1] * cry + a[2] * crz) / 6.0
-    del crx, cry, crz
-    abs_a = [np.abs(v) for v in a]
-    noise = (abs_a[0] * (np.abs(b[1] * c[2]) + np.abs(b[2] * c[1]))  # _det_condition
-             + abs_a[1] * (np.abs(b[2] * c[0]) + np.abs(b[0] * c[2]))
-             + abs_a[2] * (np.abs(b[0] * c[1]) + np.abs(b[1] * c[0]))) / 6.0
-    del abs_a
-    s = [a[k] + b[k] + c[k] for k in range(3)]
-    f1, f2 = dm / 4.0, dm / 20.0
-    err_factor = np.abs(f2) + noise * (1.0 / 20.0)
-    _add_row(total, total_abs, 0, dm)
+    a = corners[0]
+    edges = [[p[k] - a[k] for k in range(3)] for p in corners[1:]]
+    if kind == "apex":
+        normal = _cross(edges[0], edges[1])
+        det = a[0] * normal[0] + a[1] * normal[1] + a[2] * normal[2]
+        return det, _det_condition(a, edges[0], edges[1])
+    if kind == "tet":
+        normal = _cross(edges[1], edges[2])
+        det = edges[0][0] * normal[0] + edges[0][1] * normal[1] + edges[0][2] * normal[2]
+        return np.abs(det), _det_condition(edges[0], edges[1], edges[2])
+    normal = _cross(edges[0], edges[1])  # "tri": |n| is twice the area, correct to a few eps
+    twice_area = np.sqrt(normal[0] ** 2 + normal[1] ** 2 + normal[2] ** 2)
+    return twice_area, twice_area
+
+
+def _block_sums(xyz: Vec, cells: NDArray[np.int64], kind: str,
+                weight: NDArray[np.float64] | None) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Sums over one block of simplices of every row, and of their absolute values.
+
+    Struct of arrays: each quantity is a contiguous (n,) array, summed as soon
+    as it is formed (numpy's pairwise summation).
+    """
+    corners = [[x.take(cells[:, k]) for x in xyz] for k in range(cells.shape[1])]
+    raw, cond = _measure(corners, kind)
+    f0, f1, f2 = _FACTORS[kind]
+    dm = raw * f0
+    noise = cond * f0
+    if weight is not None:
+        dm *= weight
+        noise *= np.abs(weight)
+    s = [sum(c[k] for c in corners) for k in range(3)]
+    total, total_abs = np.empty(ROWS), np.empty(ROWS)
+
+    def put(row: int, terms: NDArray[np.float64]) -> None:
+        total[row] = terms.sum()
+        total_abs[row] = np.abs(terms).sum()
+
+    put(0, dm)
     for k in range(3):
-        _add_row(total, total_abs, 1 + k, f1 * s[k])
+        put(1 + k, (f1 * dm) * s[k])
+    # an element's diagonal term f2 dm acc errs by ~eps (|f2 dm| + f2 noise) acc: acc >= 0 is exact to a few eps
+    err_factor = f2 * (np.abs(dm) + noise)
     for row, (i, j) in enumerate(_IJ, start=4):
         acc = s[i] * s[j]
-        for v in (a, b, c):
-            acc += v[i] * v[j]
-        _add_row(total, total_abs, row, f2 * acc)
-        if row < 7:  # diagonal: error of this element's term (non-negative)
-            acc *= err_factor
-            total[row + 7] += acc.sum()
-            total_abs[row + 7] += acc.sum()
-    total[10] += noise.sum()
-    total_abs[10] += noise.sum()
-
-
-def _add_row(total: NDArray[np.float64], total_abs: NDArray[np.float64], row: int, terms: NDArray[np.float64]) -> None:
-    total[row] += terms.sum()
-    total_abs[row] += np.abs(terms).sum()
+        for c in corners:
+            acc += c[i] * c[j]
+        put(row, (f2 * dm) * acc)
+        if i == j:
+            total[_ERR + i] = total_abs[_ERR + i] = (err_factor * acc).sum()
+    total[_NOISE] = total_abs[_NOISE] = noise.sum()
+    return total, total_abs
 
 
 def simplex_sums(
@@ -154,30 +140,26 @@ def simplex_sums(
     kind: str,
     weight: NDArray[np.float64] | None,
 ) -> Sums:
-    total = np.zeros(ROWS)
-    total_abs = np.zeros(ROWS)
-    if kind == "apex" and weight is None:
-        xyz = [np.ascontiguousarray(points[:, k]) for k in range(3)]  # struct of arrays
-        for start in range(0, len(cells), CHUNK):
-            _apex_block_sums(xyz, cells[start : start + CHUNK], total, total_abs)
-        return _sums_from_rows(total, total_abs, len(cells))
-    for start in range(0, len(cells), CHUNK):
-        block = points[cells[start : start + CHUNK]]
+    """Integrals of the simplices ``points[cells]``: "apex" (faces of a closed
+    surface, each with the origin), "tet" (volume cells) or "tri" (area)."""
+    xyz = [np.ascontiguousarray(points[:, k]) for k in range(3)]
+    starts = range(0, len(cells), CHUNK)
+    per_block = np.empty((2, ROWS, len(starts)))
+    for b, start in enumerate(starts):
         w = None if weight is None else weight[start : start + CHUNK]
-        terms = _block_terms(block, kind, w)
-        total += terms.sum(axis=1)
-        total_abs += np.abs(terms).sum(axis=1)
-    return _sums_from_rows(total, total_abs, len(cells))
+        per_block[0, :, b], per_block[1, :, b] = _block_sums(xyz, cells[start : start + CHUNK], kind, w)
+    total, total_abs = per_block.sum(axis=2)  # pairwise over the blocks too
+    return _sums_from_rows(total, total_abs, len(cells), len(starts))
 
 
-def _sums_from_rows(total: NDArray[np.float64], total_abs: NDArray[np.float64], n: int) -> Sums:
+def _sums_from_rows(total: NDArray[np.float64], total_abs: NDArray[np.float64], n: int, blocks: int) -> Sums:
     m2 = np.empty((3, 3))
     a2 = np.empty((3, 3))
     for row, (i, j) in enumerate(_IJ, start=4):
         m2[i, j] = m2[j, i] = total[row]
         a2[i, j] = a2[j, i] = total_abs[row]
-    return Sums(float(total[0]), total[1:4].copy(), m2, float(total_abs[0]), a2, float(total[10]), n,
-                 total[11:14].copy())
+    return Sums(float(total[0]), total[1:4].copy(), m2, float(total_abs[0]), a2, float(total[_NOISE]),
+                total[_ERR:_ERR + 3].copy(), n, blocks)
 
 
 def point_sums(masses: NDArray[np.float64], x: NDArray[np.float64]) -> Sums:
@@ -186,7 +168,7 @@ def point_sums(masses: NDArray[np.float64], x: NDArray[np.float64]) -> Sums:
     for i, j in _IJ:
         m2[i, j] = m2[j, i] = float((masses * x[:, i] * x[:, j]).sum())
     diag_scale = np.array([float((masses * x[:, i] ** 2).sum()) for i in range(3)])
-    return Sums(float(masses.sum()), m1, m2, float(masses.sum()), np.abs(m2), 0.0, len(masses), diag_scale)
+    return Sums(float(masses.sum()), m1, m2, float(masses.sum()), np.abs(m2), 0.0, diag_scale, len(masses), 1)
 
 
 def local_origin(points: NDArray[np.float64]) -> NDArray[np.float64]:

