@@ -87,6 +87,8 @@ def classify(frame: PrincipalFrame, tolerance: float | None = None) -> Classific
     """Classify the body whose principal frame is ``frame``."""
     tol = frame.tolerance if tolerance is None else tolerance
     i1, i2, i3 = (float(x) for x in frame.moments)
+    if i3 == 0.0:  # all mass at one point: no axis is distinguished, every moment is zero
+        return Classification(RotorClass.SPHERICAL, None, None, True, tol, {})
     margins = {
         "gap12": (i2 - i1) / i3,
         "gap23": (i3 - i2) / i3,

@@ -173,11 +173,6 @@ def _refine(geometry: _Geometry, tolerances: Tolerances) -> tuple[Sums, NDArray[
         if settled:
             break
     _check_volume(s, geometry.kind)
-    if not np.abs(values).max() > 0:
-        raise InvalidParameterError(
-            "the masses all sit at one point, so the body has no rotational inertia; "
-            "send at least two distinct positions"
-        )
     estimate = _error_estimate(s, values)
     if not settled:
         estimate = max(estimate, step)

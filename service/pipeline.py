@@ -255,6 +255,9 @@ def _motion(frame: PrincipalFrame, cls: Classification, options: AnalysisOptions
     from .motion import predict_motion
 
     omega = np.asarray(options.omega, dtype=np.float64)
+    if not frame.moments[-1] > 0:
+        raise InvalidParameterError("the body has no rotational inertia (all its mass is at one point), "
+                                    "so its free rotation is undefined; leave out omega", parameter="omega")
     # |M| <= I3 |omega| and 2E <= I3 |omega|^2; the motion squares and multiplies these, so keep
     # |M| well inside float64 (MAX_MOMENTUM^2 = 1e300) or say why we cannot compute
     momentum_bound = float(frame.moments[-1]) * math.sqrt(float(omega @ omega))

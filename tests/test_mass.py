@@ -298,9 +298,11 @@ def test_results_are_bit_identical_across_processes(tmp_path) -> None:  # noqa: 
     assert len(outs) == 1
 
 
-def test_single_point_mass_has_no_rotational_inertia() -> None:
-    with pytest.raises(InvalidParameterError):
-        mass_properties(PointBody(np.array([2.0]), np.array([[1.0, 2.0, 3.0]])))
+def test_single_point_mass_has_zero_inertia() -> None:
+    props = mass_properties(PointBody(np.array([2.0]), np.array([[1.0, 2.0, 3.0]])))
+    assert props.mass == 2.0
+    np.testing.assert_array_equal(props.center_of_mass, [1.0, 2.0, 3.0])
+    np.testing.assert_array_equal(props.inertia.matrix, np.zeros((3, 3)))
 
 
 def test_overflowing_coordinates_are_invalid_not_infinite() -> None:
