@@ -1318,12 +1318,14 @@ def test_batch_accepts_one_zip_of_files(client):
     with zipfile.ZipFile(buf, "w") as z:
         for name in BATCH_FILES:
             z.writestr(name, (SAMPLES / name).read_bytes())
+    params = {"units": "mm", "omega": "0.1,2,0.1", "duration": "2", "samples": "3"}
     r = client.post("/v1/batch", files=[("files", ("meshes.zip", buf.getvalue(), "application/zip"))],
-                    params={"units": "mm"})
+                    params=params)
     lines = ndjson_lines(r)
     assert len(lines) == 4
     assert lines[0]["mass"] == pytest.approx(6e-6, rel=1e-13)
-    check_batch_lines(client, lines, {"units": "mm"})
+    assert len(lines[0]["precession"]["trajectory"]["t"]) == 3
+    check_batch_lines(client, lines, params)
 
 
 def test_batch_unsupported_and_unreadable_files_are_error_lines(client):
@@ -1866,3 +1868,115 @@ def test_inertia_serve_starts_the_http_service(tmp_path):
         except subprocess.TimeoutExpired:
             proc.kill()
             proc.wait()
+
+
+def test_unsorted_principal_moments_keep_the_given_frame_as_input_frame(client):
+    given = [3.0, 1.0, 2.0]
+    omega = [0.2, 0.5, 1.0]
+    res = precession_ok(client, {"principal_moments": given, "omega": omega, "duration": 3, "samples": 4})
+    I = np.diag(given)
+    np.testing.assert_allclose(res["principal"]["moments"], [1, 2, 3], rtol=1e-15)
+    check_principal(res, I)
+    A = np.abs(np.asarray(res["principal"]["axes"]))
+    np.testing.assert_allclose(A, [[0, 1, 0], [0, 0, 1], [1, 0, 0]], atol=1e-15)
+    pre = res["precession"]
+    check_invariants(pre, I, omega)
+    check_trajectory(pre, [1, 2, 3], res["principal"]["axes"], omega, 3.0, 4, I)
+
+
+def test_mass_option_scales_parts_with_their_own_densities(client):
+    res = analyze(client, "pair.obj", two_cube_obj(), densities=json.dumps({"left": 1000, "right": 3000}),
+                  mass=8)
+    assert res["mass"] == pytest.approx(8, rel=1e-13)
+    parts = {p["name"]: p for p in res["parts"]}
+    assert parts["left"]["mass"] == pytest.approx(2, rel=1e-13)
+    assert parts["right"]["mass"] == pytest.approx(6, rel=1e-13)
+    np.testing.assert_allclose(res["center_of_mass"], [2.0, 0.5, 0.5], rtol=1e-13)
+
+
+def test_cavity_is_subtracted_not_mistaken_for_inverted_winding(client):
+    outer, inner = box_corners(4, 4, 4) - 2, box_corners(2, 2, 2) - 1
+    v = np.vstack([outer, inner])
+    f = np.vstack([BOX_FACES, BOX_FACES[:, ::-1] + 8])  # the cavity's faces point into the hole
+    res = analyze(client, "hollow.stl", stl_bytes(v, f))
+    assert res["mass"] == pytest.approx(RHO * (64 - 8), rel=1e-14)
+    assert res["volume"] == pytest.approx(56, rel=1e-14)
+    I = box_inertia(64000, 4, 4, 4) - box_inertia(8000, 2, 2, 2)
+    np.testing.assert_allclose(res["inertia_tensor"], I, rtol=0, atol=1e-13 * np.trace(I))
+    check_classification(res, "spherical_top")
+
+
+def test_a_separate_inverted_shell_is_corrected_with_a_warning(client):
+    v = np.vstack([box_corners(1, 1, 1), box_corners(1, 1, 1) + [3, 0, 0]])
+    f = np.vstack([BOX_FACES, BOX_FACES[:, ::-1] + 8])
+    res = analyze(client, "two.stl", stl_bytes(v, f))
+    assert res["mass"] == pytest.approx(2000, rel=1e-14)
+    np.testing.assert_allclose(res["center_of_mass"], [2, 0.5, 0.5], rtol=1e-14)
+    assert res["warnings"]
+
+
+def test_inconsistent_winding_is_repaired_with_a_warning(client):
+    f = BOX_FACES.copy()
+    f[[0, 5, 9]] = f[[0, 5, 9]][:, ::-1]
+    res = analyze(client, "mixed.stl", stl_bytes(box_corners(1, 2, 3), f))
+    assert res["mass"] == pytest.approx(6000, rel=1e-14)
+    np.testing.assert_allclose(res["inertia_tensor"], box_inertia(6000, 1, 2, 3), rtol=0, atol=1e-12 * 6500)
+    assert res["warnings"]
+
+
+def test_obj_groups_are_parts(client):
+    text = obj_bytes([("left", box_corners(1, 1, 1), BOX_FACES),
+                      ("right", box_corners(1, 1, 1) + [2, 0, 0], BOX_FACES)]).decode()
+    res = analyze(client, "groups.obj", text.replace("o left", "g left").replace("o right", "g right").encode(),
+                  densities=json.dumps({"right": 500}))
+    parts = {p["name"]: p for p in res["parts"]}
+    assert set(parts) == {"left", "right"}
+    assert parts["left"]["mass"] == pytest.approx(1000, rel=1e-13)
+    assert parts["right"]["mass"] == pytest.approx(500, rel=1e-13)
+    assert res["mass"] == pytest.approx(1500, rel=1e-13)
+
+
+@pytest.mark.parametrize("name,data", [("empty.stl", b""), ("ascii.stl", b"solid x\nendsolid x\n"),
+                                       ("points.obj", b"v 0 0 0\nv 1 0 0\nv 0 1 0\n")],
+                         ids=["zero bytes", "ascii stl without facets", "obj without faces"])
+def test_files_without_triangles_are_empty_geometry(client, name, data):
+    r = post_mesh(client, name, data)
+    if name == "empty.stl" and r.json().get("error", {}).get("code") == "unreadable_file":
+        # a zero-byte file is arguably not a readable STL at all: both codes are accepted
+        assert_error(r, 422, "unreadable_file")
+    else:
+        assert_error(r, 422, "empty_geometry")
+
+
+def test_point_masses_far_from_the_origin_keep_their_moments(client):
+    shift = np.array([1e8, -1e8, 3e7])
+    pts = [{"mass": p["mass"], "position": (np.array(p["position"]) + shift).tolist()} for p in TRIATOMIC["points"]]
+    res = points_ok(client, {"points": pts})
+    est = res["diagnostics"]["relative_error_estimate"]
+    want = [32 / 18, 2.0, 32 / 18 + 2]
+    for got, w in zip(res["principal"]["moments"], want):
+        assert abs(got - w) <= max(est, 4.5e-16) * w, (got, w, est)
+    np.testing.assert_allclose(res["center_of_mass"], shift + [0, 16 / 18, 0], rtol=1e-16)
+
+
+def test_batch_keeps_upload_order_with_files_of_very_different_cost(client):
+    n, m = 200, 100  # a 40 000-triangle torus next to 12-triangle boxes
+    u = np.linspace(0, 2 * np.pi, n, endpoint=False)[:, None]
+    w = np.linspace(0, 2 * np.pi, m, endpoint=False)[None, :]
+    ring = 2 + 0.5 * np.cos(w)
+    pts = np.stack([ring * np.cos(u), ring * np.sin(u), 0.5 * np.sin(w) + 0 * u], -1).reshape(-1, 3)
+    i, j = np.meshgrid(np.arange(n), np.arange(m), indexing="ij")
+    a, b = i * m + j, ((i + 1) % n) * m + j
+    c, d = ((i + 1) % n) * m + (j + 1) % m, i * m + (j + 1) % m
+    faces = np.concatenate([np.stack([a, b, c], -1).reshape(-1, 3), np.stack([a, c, d], -1).reshape(-1, 3)])
+    torus = stl_bytes(pts, faces)
+    box = (SAMPLES / "box.stl").read_bytes()
+    names = [f"{k:02d}_{'torus' if k % 3 == 0 else 'box'}.stl" for k in range(9)]
+    files = [("files", (nm, torus if "torus" in nm else box, "application/octet-stream")) for nm in names]
+    lines = ndjson_lines(client.post("/v1/batch", files=files))
+    assert [line["source"]["filename"] for line in lines] == names
+    for nm, line in zip(names, lines):
+        if "box" in nm:
+            assert line["mass"] == pytest.approx(6000, rel=1e-14)
+        else:
+            assert line["source"]["triangles"] == 2 * n * m
