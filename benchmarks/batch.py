@@ -1,6 +1,6 @@
 """Batch throughput: ``inertia batch`` on local Dask workers against a plain serial trimesh loop.
 
-    python -m benchmarks.batch            # full run (~5 min on 2 cores), writes docs/batch.md
+    python -m benchmarks.batch            # full run (~6 min on 2 cores), writes docs/batch.md
     python -m benchmarks.batch --quick    # smaller sizes, a minute or so
 
 Generates its inputs (binary STL) into a temporary folder, then times, in the
@@ -397,8 +397,8 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--quick", action="store_true", help="200 small files and 4 of 180k triangles")
     parser.add_argument("--workers", type=int, default=2, help="local worker processes (default 2)")
     parser.add_argument("--out", type=Path, default=DOC, help=f"Markdown report (default {DOC.relative_to(ROOT)})")
-    parser.add_argument("--repeat", type=int, default=3,
-                        help="interleaved rounds; the best time of each contender counts (large sets: half)")
+    parser.add_argument("--repeat", type=int, default=6,
+                        help="interleaved rounds; the best time of each contender counts (large set: a third)")
     parser.add_argument("--only", choices=("tiny", "small", "large"), action="append", help="run only these sets")
     parser.add_argument("--child", nargs=3, metavar=("FOLDER", "OUT", "WORKERS"), help=argparse.SUPPRESS)
     args = parser.parse_args(argv)
@@ -421,7 +421,7 @@ def main(argv: list[str] | None = None) -> int:
             megabytes = sum(p.stat().st_size for p in files) / 1e6
             print(f"[{name}] generated {count} files, {triangles:,} triangles, {megabytes:.0f} MB in "
                   f"{time.perf_counter() - t:.1f} s", file=sys.stderr)
-            repeats = args.repeat if name != "large" else max(1, args.repeat // 2)
+            repeats = args.repeat if name != "large" else max(1, args.repeat // 3)
             tri_s, ana_s, batch_s, startup, memory = math.inf, math.inf, math.inf, 0.0, MemoryLog()
             for r in range(repeats):  # interleaved rounds, best of each: robust to a busy machine
                 load = available_cores()
