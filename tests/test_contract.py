@@ -1428,9 +1428,11 @@ def test_cli_errors_go_to_stderr_with_non_zero_exit():
     p = run_cli("analyze", "open_box.stl", "--json")
     assert p.returncode != 0
     assert not p.stdout.strip()
-    env = json.loads(p.stderr.strip().splitlines()[-1]) if p.stderr.strip().startswith("{") is False \
-        else json.loads(p.stderr)
-    assert env["error"]["code"] == "not_watertight"
+    try:
+        env = json.loads(p.stderr)
+    except json.JSONDecodeError:
+        env = json.loads(next(x for x in reversed(p.stderr.splitlines()) if x.startswith("{")))
+    assert env["error"]["code"] == "not_watertight" and env["error"]["message"]
     p = run_cli("analyze", "box.stl", "--units", "parsec")
     assert p.returncode != 0 and "invalid_parameter" in p.stderr
 
@@ -1440,6 +1442,7 @@ def test_cli_batch_writes_one_line_per_file_and_resumes(tmp_path):
     (folder / "sub").mkdir(parents=True)
     (folder / "box.stl").write_bytes((SAMPLES / "box.stl").read_bytes())
     (folder / "sub" / "open_box.stl").write_bytes((SAMPLES / "open_box.stl").read_bytes())
+    (folder / "notes.txt").write_text("not a mesh: files of unknown extensions are not read")
     out = tmp_path / "results.jsonl"
     p = run_cli("batch", str(folder), "--out", str(out), cwd=tmp_path)
     assert p.returncode in (0, 1, 2, 3, 4), p.stderr
@@ -1980,3 +1983,22 @@ def test_batch_keeps_upload_order_with_files_of_very_different_cost(client):
             assert line["mass"] == pytest.approx(6000, rel=1e-14)
         else:
             assert line["source"]["triangles"] == 2 * n * m
+
+
+def test_cli_batch_runs_on_an_existing_dask_cluster(tmp_path):
+    from distributed import LocalCluster
+
+    folder = tmp_path / "in"
+    folder.mkdir()
+    for name in ("box.stl", "open_box.stl", "tetrahedron.stl"):
+        (folder / name).write_bytes((SAMPLES / name).read_bytes())
+    out = tmp_path / "dask.jsonl"
+    with LocalCluster(n_workers=1, threads_per_worker=1, processes=False, dashboard_address=None,
+                      protocol="tcp://", host="127.0.0.1") as cluster:
+        p = run_cli("batch", str(folder), "--out", str(out), "--scheduler", cluster.scheduler_address,
+                    cwd=tmp_path)
+    assert out.exists(), p.stderr
+    lines = {Path(x["source"]["filename"]).name: x for x in map(json.loads, out.read_text().splitlines())}
+    assert set(lines) == {"box.stl", "open_box.stl", "tetrahedron.stl"}
+    assert lines["open_box.stl"]["error"]["code"] == "not_watertight"
+    assert lines["tetrahedron.stl"]["mass"] == pytest.approx(1000 / 6, rel=1e-14)
