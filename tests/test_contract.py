@@ -1827,7 +1827,8 @@ def test_cli_batch_tabular_outputs_have_one_row_per_file(tmp_path, suffix):
     if suffix == ".csv":
         import csv
 
-        rows = list(csv.DictReader(out.open()))
+        with out.open(newline="") as fh:
+            rows = list(csv.DictReader(fh))
     else:
         import pyarrow.parquet as pq
 
