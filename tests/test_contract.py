@@ -2003,3 +2003,63 @@ def test_cli_batch_runs_on_an_existing_dask_cluster(tmp_path):
     assert set(lines) == {"box.stl", "open_box.stl", "tetrahedron.stl"}
     assert lines["open_box.stl"]["error"]["code"] == "not_watertight"
     assert lines["tetrahedron.stl"]["mass"] == pytest.approx(1000 / 6, rel=1e-14)
+
+
+def test_pyramid_and_wedge_cells(client, tmp_path):
+    """[0,1]³ as three pyramids (apex at the origin, bases on x=1, y=1, z=1) and [1,2]x[0,1]²
+    as two wedges: together the 2 x 1 x 1 box."""
+    import meshio
+
+    pts: list[list[float]] = []
+
+    def P(p):
+        pts.append(list(map(float, p)))
+        return len(pts) - 1
+
+    apex = P([0, 0, 0])
+    pyramids = []
+    for quad in ([[1, 0, 0], [1, 0, 1], [1, 1, 1], [1, 1, 0]], [[0, 1, 0], [1, 1, 0], [1, 1, 1], [0, 1, 1]],
+                 [[0, 0, 1], [0, 1, 1], [1, 1, 1], [1, 0, 1]]):
+        a, b, c = (np.array(x, float) for x in quad[:3])
+        ids = [P(x) for x in quad]
+        if np.cross(b - a, c - a) @ (-a) < 0:  # VTK: base normal towards the apex
+            ids = ids[::-1]
+        pyramids.append(ids + [apex])
+    wedges = []
+    for tri in ([[1, 0], [2, 0], [2, 1]], [[1, 0], [2, 1], [1, 1]]):
+        wedges.append([P([x, y, 0]) for x, y in tri] + [P([x, y, 1]) for x, y in tri])
+    path = tmp_path / "pw.vtu"
+    meshio.write(path, meshio.Mesh(np.array(pts), [("pyramid", np.array(pyramids)), ("wedge", np.array(wedges))]))
+    res = analyze(client, "pw.vtu", path.read_bytes())
+    assert res["mass"] == pytest.approx(2000, rel=1e-14)
+    np.testing.assert_allclose(res["center_of_mass"], [1, 0.5, 0.5], rtol=1e-14)
+    np.testing.assert_allclose(res["inertia_tensor"], box_inertia(2000, 2, 1, 1), rtol=0, atol=1e-13 * 2000)
+    assert sorted(p["mass"] for p in res["parts"]) == pytest.approx([1000, 1000], rel=1e-14)
+
+
+@pytest.mark.parametrize("method", ["exact", "dop853", "rk45", "splitting"])
+def test_drift_diagnostics_are_honest(client, method):
+    """'diagnostics reports how well the trajectory keeps [M] and the energy': the reported drift
+    is at least what the returned samples show (half of it, for definitions that differ)."""
+    moments, omega = [1.0, 2.0, 3.0], [0.3, 0.8, 0.5]
+    res = precession_ok(client, {"principal_moments": moments, "omega": omega, "duration": 50, "samples": 201,
+                                 "method": method})
+    pre = res["precession"]
+    W = np.asarray(pre["trajectory"]["omega_body"])
+    I = np.asarray(moments)
+    E = 0.5 * (I * W * W).sum(axis=1)
+    M = np.linalg.norm(I * W, axis=1)
+    E0, M0 = 0.5 * I @ (np.asarray(omega) ** 2), np.linalg.norm(I * omega)
+    seen_e = float(np.max(np.abs(E / E0 - 1)))
+    seen_m = float(np.max(np.abs(M / M0 - 1)))
+    d = pre["diagnostics"]
+    assert d["energy_drift"] >= 0.5 * seen_e - 1e-15, (d, seen_e)
+    assert d["momentum_drift"] >= 0.5 * seen_m - 1e-15, (d, seen_m)
+
+
+def test_points_endpoint_accepts_the_method(client):
+    body = {**TRIATOMIC, "omega": [0.2, 1.0, 0.3], "duration": 2.0, "samples": 5, "method": "dop853"}
+    res = points_ok(client, body)
+    I = np.asarray(res["inertia_tensor"], float)
+    check_trajectory(res["precession"], res["principal"]["moments"], res["principal"]["axes"], body["omega"],
+                     2.0, 5, I, tol=1e-5)
