@@ -2063,3 +2063,12 @@ def test_points_endpoint_accepts_the_method(client):
     I = np.asarray(res["inertia_tensor"], float)
     check_trajectory(res["precession"], res["principal"]["moments"], res["principal"]["axes"], body["omega"],
                      2.0, 5, I, tol=1e-5)
+
+
+def test_moments_equal_only_within_tolerance_are_not_rounded_in_momentum_and_energy(client):
+    """Same as the hex_prism case through /v1/precession: M = diag(I) Ω exactly for the given moments."""
+    moments, omega = [1.0, 2.0, 2.0 + 1e-9], [0.3, 0.4, 0.5]
+    res = precession_ok(client, {"principal_moments": moments, "omega": omega})
+    assert res["classification"]["kind"] == "symmetric_top"
+    assert res["classification"]["asymmetry"] == pytest.approx(ray_kappa(moments), rel=1e-12)
+    check_invariants(res["precession"], np.diag(moments), omega)
