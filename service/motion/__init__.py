@@ -102,6 +102,7 @@ class _Setup:
     stable: bool | None
     warnings: tuple[str, ...]
     unique: int | None = None  # symmetry axis index of a symmetric top
+    initial: RigidProblem | None = None  # the state as given: reported M, E and omega_body come from it
 
 
 def predict_motion(
@@ -192,6 +193,14 @@ def _parse_times(duration: float | None, samples: int | None) -> Array | None:
 
 
 def _setup(frame: PrincipalFrame, classification: Classification, omega: Array, tol: Tolerances) -> _Setup:
+    """The regime, and the ideal problem that is solved; the state as given is kept beside it."""
+    decided = _decide(frame, classification, omega, tol)
+    axes = np.asarray(frame.axes, dtype=np.float64)
+    given = RigidProblem(np.asarray(frame.moments, dtype=np.float64), axes @ omega, axes, frame.quaternion)
+    return replace(decided, initial=given)
+
+
+def _decide(frame: PrincipalFrame, classification: Classification, omega: Array, tol: Tolerances) -> _Setup:
     axes = np.asarray(frame.axes, dtype=np.float64)
     omega_body = axes @ omega
     moments, warnings = _ideal_moments(np.asarray(frame.moments, dtype=np.float64), classification.rotor)
@@ -272,14 +281,17 @@ def _snap(problem: RigidProblem, axis: int | None, zero: int | None) -> RigidPro
 
 def _quantities(setup: _Setup, method: MotionMethod, tol: Tolerances) -> FreeMotion:
     problem = setup.problem
-    momentum = problem.momentum_input
+    # M = I Omega and E = Omega.I Omega/2 of the state as given, with the reported moments (API.md);
+    # the ideal top's moments only shape the motion that follows
+    given = setup.initial if setup.initial is not None else problem
+    momentum = given.momentum_input
     base = FreeMotion(
         regime=setup.regime,
         method=method,
         angular_momentum=momentum,
         angular_momentum_magnitude=float(np.linalg.norm(momentum)),
-        kinetic_energy=problem.energy,
-        omega_body=problem.omega_body,
+        kinetic_energy=given.energy,
+        omega_body=given.omega_body,
         diagnostics=MotionDiagnostics(elapsed_s=0.0),
         stable=setup.stable,
         warnings=setup.warnings,
