@@ -40,6 +40,7 @@ if str(ROOT) not in sys.path:
 from service.body import MeshBody, PointBody, VolumeBody  # noqa: E402
 from service.classify import RotorClass, classify  # noqa: E402
 from service.mass import mass_properties  # noqa: E402
+from service.motion import ideal_moments  # noqa: E402
 from service.principal import principal_frame  # noqa: E402
 from tests.exact import (exact_eigenvalues, exact_points, exact_solid, exact_tetrahedra,  # noqa: E402
                          relative_error)
@@ -637,16 +638,7 @@ def measure_motion(case: MotionCase, samples: int = 2001, reference_samples: int
 
 def _effective_moments(moments: Array, rotor: RotorClass) -> Array:
     """The moments the exact motion is computed with (service.motion's ideal top)."""
-    ideal = moments.copy()
-    if rotor is RotorClass.SPHERICAL:
-        ideal[:] = moments.mean()
-    elif rotor is RotorClass.SYMMETRIC_OBLATE:
-        ideal[:2] = moments[:2].mean()
-    elif rotor in (RotorClass.SYMMETRIC_PROLATE, RotorClass.LINEAR):
-        ideal[1:] = moments[1:].mean()
-    if rotor is RotorClass.LINEAR:
-        ideal[0] = 0.0
-    return ideal
+    return ideal_moments(moments, rotor)
 
 
 def _scipy_cell(case: MotionCase, moments: Array, omega_body0: Array, frame: object, run: bool) -> dict[str, object]:

@@ -8,6 +8,7 @@ import numpy as np
 
 if TYPE_CHECKING:
     from .classify import Classification
+    from .mass import MassProperties
     from .pipeline import AnalysisResult, PartResult, PrecessionResult
     from .principal import PrincipalFrame
 
@@ -40,14 +41,23 @@ def classification_dict(cls: "Classification") -> dict[str, Any]:
     return out
 
 
-def _part_dict(part: "PartResult") -> dict[str, Any]:
-    p = part.props
-    out: dict[str, Any] = {"name": part.name, "mass": p.mass}
+def _body_dict(p: "MassProperties") -> dict[str, Any]:
+    """mass, volume, density (solids only, API.md), area (shells), centre of mass, tensor."""
+    out: dict[str, Any] = {"mass": p.mass}
     if p.volume is not None:
         out["volume"] = p.volume
-    if p.density is not None:
-        out["density"] = p.density
+        if p.density is not None:
+            out["density"] = p.density
+    if p.area is not None:
+        out["area"] = p.area
     out["center_of_mass"] = _list(p.center_of_mass)
+    out["inertia_tensor"] = _list(p.inertia.matrix)
+    return out
+
+
+def _part_dict(part: "PartResult") -> dict[str, Any]:
+    p = part.props
+    out: dict[str, Any] = {"name": part.name, **_body_dict(p)}
     out["inertia_tensor"] = _list(p.inertia.matrix)
     out["principal"] = principal_dict(part.frame)
     out["classification"] = classification_dict(part.classification)
@@ -59,15 +69,7 @@ def _part_dict(part: "PartResult") -> dict[str, Any]:
 def analysis_dict(result: "AnalysisResult") -> dict[str, Any]:
     """The analysis result of the contract (API.md, "The analysis result")."""
     p = result.props
-    out: dict[str, Any] = {"source": dict(result.source), "mass": p.mass}
-    if p.volume is not None:  # volume and density: solids only (API.md)
-        out["volume"] = p.volume
-        if p.density is not None:
-            out["density"] = p.density
-    if p.area is not None:
-        out["area"] = p.area
-    out["center_of_mass"] = _list(p.center_of_mass)
-    out["inertia_tensor"] = _list(p.inertia.matrix)
+    out: dict[str, Any] = {"source": dict(result.source), **_body_dict(p)}
     if result.reference is not None:
         out["reference_inertia"] = {"point": _list(result.reference.point), "tensor": _list(result.reference.matrix)}
     out["principal"] = principal_dict(result.frame)

@@ -65,6 +65,7 @@ from .symmetric import SymmetricTop, uniform_rotation
 
 __all__ = [
     "predict_motion",
+    "ideal_moments",
     "FreeMotion",
     "MotionMethod",
     "Regime",
@@ -236,17 +237,28 @@ def _decide(frame: PrincipalFrame, classification: Classification, omega: Array,
     return _Setup(problem, Regime.ASYMMETRIC, nearest != 1, tuple(warnings))
 
 
-def _ideal_moments(moments: Array, rotor: RotorClass) -> tuple[Array, list[str]]:
-    """Moments of the ideal top of class ``rotor`` (see the module doc), and a warning if they moved."""
-    ideal = moments.copy()
+def ideal_moments(moments: ArrayLike, rotor: RotorClass) -> Array:
+    """Moments of the ideal top of class ``rotor``, the ones the motion is computed with.
+
+    Moments equal within the classification's tolerance become their mean;
+    the smallest moment of a linear rotator becomes 0.
+    """
+    given = np.asarray(moments, dtype=np.float64)
+    ideal = given.copy()
     if rotor is RotorClass.SPHERICAL:
-        ideal[:] = moments.mean()
+        ideal[:] = given.mean()
     elif rotor is RotorClass.SYMMETRIC_OBLATE:
-        ideal[:2] = moments[:2].mean()
+        ideal[:2] = given[:2].mean()
     elif rotor in (RotorClass.SYMMETRIC_PROLATE, RotorClass.LINEAR):
-        ideal[1:] = moments[1:].mean()
+        ideal[1:] = given[1:].mean()
     if rotor is RotorClass.LINEAR:
         ideal[0] = 0.0
+    return ideal
+
+
+def _ideal_moments(moments: Array, rotor: RotorClass) -> tuple[Array, list[str]]:
+    """``ideal_moments``, and a warning if they moved by more than rounding."""
+    ideal = ideal_moments(moments, rotor)
     shift = float(np.max(np.abs(ideal - moments)))
     warnings = []
     if shift > _IDEALISATION_NOISE * float(moments[2]):
