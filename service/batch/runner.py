@@ -48,13 +48,14 @@ WINDOW_PER_THREAD = 4
 
 
 # Dask starts workers with MALLOC_TRIM_THRESHOLD_=65536 so that freed memory
-# goes back to the OS.  Setting it also freezes glibc's mmap threshold at
-# 128 KiB, so every large numpy temporary is a fresh mmap whose pages fault in
-# and get zeroed: the pipeline then needs ~3x the CPU (measured on 1e5-1e6
-# triangle meshes).  Heap allocations up to glibc's own dynamic maximum
-# (32 MiB on 64-bit) restore the speed and keep the prompt trimming.
-MMAP_ENV = "MALLOC_MMAP_THRESHOLD_"
-MMAP_THRESHOLD = 32 << 20
+# goes back to the OS at once.  Setting it also freezes glibc's mmap threshold
+# at 128 KiB, so every large numpy temporary is a fresh mmap whose pages fault
+# in and get zeroed: the pipeline then needed ~3x the CPU on meshes of 1e5
+# triangles and ~1.5x on 1e6 (even with a 32 MiB mmap threshold added).  Our
+# tasks hold one file at a time, so glibc's own dynamic thresholds (which
+# trim freed heap beyond twice the largest recent mmap, at most 64 MiB) keep
+# worker memory flat; the local workers run without the variable.
+DROPPED_ENV = ("MALLOC_TRIM_THRESHOLD_",)
 
 
 @dataclass(frozen=True, slots=True)
@@ -97,8 +98,10 @@ def local_cluster(workers: int | None = None) -> Any:
     # distributed and numpy once) two workers start in ~1.5 s instead of ~2.5 s
     # with spawn on a 2-core machine.  Spawn where there is no forkserver.
     method = "forkserver" if "forkserver" in multiprocessing.get_all_start_methods() else "spawn"
-    settings = {"distributed.worker.multiprocessing-method": method,
-                f"distributed.nanny.pre-spawn-environ.{MMAP_ENV}": MMAP_THRESHOLD}
+    environ = {k: v for k, v in dask.config.get("distributed.nanny.pre-spawn-environ", {}).items()
+               if k not in DROPPED_ENV}
+    settings = {"distributed.worker.multiprocessing-method": method, "distributed.nanny.pre-spawn-environ": environ,
+                "distributed.worker.profile.enabled": False}
     with dask.config.set(settings):
         return distributed.LocalCluster(
             n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None, silence_logs=logging.ERROR,
