@@ -164,6 +164,8 @@ def _peer(fn: Callable[[], Array]) -> Array | str:
     """A peer's ascending principal moments, or the text of what went wrong."""
     try:
         out = np.sort(np.asarray(fn(), dtype=np.float64))
+    except ImportError as exc:
+        return f"not installed ({exc.name}; pip install -e '.[bench]')"
     except Exception as exc:  # a peer that raises gets that text in its cell
         return f"raises {type(exc).__name__}: {str(exc).splitlines()[0][:60]}"
     if not np.all(np.isfinite(out)):
@@ -172,15 +174,18 @@ def _peer(fn: Callable[[], Array]) -> Array | str:
 
 
 def trimesh_moments(v: Array, f: NDArray[np.int64]) -> Array | str:
-    import trimesh
+    def run() -> Array:
+        import trimesh
 
-    return _peer(lambda: trimesh.Trimesh(v, f, process=False).principal_inertia_components)
+        return trimesh.Trimesh(v, f, process=False).principal_inertia_components
+
+    return _peer(run)
 
 
 def numpy_stl_moments(v: Array, f: NDArray[np.int64]) -> Array | str:
-    from stl import mesh as stl_mesh
-
     def run() -> Array:
+        from stl import mesh as stl_mesh
+
         m = stl_mesh.Mesh(np.zeros(len(f), dtype=stl_mesh.Mesh.dtype))
         m.vectors[:] = v[f]  # float32 storage: this is where numpy-stl's input is rounded
         _, _, inertia = m.get_mass_properties()
@@ -191,9 +196,9 @@ def numpy_stl_moments(v: Array, f: NDArray[np.int64]) -> Array | str:
 
 def mujoco_moments(parts: Sequence[tuple[Array, NDArray[np.int64], float]]) -> Array | str:
     """Principal moments of one MuJoCo body made of mesh geoms (vertices, faces, density)."""
-    import mujoco
-
     def run() -> Array:
+        import mujoco
+
         spec = mujoco.MjSpec()
         body = spec.worldbody.add_body(name="b")
         body.add_freejoint()
