@@ -24,8 +24,8 @@ from .classify import Classification, classify
 from .conventions import length_scale
 from .errors import InvalidParameterError
 from .load import Loaded, load_body, load_points
-from .mass import InertiaTensor, MassProperties, Model, mass_properties, parallel_axis
-from .principal import PrincipalFrame, jacobi_eigh, principal_frame
+from .mass import InertiaTensor, MassProperties, Model, assembly_properties, mass_properties
+from .principal import PrincipalFrame, principal_frame
 from .tolerances import DEFAULT_TOLERANCES, EPS
 
 if TYPE_CHECKING:
@@ -158,6 +158,7 @@ def analyze_loaded(loaded: Loaded, options: AnalysisOptions, start: float | None
         raise InvalidParameterError("model=shell applies to surface meshes, not point masses", parameter="model")
     single = len(loaded.parts) == 1
     part_results = tuple(_part(p.name, p.body, options, single) for p in loaded.parts)
+    factor = 1.0
     if not single and options.mass is not None:
         factor = options.mass / sum(p.props.mass for p in part_results)
         part_results = tuple(_scaled(p, factor) for p in part_results)
@@ -166,7 +167,7 @@ def analyze_loaded(loaded: Loaded, options: AnalysisOptions, start: float | None
         frame, cls = part_results[0].frame, part_results[0].classification
         parts = None
     else:
-        props = _combined(part_results, options)
+        props = _combined(loaded, part_results, options, factor)
         frame = principal_frame(props, options.tolerance)
         cls = classify(frame)
         parts = part_results
@@ -219,34 +220,22 @@ def _scaled(part: PartResult, factor: float) -> PartResult:
     return PartResult(part.name, props, frame, classify(frame))
 
 
-def _combined(parts: Sequence[PartResult], options: AnalysisOptions) -> MassProperties:
-    """Whole assembly by the parallel-axis theorem (Landau & Lifshitz eq. 32.12)."""
-    masses = np.array([p.props.mass for p in parts])
-    scale = 1.0  # parts are already scaled to a requested total mass
-    total = float(masses.sum())
-    com = sum(p.props.mass * scale * p.props.center_of_mass for p in parts) / total
-    tensor = np.zeros((3, 3))
-    for p in parts:
-        m = p.props.mass * scale
-        tensor = tensor + parallel_axis(p.props.inertia.matrix * scale, m, p.props.center_of_mass - com)
-    values, vectors = jacobi_eigh(tensor)
+def _combined(loaded: Loaded, parts: Sequence[PartResult], options: AnalysisOptions,
+              factor: float) -> MassProperties:
+    """The whole assembly, integrated as one body with each part's material."""
+    pairs = []
+    for part in loaded.parts:
+        own = options.densities.get(part.name) if options.densities else None
+        uniform = own if own is not None else (options.density if options.density is not None else 1000.0)
+        pairs.append((part.body, uniform))
+    whole = assembly_properties(pairs, model=options.model, thickness=options.thickness, factor=factor)
     volumes = [p.props.volume for p in parts]
-    volume = float(sum(v for v in volumes if v is not None)) if all(v is not None for v in volumes) else None
     densities = {p.props.density for p in parts}
-    density = (densities.pop() * scale) if len(densities) == 1 and None not in densities else None
-    estimate = max(p.props.relative_error_estimate for p in parts) + 16 * EPS * len(parts)
-    warnings: list[str] = []
-    for p in parts:
-        warnings.extend(f"{p.name}: {w}" for w in p.props.warnings)
-    return MassProperties(
-        mass=total,
-        center_of_mass=com,
-        inertia=InertiaTensor(tensor, "centre_of_mass", com),
-        principal_moments=values,
-        principal_axes=vectors,
-        relative_error_estimate=estimate,
-        volume=volume,
-        density=density,
+    warnings = [f"{p.name}: {w}" for p in parts for w in p.props.warnings]
+    return replace(
+        whole,
+        volume=float(sum(v for v in volumes if v is not None)) if None not in volumes else None,
+        density=densities.pop() if len(densities) == 1 and None not in densities else None,
         warnings=tuple(warnings),
     )
 

@@ -191,3 +191,28 @@ def test_gltf_with_external_buffers_is_refused_with_advice() -> None:
     with pytest.raises(UnreadableFileError) as err:
         analyze(data, filename="part.gltf")
     assert ".glb" in err.value.message and "external buffer" in err.value.message
+
+
+def test_assembly_far_from_the_origin_keeps_every_moment() -> None:
+    import sys
+
+    from paths import ROOT
+
+    sys.path.insert(0, str(ROOT / "tests"))
+    from exact import exact_eigenvalues, exact_solid
+
+    offset = np.array([1e6, -6e5, 3e5])  # OBJ text keeps float64 coordinates
+    left = trimesh.Trimesh(*box(1.0, 1.0, 1.0), process=False)
+    right = trimesh.Trimesh(*box(1.0, 2.0, 1.0), process=False)
+    left.apply_translation(offset)
+    right.apply_translation(offset + [3.0, 1.0, 0.0])
+    scene = trimesh.Scene()
+    scene.add_geometry(left, node_name="left", geom_name="left")
+    scene.add_geometry(right, node_name="right", geom_name="right")
+    doc = analyze(export(scene, "obj", digits=17), filename="far.obj", options=AnalysisOptions(density=1.0)).as_dict()
+    vertices = np.vstack([left.vertices, right.vertices])
+    faces = np.vstack([left.faces, right.faces + len(left.vertices)])
+    exact = sorted(float(x) for x in exact_eigenvalues(exact_solid(vertices, faces)[2]))
+    errors = np.abs(np.array(doc["principal"]["moments"]) - exact) / np.array(exact)
+    assert doc["diagnostics"]["relative_error_estimate"] <= 1e-12
+    assert np.all(errors <= doc["diagnostics"]["relative_error_estimate"])
