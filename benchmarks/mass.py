@@ -132,6 +132,7 @@ def stage_breakdown(path: Path) -> dict[str, float]:
     """Seconds per stage of one in-process ``pipeline.analyze`` (after a warm-up run)."""
     import service.load.stl as stl
     import service.mass as mass
+    import service.solid as solid
     from service import pipeline
 
     times: dict[str, float] = defaultdict(float)
@@ -150,9 +151,9 @@ def stage_breakdown(path: Path) -> dict[str, float]:
         passes[0] += 1
         return f"integration pass {passes[0]}"
 
-    patches = [(stl, "read_stl", "read STL + float32 weld"), (mass, "weld", "weld check (float64)"),
-               (mass, "surface_topology", "edge topology (watertight check)"),
-               (mass, "_orient_outward", "outward orientation"), (mass._Geometry, "sums", pass_name)]
+    patches = [(stl, "read_stl_file", "read STL + float32 weld"), (solid, "weld", "weld check (float64)"),
+               (solid, "surface_topology", "edge topology (watertight check)"),
+               (solid, "_orient_outward", "outward orientation"), (mass._Geometry, "sums", pass_name)]
     saved = [(obj, attr, getattr(obj, attr)) for obj, attr, _ in patches]
     try:
         for obj, attr, name in patches:
