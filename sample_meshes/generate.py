@@ -10,7 +10,6 @@ written, never from the service itself.
 from __future__ import annotations
 
 import json
-import math
 import struct
 from fractions import Fraction
 from pathlib import Path

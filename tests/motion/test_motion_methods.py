@@ -94,7 +94,6 @@ def test_elliptic_integrals_match_mpmath(m1, b):
         F = mp.ellipf(phi, m)
         Pi = mp.ellippi(-b, phi, m)  # Pi(n; phi | m), n = -b
         Pic = mp.ellippi(-b, m)
-        Kc = mp.ellipk(m)
     assert incomplete_first_kind(s, c, m1) == pytest.approx(float(F), rel=1e-15)
     pi_value = float(F) - b / 3 * third_kind_rj(np.array([s]), np.array([c]), np.array([d]), b)[0]
     assert pi_value == pytest.approx(float(Pi), rel=1e-14)
