@@ -12,7 +12,7 @@ in the same run:
     against a script that imports trimesh, loads the file and reads
     ``mass_properties`` and ``is_watertight``, and one that calls numpy-stl's
     ``Mesh.from_file`` + ``get_mass_properties``.  Wall time and peak RSS
-    (``os.wait4`` rusage of that child) are the median of ``--repeat`` runs.
+    (GNU time's %M for the tool's own process, else ``os.wait4``) are the median of ``--repeat`` runs.
 (b) our stages in process (read + weld of the STL, welding check, edge
     topology, outward orientation, each integration pass), timed by
     wrapping the stage functions around one ``pipeline.analyze`` call.
@@ -78,19 +78,31 @@ def torus_stl(path: Path, nu: int, nv: int, major: float = 3.0, minor: float = 1
     return len(faces)
 
 
+GNU_TIME = "/usr/bin/time"
+
+
 def run_process(cmd: list[str]) -> tuple[float, int, str]:
-    """Wall time [s], peak RSS [bytes] and stdout of one child process."""
-    with tempfile.TemporaryFile() as out:
+    """Wall time [s], peak RSS [bytes] and stdout of one child process.
+
+    Linux carries a process's high-water RSS across fork and exec into the
+    child's ``ru_maxrss``, so a child of this (large) benchmark process would
+    report at least this process's own peak.  GNU time, itself tiny, forks the
+    tool and reports the tool's own peak; without it we fall back to wait4.
+    """
+    wrapped = os.path.exists(GNU_TIME)
+    with tempfile.TemporaryFile() as out, tempfile.NamedTemporaryFile("r") as rss_file:
+        full = [GNU_TIME, "-f", "%M", "-o", rss_file.name, *cmd] if wrapped else cmd
         start = time.perf_counter()
-        proc = subprocess.Popen(cmd, stdout=out, stderr=subprocess.PIPE)
+        proc = subprocess.Popen(full, stdout=out, stderr=subprocess.PIPE)
         _, status, usage = os.wait4(proc.pid, 0)
         wall = time.perf_counter() - start
         proc.returncode = os.waitstatus_to_exitcode(status)
         err = proc.stderr.read().decode() if proc.stderr else ""
         if proc.returncode != 0:
             raise RuntimeError(f"{cmd[:3]} failed ({proc.returncode}): {err[-2000:]}")
+        peak_kb = int(rss_file.read().split()[-1]) if wrapped else usage.ru_maxrss
         out.seek(0)
-        return wall, usage.ru_maxrss * 1024, out.read().decode()
+        return wall, peak_kb * 1024, out.read().decode()
 
 
 def tool_commands(path: Path) -> dict[str, list[str]]:
@@ -208,7 +220,7 @@ def report(results: dict[str, dict[str, Any]], stages: dict[str, dict[str, float
              "`inertia analyze FILE --json` (load, float32 weld, watertight and winding checks, exact",
              "multi-pass integration, JSON) against a script that imports trimesh, loads the file and reads",
              "`mass_properties` and `is_watertight`, and one that runs numpy-stl's `Mesh.from_file` +",
-             "`get_mass_properties`.  Times and peak RSS (`os.wait4` rusage of the child) are medians of the",
+             "`get_mass_properties`.  Times and peak RSS (GNU time's maximum resident set of the tool's own process) are medians of the",
              "runs shown; numpy-stl runs once from 1e6 triangles up (its exact mass path takes minutes).", "",
              "## Whole process", "",
              "| triangles | file MB | inertia s | trimesh s | numpy-stl s | trimesh / inertia | numpy-stl / inertia "
