@@ -58,7 +58,7 @@ def orient_axes(axes: NDArray[np.float64]) -> NDArray[np.float64]:
             out[i] = -out[i]
     out[2] = np.cross(out[0], out[1])
     out[2] /= np.linalg.norm(out[2])
-    return out
+    return out + 0.0  # -0.0 becomes 0.0: the same axis prints the same way
 
 
 def quaternion_from_matrix(matrix: NDArray[np.float64]) -> NDArray[np.float64]:
