@@ -8,17 +8,18 @@ not to the coordinates, so a unit conversion never perturbs the polyhedron.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 from .errors import EmptyGeometryError, InvalidParameterError
 
 __all__ = ["MeshBody", "VolumeBody", "PointBody", "Part", "Body"]
 
 
-def _frozen(arr: NDArray, dtype: type) -> NDArray:  # type: ignore[type-arg]
-    out = np.ascontiguousarray(arr, dtype=dtype)
+def _frozen(arr: ArrayLike, dtype: type[np.generic]) -> NDArray[Any]:
+    out: NDArray[Any] = np.ascontiguousarray(arr, dtype=dtype)
     out.flags.writeable = False
     return out
 

@@ -68,9 +68,10 @@ def _cross(u: Vec, v: Vec) -> Vec:
 
 def _det_condition(a: Vec, u: Vec, v: Vec) -> NDArray[np.float64]:
     """sum over permutations of |a_i u_j v_k|: the rounding of a . (u x v) is a few eps times this."""
-    return (np.abs(a[0]) * (np.abs(u[1] * v[2]) + np.abs(u[2] * v[1]))
+    cond: NDArray[np.float64] = (np.abs(a[0]) * (np.abs(u[1] * v[2]) + np.abs(u[2] * v[1]))
             + np.abs(a[1]) * (np.abs(u[2] * v[0]) + np.abs(u[0] * v[2]))
             + np.abs(a[2]) * (np.abs(u[0] * v[1]) + np.abs(u[1] * v[0])))
+    return cond
 
 
 def _measure(corners: list[Vec], kind: str) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
@@ -180,4 +181,5 @@ def local_origin(points: NDArray[np.float64]) -> NDArray[np.float64]:
     """
     lo = points.min(axis=0)
     hi = points.max(axis=0)
-    return lo + 0.5 * (hi - lo)
+    origin: NDArray[np.float64] = lo + 0.5 * (hi - lo)
+    return origin

@@ -102,7 +102,8 @@ def parallel_axis(tensor: NDArray[np.float64], mass: float, offset: NDArray[np.f
     Landau & Lifshitz §32, eq. (32.12); seed notes eq. (29).
     """
     a = np.asarray(offset, dtype=np.float64)
-    return tensor + mass * (np.dot(a, a) * np.eye(3) - np.outer(a, a))
+    shifted: NDArray[np.float64] = tensor + mass * (np.dot(a, a) * np.eye(3) - np.outer(a, a))
+    return shifted
 
 
 def _covariance(s: Sums) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
@@ -327,7 +328,8 @@ def assembly_properties(
     if len(scales) != 1:
         raise InvalidParameterError("the parts of one assembly must share a length unit")
     L = scales.pop()
-    geoms, warnings = [], []
+    geoms: list[tuple[_Geometry, NDArray[np.float64]]] = []
+    warnings: list[str] = []
     for body, density in parts:
         geometry, more = _geometry(body, model, thickness, tolerances)
         geoms.append((geometry, _element_weights(geometry, density, model, thickness, L) * factor))

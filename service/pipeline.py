@@ -49,7 +49,7 @@ def _vector(name: str, value: Sequence[float] | None) -> tuple[float, float, flo
         raise InvalidParameterError(f"{name} must have 3 components, got {len(vec)}", parameter=name)
     if not all(math.isfinite(x) for x in vec):
         raise InvalidParameterError(f"{name} must be finite (no NaN or infinity)", parameter=name)
-    return vec  # type: ignore[return-value]
+    return (vec[0], vec[1], vec[2])
 
 
 def _positive(name: str, value: float | None) -> None:

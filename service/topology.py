@@ -70,8 +70,7 @@ def row_ids(columns: Sequence[NDArray[np.unsignedinteger]]) -> tuple[NDArray[np.
     heads = np.sort(first)
     rank = np.empty(len(first), dtype=np.int64)
     rank[np.argsort(first)] = np.arange(len(first))
-    group = np.cumsum(new, dtype=np.int32 if len(first) < 2**31 else np.int64)
-    group -= 1
+    group = np.cumsum(new, dtype=np.int32 if len(first) < 2**31 else np.int64) - 1
     ids = np.empty(n, dtype=np.int64)
     for start in range(0, n, SCATTER_CHUNK):
         stop = start + SCATTER_CHUNK

@@ -100,7 +100,7 @@ _START_LOCK = threading.Lock()
 
 
 class _Worker:
-    def __init__(self, ctx: multiprocessing.context.BaseContext) -> None:
+    def __init__(self, ctx: Any) -> None:  # a multiprocessing context (forkserver or spawn)
         parent, child = ctx.Pipe()
         self.process = ctx.Process(target=_serve_jobs, args=(child,), daemon=True, name="inertia-compute")
         with _START_LOCK, _main_not_rerun():

@@ -45,7 +45,7 @@ MeshFiles = Annotated[list[UploadFile], File(description="mesh files, or one .zi
 health = APIRouter()
 v1 = APIRouter(prefix="/v1")
 
-_UNSUPPORTED = {415: {"model": ErrorOut, "description": "unsupported_format"}}
+_UNSUPPORTED: dict[int | str, dict[str, Any]] = {415: {"model": ErrorOut, "description": "unsupported_format"}}
 _CURL = ("Example (from the repository root):\n\n"
          "    curl -F file=@sample_meshes/box.stl 'http://localhost:8000/v1/analyze/mesh?units=m&density=1000'")
 

@@ -55,7 +55,7 @@ def _triple(name: str, text: str | None) -> tuple[float, float, float] | None:
         raise InvalidParameterError(f"{name} must be three numbers 'x,y,z', got {text!r}", parameter=name) from None
     if len(values) != 3 or not all(math.isfinite(v) for v in values):
         raise InvalidParameterError(f"{name} must be three finite numbers 'x,y,z', got {text!r}", parameter=name)
-    return values  # type: ignore[return-value]
+    return (values[0], values[1], values[2])
 
 
 def _reject_constant(name: str) -> float:
@@ -115,7 +115,7 @@ class PointIn(_Request):
     position: RealVector = Field(description="position [units of the request]")
 
 
-_POINTS_EXAMPLE = {
+_POINTS_EXAMPLE: dict[str, Any] = {
     "points": [{"mass": 1.0, "position": [0, 0, 0]}, {"mass": 2.0, "position": [1, 0, 0]},
                {"mass": 1.0, "position": [0, 1, 0]}],
     "units": "m", "tolerance": 1e-6, "reference": [0, 0, 0],

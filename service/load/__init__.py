@@ -76,7 +76,7 @@ def _load_path(path: str, filename: str, format: str | None, units: str | None) 
     return Loaded(parts, filename, "stl", "mesh", units or "m", "request" if units else "default")
 
 
-def _load_bytes(data: bytes | memoryview, filename: str | None, format: str | None, units: str | None) -> Loaded:
+def _load_bytes(data: bytes, filename: str | None, format: str | None, units: str | None) -> Loaded:
     if not len(data):
         raise EmptyGeometryError("the file is empty; send a mesh with geometry", filename=filename)
     fmt = sniff_format(filename, format, bytes(data[:512]))

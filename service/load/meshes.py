@@ -40,7 +40,7 @@ def read_trimesh_parts(data: bytes, fmt: str, length_scale: float) -> tuple[list
 
     if fmt == "gltf":
         _check_gltf_self_contained(data)
-    extra = {"split_objects": True, "split_groups": True, "group_material": False} if fmt == "obj" else {}
+    extra: dict[str, Any] = {"split_objects": True, "split_groups": True, "group_material": False} if fmt == "obj" else {}
     try:
         scene = trimesh.load_scene(
             io.BytesIO(data), file_type=fmt, process=False, skip_materials=True, merge_primitives=False, **extra

@@ -124,7 +124,8 @@ def third_kind_rj(
 
     With n = -b, DLMF 19.25.14 gives Pi(n; am u | m) = u + (n/3) times this.
     """
-    return sn**3 * elliprj(cn * cn, dn * dn, 1.0, 1.0 + b * sn * sn)
+    value: NDArray[np.float64] = sn**3 * elliprj(cn * cn, dn * dn, 1.0, 1.0 + b * sn * sn)
+    return value
 
 
 def complete_third_kind_rj(m1: float, b: float) -> float:

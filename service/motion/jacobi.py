@@ -210,14 +210,16 @@ class AsymmetricTop:
             u = self.rate * t + self.u0
             rb = np.sqrt(b)
             bounded = rb * (np.arctan(rb * np.tanh(u)) - np.arctan(rb * np.tanh(self.u0)))
-            return (self.momentum / self.moments[a] + coef * self.rate / (1 + b)) * t + coef * bounded / (1 + b)
+            angle: Array = (self.momentum / self.moments[a] + coef * self.rate / (1 + b)) * t + coef * bounded / (1 + b)
+            return angle
         # Pi(-b; am u) = u - (b/3) [2 j R_J(0, m1, 1, 1+b) + sn_r^3 R_J(cn_r^2, dn_r^2, 1, 1 + b sn_r^2)]
         sn_r, cn_r, dn_r = reduced
         sn0, cn0, dn0 = jacobi_sncndn(np.array([self.u0]), self.m1)
         tail = 2.0 * j * complete_third_kind_rj(self.m1, b) + third_kind_rj(sn_r, cn_r, dn_r, b)
         tail = tail - third_kind_rj(sn0, cn0, dn0, b)
         other = 0 if a == 2 else 2  # |M|/I_a + c = |M|/I_other (see module doc)
-        return (self.momentum / self.moments[other]) * t - coef * (b / 3.0) * tail
+        precession: Array = (self.momentum / self.moments[other]) * t - coef * (b / 3.0) * tail
+        return precession
 
     def _euler_frame(self, omega: Array) -> Array:
         """E(m): rows m x e_a / |m x e_a|, m x row1, m, for m = M_body/|M| (N, 3, 3)."""

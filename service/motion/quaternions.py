@@ -70,9 +70,10 @@ def from_axis_angle(axis: ArrayLike, angle: ArrayLike) -> Array:
 
 def canonical(q: ArrayLike) -> Array:
     """Normalise and pick the sign with w >= 0 (``service.conventions``)."""
-    q = np.asarray(q, dtype=np.float64)
-    q = q / np.linalg.norm(q, axis=-1, keepdims=True)
-    return np.where(q[..., :1] < 0.0, -q, q)
+    arr = np.asarray(q, dtype=np.float64)
+    unit = arr / np.linalg.norm(arr, axis=-1, keepdims=True)
+    signed: Array = np.where(unit[..., :1] < 0.0, -unit, unit)
+    return signed
 
 
 def to_matrices(q: ArrayLike) -> Array:
