@@ -1986,6 +1986,7 @@ def test_batch_keeps_upload_order_with_files_of_very_different_cost(client):
             assert line["source"]["triangles"] == 2 * n * m
 
 
+@pytest.mark.filterwarnings("ignore:Port 8787 is already in use")  # a dashboard elsewhere on this machine
 def test_cli_batch_runs_on_an_existing_dask_cluster(tmp_path):
     from distributed import LocalCluster
 
