@@ -303,7 +303,7 @@ def _verdict(row: Row, workers: int, quick: bool) -> list[str]:
     steady = row.trimesh_s / (row.batch_s - row.startup_s)
     verdict = "met" if ratio >= 1.8 else "not met"
     return [
-        f"**Target** (issue 7: with {workers} local workers at least 1.8x the serial loop's files per second on "
+        f"**Target** (with {workers} local workers at least 1.8x the serial loop's files per second on "
         f"small files): **{ratio:.2f}x** including the cluster start-up, **{verdict}**; {steady:.2f}x once the "
         "cluster is up." + (" Quick run: too few files to judge." if quick else ""),
         "",

@@ -250,7 +250,7 @@ def torus(n_major: int, n_minor: int, R: float = 1.0, r: float = 0.4) -> tuple[n
 
 
 def mesh_moments(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
-    """Principal moments at unit density through service.mass (the lead's module)."""
+    """Principal moments at unit density through service.mass."""
     from service.body import MeshBody
     from service.mass import mass_properties
 

@@ -57,7 +57,7 @@ GENERIC = Rotation.from_euler("zyx", [0.3, 0.7, 1.1]).as_matrix()
 DIRECTION = np.array([1.0, -0.6180339887, 0.4142135623])
 """Offset direction: irrational-looking components so no coordinate stays a round number."""
 
-BOUND_EXACT = 1e-12  # issue 6 / API Accuracy: every principal moment of an exact polyhedron
+BOUND_EXACT = 1e-12  # API.md, Accuracy: every principal moment of an exact polyhedron
 BOUND_THIN = 1e-9  # the smallest moment of needles and plates up to aspect 1e6
 BOUND_INVARIANT = 1e-12  # energy and |M| of the exact motion over 1e5 time units
 HORIZON = 1e5  # time units of every motion case

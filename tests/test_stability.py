@@ -3,7 +3,7 @@
 The battery and its exact references live in ``benchmarks/stability.py`` and
 ``tests/exact.py`` (rational integration of the stored float64 vertices,
 50-digit eigenvalues); here each row's bound is checked against our code so a
-regression fails CI.  Bounds (issue 6, API "Accuracy"): every principal moment
+regression fails CI.  Bounds (API.md, "Accuracy", and the stability report): every principal moment
 of an exact polyhedron to 1e-12 relative at any offset up to 1e8 sizes and any
 rotation, the smallest moment of a needle or plate to 1e-9, no NaN or infinity,
 invariants of the exact motion to 1e-12 over 1e5 time units.
