@@ -1,4 +1,4 @@
-"""Black-box tests of the HTTP contract (/work/shared/API.md) and of the CLI.
+"""Black-box tests of the HTTP contract (API.md) and of the CLI.
 
 Only public surfaces are used: the ASGI app through ``fastapi.testclient``
 (``service.app.app``, or ``service.api.create_app()`` after setting the
