@@ -150,9 +150,26 @@ class _Geometry:
             ) from exc
 
 
-def _refine(geometry: _Geometry, tolerances: Tolerances) -> tuple[Sums, NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], float]:
-    """Multi-pass integration.  Returns final sums, COM, tensor (input frame),
-    moments, axes (rows) and the relative error estimate of the moments."""
+@dataclass(frozen=True, slots=True)
+class _Refined:
+    """What the passes found, in the file's units and the geometry's measure.
+
+    sums : the final pass's integrals (principal frame, about the centre).
+    com : (3,) centre, input frame.  tensor : (3, 3) about it, input frame.
+    moments, axes : eigenvalues and axes (rows) from the final pass.
+    estimate : relative error bound of the moments.
+    """
+
+    sums: Sums
+    com: NDArray[np.float64]
+    tensor: NDArray[np.float64]
+    moments: NDArray[np.float64]
+    axes: NDArray[np.float64]
+    estimate: float
+
+
+def _refine(geometry: _Geometry, tolerances: Tolerances) -> _Refined:
+    """Multi-pass integration: a coarse pass, then passes in the principal frame until it settles."""
     origin = local_origin(geometry.points)
     s = geometry.sums(origin, None)
     _check_volume(s, geometry.kind)
@@ -180,7 +197,7 @@ def _refine(geometry: _Geometry, tolerances: Tolerances) -> tuple[Sums, NDArray[
         estimate = max(estimate, step)
     tensor = rotation @ np.diag(values) @ rotation.T
     tensor = 0.5 * (tensor + tensor.T)
-    return s, com, tensor, values, rotation.T.copy(), estimate
+    return _Refined(s, com, tensor, values, rotation.T.copy(), estimate)
 
 
 def _offdiagonal_ratio(t: NDArray[np.float64]) -> float:
@@ -256,7 +273,9 @@ def mass_properties(
     """
     _check_material(body, density, mass, model, thickness)
     geometry, warnings = _geometry(body, model, thickness, tolerances)
-    s, com, tensor, moments, axes, estimate = _refine(geometry, tolerances)
+    refined = _refine(geometry, tolerances)
+    s, com, tensor, moments, axes, estimate = (refined.sums, refined.com, refined.tensor, refined.moments,
+                                               refined.axes, refined.estimate)
     L = body.length_scale
     if isinstance(body, PointBody):
         measure_to_mass = 1.0 if mass is None else mass / s.m0
@@ -345,7 +364,9 @@ def assembly_properties(
         kind,
         np.concatenate([w for _, w in geoms]),
     )
-    s, com, tensor, moments, axes, estimate = _refine(whole, tolerances)
+    refined = _refine(whole, tolerances)
+    s, com, tensor, moments, axes, estimate = (refined.sums, refined.com, refined.tensor, refined.moments,
+                                               refined.axes, refined.estimate)
     length_power = {"apex": 5, "tet": 5, "tri": 4, "points": 2}[kind]
     to_mass = L ** (length_power - 2)
     inertia_scale = L**length_power

@@ -122,7 +122,7 @@ class AnalysisResult:
     frame: PrincipalFrame
     classification: Classification
     reference: InertiaTensor | None = None
-    motion: "FreeMotion | None" = None
+    motion: FreeMotion | None = None
     parts: tuple[PartResult, ...] | None = None
     warnings: tuple[str, ...] = ()
     elapsed_s: float = 0.0
@@ -240,7 +240,7 @@ def _combined(loaded: Loaded, parts: Sequence[PartResult], options: AnalysisOpti
     )
 
 
-def _motion(frame: PrincipalFrame, cls: Classification, options: AnalysisOptions) -> "FreeMotion":
+def _motion(frame: PrincipalFrame, cls: Classification, options: AnalysisOptions) -> FreeMotion:
     from .motion import predict_motion
 
     omega = np.asarray(options.omega, dtype=np.float64)
@@ -277,7 +277,7 @@ def _source(loaded: Loaded, parts: Sequence[PartResult]) -> dict[str, Any]:
         out["watertight"] = all(w for _, w in closed)
     elif loaded.kind == "volume":
         vols = [b for b in bodies if isinstance(b, VolumeBody)]
-        out["points"] = int(len(vols[0].points))
+        out["points"] = len(vols[0].points)
         out["tetrahedra"] = int(sum(len(b.tets) for b in vols))
     else:
         out["points"] = int(sum(len(b.masses) for b in bodies if isinstance(b, PointBody)))
@@ -306,7 +306,7 @@ class PrecessionResult:
 
     frame: PrincipalFrame
     classification: Classification
-    motion: "FreeMotion"
+    motion: FreeMotion
     relative_error_estimate: float
     elapsed_s: float
     warnings: tuple[str, ...] = field(default=())

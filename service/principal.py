@@ -108,7 +108,7 @@ class PrincipalFrame:
         values: NDArray[np.float64],
         vectors: NDArray[np.float64],
         tolerance: float = DEFAULT_TOLERANCES.moment_rel,
-    ) -> "PrincipalFrame":
+    ) -> PrincipalFrame:
         """Sort eigenpairs ascending, orient the axes, derive the quaternion."""
         order = np.argsort(values, kind="stable")
         moments = np.asarray(values, dtype=np.float64)[order]
@@ -119,7 +119,7 @@ class PrincipalFrame:
     @classmethod
     def from_tensor(
         cls, tensor: NDArray[np.float64], tolerance: float = DEFAULT_TOLERANCES.moment_rel
-    ) -> "PrincipalFrame":
+    ) -> PrincipalFrame:
         """Principal frame of an inertia tensor about the centre of mass."""
         matrix = np.asarray(tensor, dtype=np.float64)
         if matrix.shape != (3, 3) or not np.all(np.isfinite(matrix)):
@@ -168,6 +168,6 @@ def equal_moment_pairs(moments: NDArray[np.float64], tolerance: float) -> tuple[
     return ()
 
 
-def principal_frame(props: "MassProperties", tolerance: float = DEFAULT_TOLERANCES.moment_rel) -> PrincipalFrame:
+def principal_frame(props: MassProperties, tolerance: float = DEFAULT_TOLERANCES.moment_rel) -> PrincipalFrame:
     """Principal frame of the mass properties (moments refined in the body frame)."""
     return PrincipalFrame.from_eigen(props.principal_moments, props.principal_axes, tolerance)

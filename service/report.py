@@ -19,7 +19,7 @@ def _list(arr: Any) -> Any:
     return np.asarray(arr, dtype=np.float64).tolist()
 
 
-def principal_dict(frame: "PrincipalFrame") -> dict[str, Any]:
+def principal_dict(frame: PrincipalFrame) -> dict[str, Any]:
     return {
         "moments": _list(frame.moments),
         "axes": _list(frame.axes),
@@ -28,7 +28,7 @@ def principal_dict(frame: "PrincipalFrame") -> dict[str, Any]:
     }
 
 
-def classification_dict(cls: "Classification") -> dict[str, Any]:
+def classification_dict(cls: Classification) -> dict[str, Any]:
     out: dict[str, Any] = {"kind": cls.kind}
     if cls.shape is not None:
         out["shape"] = cls.shape
@@ -41,7 +41,7 @@ def classification_dict(cls: "Classification") -> dict[str, Any]:
     return out
 
 
-def _body_dict(p: "MassProperties") -> dict[str, Any]:
+def _body_dict(p: MassProperties) -> dict[str, Any]:
     """mass, volume, density (solids only, API.md), area (shells), centre of mass, tensor."""
     out: dict[str, Any] = {"mass": p.mass}
     if p.volume is not None:
@@ -55,7 +55,7 @@ def _body_dict(p: "MassProperties") -> dict[str, Any]:
     return out
 
 
-def _part_dict(part: "PartResult") -> dict[str, Any]:
+def _part_dict(part: PartResult) -> dict[str, Any]:
     p = part.props
     out: dict[str, Any] = {"name": part.name, **_body_dict(p)}
     out["inertia_tensor"] = _list(p.inertia.matrix)
@@ -66,7 +66,7 @@ def _part_dict(part: "PartResult") -> dict[str, Any]:
     return out
 
 
-def analysis_dict(result: "AnalysisResult") -> dict[str, Any]:
+def analysis_dict(result: AnalysisResult) -> dict[str, Any]:
     """The analysis result of the contract (API.md, "The analysis result")."""
     p = result.props
     out: dict[str, Any] = {"source": dict(result.source), **_body_dict(p)}
@@ -86,7 +86,7 @@ def analysis_dict(result: "AnalysisResult") -> dict[str, Any]:
     return out
 
 
-def precession_dict(result: "PrecessionResult") -> dict[str, Any]:
+def precession_dict(result: PrecessionResult) -> dict[str, Any]:
     """The response of POST /v1/precession."""
     out = {
         "principal": principal_dict(result.frame),

@@ -17,6 +17,7 @@ scipy import.
 
 from __future__ import annotations
 
+import itertools
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -251,7 +252,7 @@ def _edge_order(key: NDArray[np.uint64], key_bits: int) -> tuple[NDArray[np.int6
     del bucket
     order = np.empty(m, dtype=np.int64)
     starts = []
-    for b0, b1 in zip(bounds[:-1], bounds[1:]):
+    for b0, b1 in itertools.pairwise(bounds):
         if b1 == b0:
             continue
         sub = by_bucket[b0:b1]

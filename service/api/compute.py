@@ -28,8 +28,8 @@ import sys
 import threading
 import traceback
 from collections.abc import Iterator
-from contextlib import contextmanager
 from concurrent.futures import ThreadPoolExecutor
+from contextlib import contextmanager
 from multiprocessing.connection import Connection
 from typing import Any
 
@@ -67,11 +67,11 @@ def _serve_jobs(conn: Connection) -> None:
             outcome: tuple[str, Any] = ("ok", run_job(job))
         except ServiceError as exc:
             outcome = ("error", exc)
-        except BaseException:  # noqa: BLE001 - reported to the parent, which logs it
+        except BaseException:
             outcome = ("crash", traceback.format_exc())
         try:
             conn.send(outcome)
-        except Exception:  # noqa: BLE001 - e.g. an unpicklable error: report it as a crash
+        except Exception:
             conn.send(("crash", traceback.format_exc()))
 
 

@@ -43,7 +43,7 @@ async def _one(pool: ComputePool, item: Item, options: AnalysisOptions) -> bytes
         return _line(await pool.run(MeshJob(item.data, item.filename, options)))
     except ServiceError as exc:
         return _error_line(item.filename, exc)
-    except Exception as exc:  # noqa: BLE001 - one file never fails the batch
+    except Exception as exc:
         log.error("unexpected error on batch file %r", item.filename, exc_info=exc)
         return _line({"source": {"filename": item.filename}, "error": {
             "code": "internal_error", "message": "the server failed on this file; the error was logged",

@@ -210,7 +210,7 @@ def _rows(future: Any, group: list[Source], resubmit: Callable[[list[Source]], N
     try:
         rows: list[dict[str, Any]] = future.result()
         return rows
-    except Exception as exc:  # noqa: BLE001  KilledWorker, lost connection: rarely the file's fault
+    except Exception as exc:
         if len(group) > 1:
             for src in group:
                 resubmit([src])

@@ -37,7 +37,7 @@ def analyze_source(source: Source, options: AnalysisOptions, zips: ZipCache | No
         return analyze(data, filename=source.name, options=options).as_dict()
     except ServiceError as exc:
         return _json_safe(error_row(source.name, exc))
-    except Exception as exc:  # noqa: BLE001  one file never stops the run; its row says what happened
+    except Exception as exc:
         err = InternalError(f"unexpected {type(exc).__name__} while analysing this file: {exc}; please report it")
         return error_row(source.name, err)
 

@@ -57,7 +57,7 @@ def load_body(
 def _load_path(path: str, filename: str, format: str | None, units: str | None) -> Loaded:
     """A file on disk; a binary STL is read in blocks, never held whole beside its vertices."""
     try:
-        fh = open(path, "rb")
+        fh = open(path, "rb")  # noqa: SIM115  (closed by the with below; only opening errors are caught here)
     except OSError as exc:
         raise UnreadableFileError(f"cannot open {path!r}: {exc.strerror}") from exc
     with fh:

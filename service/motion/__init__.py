@@ -47,8 +47,8 @@ References: Landau & Lifshitz, Mechanics §§33-37; Celledoni, Fasso, Safstrom
 from __future__ import annotations
 
 import time
+from collections.abc import Mapping
 from dataclasses import dataclass, replace
-from typing import Mapping
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -336,7 +336,7 @@ def _asymmetric_quantities(base: FreeMotion, top: AsymmetricTop) -> FreeMotion:
             "Omega starts on the separatrix (2 E I2 = |M|^2 within rounding): the motion approaches "
             "rotation about the intermediate axis forever, so it has no period"
         )
-        return replace(base, warnings=base.warnings + (warning,))
+        return replace(base, warnings=(*base.warnings, warning))
     period = top.period
     flip = 0.5 * period if base.stable is False else None
     return replace(base, period=period, flip_interval=flip)

@@ -28,8 +28,8 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from . import quaternions as quat
 from ..errors import MotionError
+from . import quaternions as quat
 from .invariants import RigidProblem
 
 __all__ = ["integrate_scipy", "integrate_splitting", "SPLITTING_ORDER", "max_body_rate"]

@@ -108,7 +108,7 @@ class AsymmetricTop:
     b: float  # phi_dot = |M|/I_a + c / (1 + b sn^2)
 
     @classmethod
-    def from_initial(cls, moments: Array, omega_body: Array, separatrix_rel: float) -> "AsymmetricTop":
+    def from_initial(cls, moments: Array, omega_body: Array, separatrix_rel: float) -> AsymmetricTop:
         I1, I2, I3 = (float(x) for x in moments)
         W1, W3 = float(omega_body[0]), float(omega_body[2])
         g21, g32, g31 = I2 - I1, I3 - I2, I3 - I1

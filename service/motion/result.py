@@ -148,7 +148,7 @@ class FreeMotion:
         object.__setattr__(self, "angular_momentum", _frozen(self.angular_momentum, (3,)))
         object.__setattr__(self, "omega_body", _frozen(self.omega_body, (3,)))
         numbers = [self.angular_momentum_magnitude, self.kinetic_energy]
-        numbers += [getattr(self, k) for k in _OPTIONAL_SCALARS + ("flip_interval",)]
+        numbers += [getattr(self, k) for k in (*_OPTIONAL_SCALARS, "flip_interval")]
         finite = all(np.isfinite(x) for x in numbers if x is not None)
         if not finite or not np.all(np.isfinite(self.angular_momentum)):
             raise ValueError("FreeMotion holds a non-finite number")  # a bug, never an input error
