@@ -25,6 +25,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from .arrays import freeze_fields
 from .body import Body, PointBody, VolumeBody
 from .ddouble import rotated
 from .errors import InvalidParameterError, ZeroVolumeError
@@ -59,10 +60,7 @@ class InertiaTensor:
     frame: str = "input"
 
     def __post_init__(self) -> None:
-        for name in ("matrix", "point"):
-            arr = np.array(getattr(self, name), dtype=np.float64)
-            arr.flags.writeable = False
-            object.__setattr__(self, name, arr)
+        freeze_fields(self, {"matrix": (3, 3), "point": (3,)})
 
 
 @dataclass(frozen=True, slots=True)

@@ -17,6 +17,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numpy.typing import NDArray
 
+from .arrays import freeze_fields
 from .conventions import orient_axes, quaternion_from_matrix
 from .errors import InvalidParameterError
 from .tolerances import DEFAULT_TOLERANCES, Tolerances
@@ -95,12 +96,7 @@ class PrincipalFrame:
     tolerance: float
 
     def __post_init__(self) -> None:
-        for name, shape in (("moments", (3,)), ("axes", (3, 3)), ("quaternion", (4,))):
-            arr = np.array(getattr(self, name), dtype=np.float64)
-            if arr.shape != shape:
-                raise ValueError(f"{name} must have shape {shape}, got {arr.shape}")
-            arr.flags.writeable = False
-            object.__setattr__(self, name, arr)
+        freeze_fields(self, {"moments": (3,), "axes": (3, 3), "quaternion": (4,)})
 
     @classmethod
     def from_eigen(

@@ -18,6 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from ..arrays import freeze_fields
 from . import quaternions as quat
 
 __all__ = ["RigidProblem", "kinetic_energy", "invariant_drifts"]
@@ -41,12 +42,7 @@ class RigidProblem:
     to_input: Array
 
     def __post_init__(self) -> None:
-        for name, shape in (("moments", (3,)), ("omega_body", (3,)), ("axes", (3, 3)), ("to_input", (4,))):
-            arr = np.array(getattr(self, name), dtype=np.float64)
-            if arr.shape != shape:
-                raise ValueError(f"{name} must have shape {shape}, got {arr.shape}")
-            arr.flags.writeable = False
-            object.__setattr__(self, name, arr)
+        freeze_fields(self, {"moments": (3,), "omega_body": (3,), "axes": (3, 3), "to_input": (4,)})
 
     @property
     def momentum_body(self) -> Array:

@@ -14,6 +14,8 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from ..arrays import frozen_array
+
 __all__ = ["Regime", "MotionMethod", "Trajectory", "MotionDiagnostics", "FreeMotion"]
 
 Array = NDArray[np.float64]
@@ -39,14 +41,6 @@ class MotionMethod(enum.Enum):
     SPLITTING = "splitting"
 
 
-def _frozen(value: Any, shape: tuple[int, ...] | None = None) -> Array:
-    arr = np.array(value, dtype=np.float64)
-    if shape is not None and arr.shape[-len(shape):] != shape:
-        raise ValueError(f"expected trailing shape {shape}, got {arr.shape}")
-    arr.flags.writeable = False
-    return arr
-
-
 @dataclass(frozen=True, slots=True)
 class Trajectory:
     """Sampled motion.
@@ -65,9 +59,9 @@ class Trajectory:
     quaternion: Array
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "t", _frozen(self.t))
+        object.__setattr__(self, "t", frozen_array(self.t))
         for name, shape in (("omega_body", (3,)), ("omega", (3,)), ("quaternion", (4,))):
-            arr = _frozen(getattr(self, name), shape)
+            arr = frozen_array(getattr(self, name), shape)
             if arr.shape[0] != self.t.shape[0]:
                 raise ValueError(f"{name} has {arr.shape[0]} rows for {self.t.shape[0]} times")
             object.__setattr__(self, name, arr)
@@ -145,8 +139,8 @@ class FreeMotion:
     warnings: tuple[str, ...] = ()
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "angular_momentum", _frozen(self.angular_momentum, (3,)))
-        object.__setattr__(self, "omega_body", _frozen(self.omega_body, (3,)))
+        object.__setattr__(self, "angular_momentum", frozen_array(self.angular_momentum, (3,)))
+        object.__setattr__(self, "omega_body", frozen_array(self.omega_body, (3,)))
         numbers = [self.angular_momentum_magnitude, self.kinetic_energy]
         numbers += [getattr(self, k) for k in (*_OPTIONAL_SCALARS, "flip_interval")]
         finite = all(np.isfinite(x) for x in numbers if x is not None)
