@@ -19,12 +19,15 @@ import numpy as np
 from numpy.typing import NDArray
 
 __all__ = [
+    "DEFAULT_DENSITY",
     "LENGTH_UNITS",
     "length_scale",
     "orient_axes",
     "quaternion_from_matrix",
     "matrix_from_quaternion",
 ]
+
+DEFAULT_DENSITY = 1000.0  # kg/m^3 (water), the API's default when neither density nor mass is given
 
 LENGTH_UNITS: dict[str, float] = {
     "m": 1.0,

@@ -27,6 +27,7 @@ from numpy.typing import NDArray
 
 from .arrays import freeze_fields
 from .body import Body, PointBody, VolumeBody
+from .conventions import DEFAULT_DENSITY
 from .ddouble import rotated
 from .errors import InvalidParameterError, ZeroVolumeError
 from .integrals import Sums, local_origin, point_sums, simplex_sums
@@ -283,7 +284,7 @@ def mass_properties(
         area = s.m0 * L**2
         assert thickness is not None
         shell_volume = area * thickness * L
-        rho = density if density is not None else (1000.0 if mass is None else mass / shell_volume)
+        rho = density if density is not None else (DEFAULT_DENSITY if mass is None else mass / shell_volume)
         measure_to_mass = rho * thickness * L
         length_power = 4
         volume, uniform_density = None, rho
@@ -296,7 +297,7 @@ def mass_properties(
             measure_to_mass = 1.0 if mass is None else mass / (s.m0 * L**3)
             uniform_density = None
         else:
-            rho = density if density is not None else (1000.0 if mass is None else mass / volume)
+            rho = density if density is not None else (DEFAULT_DENSITY if mass is None else mass / volume)
             measure_to_mass = rho
             uniform_density = rho
         length_power = 5
@@ -386,7 +387,7 @@ def _element_weights(geometry: _Geometry, density: float | None, model: str, thi
     n = len(geometry.points) if geometry.kind == "points" else len(geometry.cells)
     if geometry.weight is not None:  # cell densities or point masses
         return np.asarray(geometry.weight, dtype=np.float64)
-    rho = 1000.0 if density is None else density
+    rho = DEFAULT_DENSITY if density is None else density
     if model == Model.SHELL:
         assert thickness is not None
         rho = rho * thickness * L

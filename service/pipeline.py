@@ -194,10 +194,15 @@ def analyze_loaded(loaded: Loaded, options: AnalysisOptions, start: float | None
     )
 
 
-def _part(name: str, body: Any, options: AnalysisOptions, single: bool) -> PartResult:
-    density = options.density
+def _part_density(name: str, options: AnalysisOptions) -> float | None:
+    """A part's density [kg/m^3]: its own from ``densities``, else the common one (None: the default)."""
     if options.densities and name in options.densities:
-        density = float(options.densities[name])
+        return float(options.densities[name])
+    return options.density
+
+
+def _part(name: str, body: Any, options: AnalysisOptions, single: bool) -> PartResult:
+    density = _part_density(name, options)
     # several parts: a total mass is shared out after all parts are integrated
     mass = options.mass if single else None
     props = mass_properties(body, density=None if mass is not None else density, mass=mass,
@@ -223,11 +228,7 @@ def _scaled(part: PartResult, factor: float) -> PartResult:
 def _combined(loaded: Loaded, parts: Sequence[PartResult], options: AnalysisOptions,
               factor: float) -> MassProperties:
     """The whole assembly, integrated as one body with each part's material."""
-    pairs = []
-    for part in loaded.parts:
-        own = options.densities.get(part.name) if options.densities else None
-        uniform = own if own is not None else (options.density if options.density is not None else 1000.0)
-        pairs.append((part.body, uniform))
+    pairs = [(part.body, _part_density(part.name, options)) for part in loaded.parts]
     whole = assembly_properties(pairs, model=options.model, thickness=options.thickness, factor=factor)
     volumes = [p.props.volume for p in parts]
     densities = {p.props.density for p in parts}
