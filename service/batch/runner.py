@@ -27,6 +27,7 @@ from typing import Any
 
 from ..errors import InvalidParameterError
 from ..pipeline import AnalysisOptions
+from .extras import require
 from .rows import error_row
 from .sinks import done_names, open_sink, output_format
 from .sources import Source, list_sources
@@ -75,13 +76,7 @@ class BatchSummary:
 
 
 def _distributed() -> Any:
-    try:
-        import distributed
-    except ImportError as exc:
-        raise InvalidParameterError(
-            "batch runs need Dask: pip install 'inertia-service[batch]'", parameter="workers"
-        ) from exc
-    return distributed
+    return require("distributed", purpose="a batch run", extra="batch", parameter="workers")
 
 
 def local_cluster(workers: int | None = None) -> Any:

@@ -22,6 +22,7 @@ from collections.abc import Iterator
 from typing import IO, Any, Protocol
 
 from ..errors import InvalidParameterError
+from .extras import require
 from .rows import COLUMNS, FLOAT_COLUMNS, flat_row, row_name
 
 __all__ = ["OUTPUT_FORMATS", "Sink", "done_names", "open_sink"]
@@ -53,14 +54,7 @@ def output_format(path: str) -> str:
 
 
 def _pyarrow() -> Any:
-    try:
-        import pyarrow  # type: ignore[import-untyped,unused-ignore]
-        import pyarrow.parquet  # type: ignore[import-untyped,unused-ignore]
-    except ImportError as exc:
-        raise InvalidParameterError(
-            "Parquet output needs pyarrow: pip install 'inertia-service[parquet]'", parameter="out"
-        ) from exc
-    return pyarrow
+    return require("pyarrow.parquet", purpose="Parquet output", extra="parquet", parameter="out")
 
 
 # ---------------------------------------------------------------------------

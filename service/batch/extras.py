@@ -1,0 +1,25 @@
+"""The optional dependencies of batch runs, imported only when a run needs them."""
+
+from __future__ import annotations
+
+import importlib
+import sys
+from types import ModuleType
+
+from ..errors import InvalidParameterError
+
+__all__ = ["require"]
+
+
+def require(module: str, *, purpose: str, extra: str, parameter: str) -> ModuleType:
+    """Import ``module`` (e.g. "pyarrow.parquet") and return its top-level package,
+    or say which extra to install."""
+    top = module.split(".")[0]
+    try:
+        importlib.import_module(top)  # the package first: a blocked or missing package fails here
+        importlib.import_module(module)
+    except ImportError as exc:
+        raise InvalidParameterError(
+            f"{purpose} needs {top}: pip install 'inertia-service[{extra}]'", parameter=parameter
+        ) from exc
+    return sys.modules[top]
