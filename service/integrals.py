@@ -48,14 +48,15 @@ class Sums:
     abs_m2: NDArray[np.float64]
     noise: float
     element_err: NDArray[np.float64]
+    measure: float  # int dV (or dA, or the count of points) without the weights
     terms: int
     blocks: int
 
 
 _IJ = ((0, 0), (1, 1), (2, 2), (0, 1), (0, 2), (1, 2))
 # rows of a block's sums: m0, m1 (x y z), m2 (xx yy zz xy xz yz), det noise, error scale of xx yy zz
-ROWS = 14
-_NOISE, _ERR = 10, 11
+ROWS = 15
+_NOISE, _ERR, _MEASURE = 10, 11, 14
 # a simplex's measure dm, and the factors of its first and second moments (int x = f1 S, ...)
 _FACTORS = {"apex": (1 / 6, 1 / 4, 1 / 20), "tet": (1 / 6, 1 / 4, 1 / 20), "tri": (1 / 2, 1 / 3, 1 / 12)}
 
@@ -132,6 +133,7 @@ def _block_sums(xyz: Vec, cells: NDArray[np.int64], kind: str,
         if i == j:
             total[_ERR + i] = total_abs[_ERR + i] = (err_factor * acc).sum()
     total[_NOISE] = total_abs[_NOISE] = noise.sum()
+    total[_MEASURE] = total_abs[_MEASURE] = (raw * f0).sum()
     return total, total_abs
 
 
@@ -160,7 +162,7 @@ def _sums_from_rows(total: NDArray[np.float64], total_abs: NDArray[np.float64], 
         m2[i, j] = m2[j, i] = total[row]
         a2[i, j] = a2[j, i] = total_abs[row]
     return Sums(float(total[0]), total[1:4].copy(), m2, float(total_abs[0]), a2, float(total[_NOISE]),
-                total[_ERR:_ERR + 3].copy(), n, blocks)
+                total[_ERR:_ERR + 3].copy(), float(total[_MEASURE]), n, blocks)
 
 
 def point_sums(masses: NDArray[np.float64], x: NDArray[np.float64]) -> Sums:
@@ -169,7 +171,7 @@ def point_sums(masses: NDArray[np.float64], x: NDArray[np.float64]) -> Sums:
     for i, j in _IJ:
         m2[i, j] = m2[j, i] = float((masses * x[:, i] * x[:, j]).sum())
     diag_scale = np.array([float((masses * x[:, i] ** 2).sum()) for i in range(3)])
-    return Sums(float(masses.sum()), m1, m2, float(masses.sum()), np.abs(m2), 0.0, diag_scale, len(masses), 1)
+    return Sums(float(masses.sum()), m1, m2, float(masses.sum()), np.abs(m2), 0.0, diag_scale, float(len(masses)), len(masses), 1)
 
 
 def local_origin(points: NDArray[np.float64]) -> NDArray[np.float64]:

@@ -293,7 +293,7 @@ def mass_properties(
         volume = s.m0 * L**3
         weighted = isinstance(body, VolumeBody) and body.cell_density is not None
         if weighted:
-            volume = _unweighted_volume(geometry) * L**3
+            volume = s.measure * L**3
             measure_to_mass = 1.0 if mass is None else mass / (s.m0 * L**3)
             uniform_density = None
         else:
@@ -402,11 +402,6 @@ def _check_finite_results(mass: float, com: NDArray[np.float64], tensor: NDArray
             "express the input in other units"
         )
 
-
-def _unweighted_volume(geometry: _Geometry) -> float:
-    return _Geometry(geometry.points, geometry.cells, geometry.kind, None).sums(
-        local_origin(geometry.points), None
-    ).m0
 
 
 def _check_material(body: Body, density: float | None, mass: float | None, model: str, thickness: float | None) -> None:

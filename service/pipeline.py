@@ -35,7 +35,6 @@ __all__ = ["AnalysisOptions", "AnalysisResult", "PartResult", "analyze", "analyz
            "analyze_loaded", "PrecessionResult", "precession"]
 
 METHODS = ("exact", "dop853", "rk45", "splitting")
-MAX_MOMENTUM = 1e150  # bound on I3 |omega| (and I3 |omega|^2): their squares and products stay finite
 
 
 def _vector(name: str, value: Sequence[float] | None) -> tuple[float, float, float] | None:
@@ -244,19 +243,8 @@ def _combined(loaded: Loaded, parts: Sequence[PartResult], options: AnalysisOpti
 def _motion(frame: PrincipalFrame, cls: Classification, options: AnalysisOptions) -> FreeMotion:
     from .motion import predict_motion
 
-    omega = np.asarray(options.omega, dtype=np.float64)
-    if not frame.moments[-1] > 0:
-        raise InvalidParameterError("the body has no rotational inertia (all its mass is at one point), "
-                                    "so its free rotation is undefined; leave out omega", parameter="omega")
-    # |M| <= I3 |omega| and 2E <= I3 |omega|^2; the motion squares and multiplies these, so keep
-    # |M| well inside float64 (MAX_MOMENTUM^2 = 1e300) or say why we cannot compute
-    momentum_bound = float(frame.moments[-1]) * math.sqrt(float(omega @ omega))
-    if not (momentum_bound <= MAX_MOMENTUM and float(frame.moments[-1]) * float(omega @ omega) <= MAX_MOMENTUM):
-        raise InvalidParameterError("omega and the moments of inertia are so large that the angular momentum "
-                                    "or energy would overflow float64; rescale them (other units)",
-                                    parameter="omega")
     return predict_motion(
-        frame, cls, omega, duration=options.duration, samples=options.samples,
+        frame, cls, np.asarray(options.omega, dtype=np.float64), duration=options.duration, samples=options.samples,
         method=options.method,
     )
 

@@ -75,6 +75,7 @@ __all__ = [
     "MAX_SAMPLES",
 ]
 
+MAX_MOMENTUM = 1e150  # bound on I3 |omega| and I3 |omega|^2: their squares (1e300) stay finite
 MAX_SAMPLES = 1_000_000
 """Largest ``samples``: 1e6 samples are ~100 MB of JSON, beyond any client's use."""
 
@@ -130,6 +131,7 @@ def predict_motion(
     started = time.perf_counter()
     chosen = _parse_method(method)
     omega = _parse_omega(angular_velocity)
+    _check_scale(frame, omega)
     times = _parse_times(duration, samples)
     if classification.rotor not in CAPABILITIES[chosen]:
         raise MotionError(
@@ -172,6 +174,20 @@ def _parse_omega(angular_velocity: ArrayLike) -> Array:
     if not np.all(np.isfinite(omega)):
         raise InvalidParameterError("omega must be finite (no NaN or infinity)", parameter="omega")
     return omega
+
+
+def _check_scale(frame: PrincipalFrame, omega: Array) -> None:
+    """The body must have inertia, and |M| and E must stay well inside float64."""
+    largest = float(frame.moments[-1])
+    if not largest > 0:
+        raise InvalidParameterError("the body has no rotational inertia (all its mass is at one point), "
+                                    "so its free rotation is undefined; leave out omega", parameter="omega")
+    # |M| <= I3 |omega| and 2E <= I3 |omega|^2; the motion squares and multiplies these
+    speed2 = float(omega @ omega)
+    if not (largest * np.sqrt(speed2) <= MAX_MOMENTUM and largest * speed2 <= MAX_MOMENTUM):
+        raise InvalidParameterError("omega and the moments of inertia are so large that the angular momentum "
+                                    "or energy would overflow float64; rescale them (other units)",
+                                    parameter="omega")
 
 
 def _parse_times(duration: float | None, samples: int | None) -> Array | None:
