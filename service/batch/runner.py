@@ -7,6 +7,12 @@ and on every worker stays bounded whatever the number of files.  Workers read
 their inputs themselves (paths or fsspec URLs they can reach); only rows come
 back, and each is written and flushed as soon as its task completes.
 
+A local cluster is started in a background thread while this process
+analyses the first small files itself, with the same task function the
+workers run: the half second a cluster takes to start is not lost.  Its
+workers fork from a ``forkserver`` that is started first, with Dask and the
+pipeline already imported, so they do not import them again.
+
 Scheduling, retries of tasks on workers that died, and the transport are
 Dask's.  A task whose worker keeps dying (``KilledWorker``, e.g. out of
 memory) is split into single files; a single file that still fails gets an
@@ -15,21 +21,24 @@ memory) is split into single files; a single file that still fails gets an
 
 from __future__ import annotations
 
+import contextlib
 import logging
 import math
+import multiprocessing
 import os
 import sys
 import time
 import uuid
 from collections.abc import Callable, Iterator, Sequence
+from concurrent.futures import Future, ThreadPoolExecutor
 from dataclasses import dataclass
 from typing import Any
 
 from ..errors import InvalidParameterError
 from ..pipeline import AnalysisOptions
-from .extras import require
+from .extras import ensure_installed, require
 from .rows import error_row
-from .sinks import done_names, open_sink, output_format
+from .sinks import Sink, done_names, open_sink, output_format
 from .sources import Source, list_sources
 from .tasks import InternalError, analyze_sources
 
@@ -46,6 +55,13 @@ TASKS_PER_THREAD = 8
 # Tasks in flight per worker thread: enough to hide the round trip, few enough
 # to bound memory (each holds at most TASK_BYTES of input plus its rows).
 WINDOW_PER_THREAD = 4
+# While the local cluster starts, this process analyses files up to this size
+# itself (~20,000 triangles of binary STL, ~10 ms each): it stays responsive
+# to the cluster being ready, and large files wait for the workers, whose
+# memory the nanny watches.
+HEAD_START_BYTES = 1 << 20
+# What local workers fork from: a forkserver that has imported these once.
+WORKER_PRELOAD = ["distributed", "service.batch.tasks"]
 
 
 # Dask starts workers with MALLOC_TRIM_THRESHOLD_=65536 so that freed memory
@@ -75,24 +91,20 @@ class BatchSummary:
                 f"{self.out}; {self.elapsed_s:.1f} s, {rate:.1f} files/s")
 
 
+_DASK = {"purpose": "a batch run", "extra": "batch", "parameter": "workers"}
+
+
 def _distributed() -> Any:
-    return require("distributed", purpose="a batch run", extra="batch", parameter="workers")
+    return require("distributed", **_DASK)
 
 
 def local_cluster(workers: int | None = None) -> Any:
     """The default engine: one single-threaded worker process per core (or ``workers``)."""
     distributed = _distributed()
-    n = workers if workers is not None else (os.cpu_count() or 1)
-    if n < 1:
-        raise InvalidParameterError(f"--workers must be at least 1, got {n}", parameter="workers")
-    import multiprocessing
-
+    n = _worker_count(workers)
     import dask
 
-    # Start-up is paid by every run: with a forkserver (which preloads
-    # distributed and numpy once) two workers start in ~1.5 s instead of ~2.5 s
-    # with spawn on a 2-core machine.  Spawn where there is no forkserver.
-    method = "forkserver" if "forkserver" in multiprocessing.get_all_start_methods() else "spawn"
+    method = "forkserver" if _start_forkserver() else "spawn"
     environ = {k: v for k, v in dask.config.get("distributed.nanny.pre-spawn-environ", {}).items()
                if k not in DROPPED_ENV}
     settings = {"distributed.worker.multiprocessing-method": method, "distributed.nanny.pre-spawn-environ": environ,
@@ -100,8 +112,34 @@ def local_cluster(workers: int | None = None) -> Any:
     with dask.config.set(settings):
         return distributed.LocalCluster(
             n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None, silence_logs=logging.ERROR,
-            preload=["service.batch.tasks"],  # import the pipeline at start-up, not in the first task
+            preload=["service.batch.tasks"],  # a no-op after a forkserver; spawned workers import it at start-up
         )
+
+
+def _worker_count(workers: int | None) -> int:
+    n = workers if workers is not None else (os.cpu_count() or 1)
+    if n < 1:
+        raise InvalidParameterError(f"--workers must be at least 1, got {n}", parameter="workers")
+    return n
+
+
+def _start_forkserver() -> bool:
+    """Start the forkserver local workers fork from, importing Dask and the pipeline once; False if none.
+
+    Called before this process imports Dask itself, so the server's imports
+    run beside the client's.  Each worker then starts in a fraction of a
+    second instead of importing everything again (as ``spawn`` does), which on
+    a small machine is most of a cluster's start-up.  The forkserver is one
+    per process: if one is already running (an HTTP server's compute pool, an
+    earlier cluster), workers fork from it and import what it lacks.
+    """
+    if "forkserver" not in multiprocessing.get_all_start_methods():
+        return False
+    from multiprocessing import forkserver
+
+    multiprocessing.get_context("forkserver").set_forkserver_preload(WORKER_PRELOAD)
+    forkserver.ensure_running()
+    return True
 
 
 def connect(scheduler: str | None, workers: int | None) -> tuple[Any, Any]:
@@ -132,39 +170,111 @@ def run_batch(
     """Analyse every input under ``paths`` into ``out`` (.jsonl, .csv or .parquet).
 
     Runs on ``client`` when given, else on the cluster at ``scheduler``, else
-    on a local cluster of ``workers`` processes started for this run.
+    on a local cluster of ``workers`` processes started for this run (this
+    process analyses the first small files while it starts).
     """
     start = time.perf_counter()
     if scheduler is not None and workers is not None:
         raise InvalidParameterError("give --workers (a local cluster) or --scheduler (an existing one), not both",
                                     parameter="workers")
     output_format(out)  # fail on a bad --out before any work
+    local = client is None and scheduler is None
+    if local:  # a bad --workers or a missing extra fails before any work too
+        ensure_installed("distributed", **_DASK)
+        _worker_count(workers)
+        _start_forkserver()  # its imports run while this process lists the inputs
     sources = list_sources([_absolute(p) for p in paths])
     done = done_names(out) if resume else set()
     pending = [s for s in sources if s.name not in done]
     skipped = len(sources) - len(pending)
-    if not pending:  # nothing to do: no cluster, but the output exists as for any run
-        open_sink(out, resume).close()
-        errors = 0
-    elif client is not None:
-        errors = _run(client, pending, options, out, resume, progress)
-    else:
-        client, cluster = connect(scheduler, workers)
-        try:
-            errors = _run(client, pending, options, out, resume, progress)
-        finally:
-            client.close()
-            if cluster is not None:
-                cluster.close()
-    return BatchSummary(len(pending), errors, skipped, time.perf_counter() - start, out)
+    output = _Output(open_sink(out, resume), _progress_bar(len(pending), progress and bool(pending)))
+    try:
+        if not pending:  # nothing to do: no cluster, but the output exists as for any run
+            pass
+        elif client is not None:
+            _distribute(client, pending, options, output)
+        elif scheduler is not None:
+            client, _ = connect(scheduler, None)
+            try:
+                _distribute(client, pending, options, output)
+            finally:
+                client.close()
+        else:
+            _run_local(pending, workers, options, output)
+    finally:
+        output.close()
+    return BatchSummary(len(pending), output.errors, skipped, time.perf_counter() - start, out)
 
 
 def _absolute(path: str) -> str:
     return path if "://" in path else os.path.abspath(path)
 
 
-def _run(client: Any, pending: list[Source], options: AnalysisOptions, out: str, append: bool,
-         progress: bool) -> int:
+class _Output:
+    """The sink, the progress bar and the error count of one run."""
+
+    def __init__(self, sink: Sink, bar: Any) -> None:
+        self.sink, self.bar, self.errors = sink, bar, 0
+
+    def write(self, rows: list[dict[str, Any]]) -> None:
+        for row in rows:
+            self.sink.write(row)
+            self.errors += "error" in row
+        self.sink.flush()
+        self.bar.update(len(rows))
+
+    def close(self) -> None:
+        try:
+            self.bar.close()
+        finally:
+            self.sink.close()
+
+
+def _run_local(pending: list[Source], workers: int | None, options: AnalysisOptions, output: _Output) -> None:
+    """Start a local cluster in the background, analyse small files here meanwhile, then hand over the rest.
+
+    The thread also imports Dask, so even that is not waited for.
+    """
+    with ThreadPoolExecutor(max_workers=1, thread_name_prefix="inertia-local-cluster") as pool:
+        starting = pool.submit(local_cluster, workers)
+        try:
+            rest = _head_start(pending, starting.done, options, output)
+        except BaseException:
+            _close_when_started(starting)
+            raise
+        cluster = starting.result()
+    try:
+        if rest:
+            client = _distributed().Client(cluster)
+            try:
+                _distribute(client, rest, options, output)
+            finally:
+                client.close()
+    finally:
+        cluster.close()
+
+
+def _head_start(pending: list[Source], ready: Callable[[], bool], options: AnalysisOptions,
+                output: _Output) -> list[Source]:
+    """Analyse small files here, one at a time, until ``ready()``; returns the files left for the workers."""
+    deferred: list[Source] = []
+    for i, src in enumerate(pending):
+        if ready():
+            return deferred + pending[i:]
+        if src.size is None or src.size > HEAD_START_BYTES:
+            deferred.append(src)
+            continue
+        output.write(analyze_sources([src], options))
+    return deferred
+
+
+def _close_when_started(starting: Future[Any]) -> None:
+    with contextlib.suppress(Exception):  # the error being raised matters more than a failed start
+        starting.result().close()
+
+
+def _distribute(client: Any, pending: list[Source], options: AnalysisOptions, output: _Output) -> None:
+    """Run ``pending`` on the cluster behind ``client``, a bounded window of tasks at a time."""
     distributed = _distributed()
     threads = max(1, sum(client.nthreads().values()))
     tasks = _groups(pending, threads)
@@ -177,27 +287,15 @@ def _run(client: Any, pending: list[Source], options: AnalysisOptions, out: str,
         in_flight[key] = group
         ac.add(client.submit(analyze_sources, group, options, key=key, pure=False, retries=0))
 
-    errors = 0
-    sink = open_sink(out, append)
-    bar = _progress_bar(len(pending), progress)
-    try:
-        ac = distributed.as_completed()
-        for group in _take(tasks, WINDOW_PER_THREAD * threads):
+    ac = distributed.as_completed()
+    for group in _take(tasks, WINDOW_PER_THREAD * threads):
+        submit(group, ac)
+    for future in ac:
+        group = in_flight.pop(future.key)
+        output.write(_rows(future, group, lambda g: submit(g, ac)))
+        future.release()
+        for group in _take(tasks, 1):
             submit(group, ac)
-        for future in ac:
-            group = in_flight.pop(future.key)
-            for row in _rows(future, group, lambda g: submit(g, ac)):
-                sink.write(row)
-                errors += "error" in row
-                bar.update(1)
-            sink.flush()
-            future.release()
-            for group in _take(tasks, 1):
-                submit(group, ac)
-    finally:
-        bar.close()
-        sink.close()
-    return errors
 
 
 def _rows(future: Any, group: list[Source], resubmit: Callable[[list[Source]], None]) -> list[dict[str, Any]]:

@@ -11,7 +11,7 @@ from pathlib import Path
 from typing import Any
 
 import pytest
-from batchlib import N_FILES, box, stl_bytes
+from batchlib import N_FILES, box, stl_bytes, without_timing
 
 from service.batch import runner
 from service.batch.sources import Source, iter_inputs, iter_zip_bytes, list_sources, read_source
@@ -146,3 +146,62 @@ def test_a_task_whose_worker_died_is_split_into_single_files() -> None:
     (row,) = runner._rows(_FailedFuture(), [group[0]], again.append)
     assert row["source"] == {"filename": "a.stl"} and row["error"]["code"] == "internal_error"
     assert "more memory" in row["error"]["message"]
+
+
+class _Collect:
+    def __init__(self) -> None:
+        self.rows: list[dict[str, Any]] = []
+
+    def write(self, rows: list[dict[str, Any]]) -> None:
+        self.rows.extend(rows)
+
+
+def test_head_start_analyses_small_files_until_the_cluster_is_ready(library: Library) -> None:
+    sources = list_sources([str(library[0])])
+    big = Source("big.stl", "/not/read/big.stl", None, runner.HEAD_START_BYTES + 1)
+    unsized = Source("remote.stl", "https://example.invalid/remote.stl", None, None)
+    pending = [sources[0], big, unsized, *sources[1:]]
+    answers = iter([False] * 5 + [True])
+    out = _Collect()
+    rest = runner._head_start(pending, lambda: next(answers), AnalysisOptions(), out)  # type: ignore[arg-type]
+    # five inputs looked at: three analysed here, the large and the unsized one left for the workers
+    assert [r["source"]["filename"] for r in out.rows] == [s.name for s in (sources[0], *sources[1:3])]
+    assert rest == [big, unsized, *sources[3:]]
+    expected = analyze_sources([sources[0], *sources[1:3]], AnalysisOptions())
+    assert [without_timing(r) for r in out.rows] == [without_timing(r) for r in expected]
+
+
+def test_head_start_hands_everything_over_when_no_file_is_small_enough(library: Library,
+                                                                         monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setattr(runner, "HEAD_START_BYTES", -1)
+    sources = list_sources([str(library[0])])
+    out = _Collect()
+    assert runner._head_start(sources, lambda: False, AnalysisOptions(), out) == sources  # type: ignore[arg-type]
+    assert out.rows == []
+
+
+class _FakeCluster:
+    closed = False
+
+    def close(self) -> None:
+        self.closed = True
+
+
+def test_an_interrupted_head_start_still_closes_the_cluster_it_started(library: Library,
+                                                                        monkeypatch: pytest.MonkeyPatch) -> None:
+    cluster = _FakeCluster()
+
+    def slow_start(workers: int | None) -> _FakeCluster:
+        import time
+
+        time.sleep(0.2)  # the interrupt comes while the cluster is still starting
+        return cluster
+
+    def interrupted(*args: Any) -> None:
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(runner, "local_cluster", slow_start)
+    monkeypatch.setattr(runner, "analyze_sources", interrupted)
+    with pytest.raises(KeyboardInterrupt):
+        runner._run_local(list_sources([str(library[0])]), 2, AnalysisOptions(), _Collect())  # type: ignore[arg-type]
+    assert cluster.closed

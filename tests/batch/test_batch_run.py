@@ -42,6 +42,18 @@ def local_rows(library: Library, tmp_path_factory: pytest.TempPathFactory) -> Pa
     return out
 
 
+@pytest.fixture(scope="module")
+def worker_rows(library: Library, tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """The same through the default engine with no head start: every file analysed on a worker."""
+    from service.batch import runner
+
+    out = tmp_path_factory.mktemp("workers") / "rows.jsonl"
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(runner, "HEAD_START_BYTES", -1)
+        assert batch(str(library[0]), "--out", str(out), "--workers", "2") == 0
+    return out
+
+
 def test_fifty_files_give_fifty_rows_three_of_them_errors(local_rows: Path, library: Library) -> None:
     rows = by_name(read_jsonl(local_rows))
     assert len(rows) == N_FILES
@@ -54,6 +66,14 @@ def test_every_row_equals_the_single_file_analysis(local_rows: Path, library: Li
     root = library[0]
     for name, row in by_name(read_jsonl(local_rows)).items():
         assert row == reference(root / name, name), name  # exact: floats survive JSON bit for bit
+
+
+def test_local_workers_give_the_rows_of_the_head_start(worker_rows: Path, local_rows: Path, library: Library) -> None:
+    rows = by_name(read_jsonl(worker_rows))
+    assert set(rows) == set(library[1])
+    assert rows == by_name(read_jsonl(local_rows))
+    for name, row in rows.items():
+        assert row == reference(library[0] / name, name), name
 
 
 def test_numbers_equal_analyze_of_the_path(local_rows: Path, library: Library) -> None:
