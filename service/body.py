@@ -37,6 +37,8 @@ class MeshBody:
     """A triangle surface.
 
     vertices : (n, 3) float64, file units.  faces : (m, 3) int64 indices.
+    welded : the reader already merged vertices with bit-identical coordinates
+        (as ``topology.weld`` does), so the solid path need not weld again.
     """
 
     vertices: NDArray[np.float64]
@@ -44,6 +46,7 @@ class MeshBody:
     length_scale: float = 1.0
     name: str | None = None
     warnings: tuple[str, ...] = ()
+    welded: bool = False
 
     def __post_init__(self) -> None:
         v = _frozen(self.vertices, np.float64)

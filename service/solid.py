@@ -21,7 +21,7 @@ __all__ = ["closed_surface"]
 
 def closed_surface(body: MeshBody) -> tuple[NDArray[np.float64], NDArray[np.int64], tuple[str, ...]]:
     """Weld, check closedness, repair winding; the geometry to integrate."""
-    vertices, faces = weld(body.vertices, body.faces)
+    vertices, faces = (body.vertices, body.faces) if body.welded else weld(body.vertices, body.faces)
     degenerate = (faces[:, 0] == faces[:, 1]) | (faces[:, 1] == faces[:, 2]) | (faces[:, 0] == faces[:, 2])
     if np.any(degenerate):
         faces = faces[~degenerate]  # zero-area faces contribute nothing to any integral
@@ -51,11 +51,18 @@ def closed_surface(body: MeshBody) -> tuple[NDArray[np.float64], NDArray[np.int6
 
 
 def _signed_volumes(x: NDArray[np.float64], faces: NDArray[np.int64]) -> NDArray[np.float64]:
-    """6 x the signed volume of each tetrahedron (origin, face), in blocks."""
+    """6 x the signed volume of each tetrahedron (origin, face), a . (b x c), in blocks.
+
+    Formed one coordinate column at a time (contiguous arrays), about three
+    times faster than ``np.cross`` on rows for the meshes of a part library.
+    """
+    xs = [np.ascontiguousarray(x[:, k]) for k in range(3)]
     det = np.empty(len(faces))
     for start in range(0, len(faces), CHUNK):
-        a, b, c = (x[faces[start : start + CHUNK, k]] for k in range(3))
-        det[start : start + CHUNK] = np.einsum("ij,ij->i", a, np.cross(b, c))
+        block = faces[start : start + CHUNK]
+        a, b, c = ([xk.take(block[:, j]) for xk in xs] for j in range(3))
+        det[start : start + CHUNK] = (a[0] * (b[1] * c[2] - b[2] * c[1]) + a[1] * (b[2] * c[0] - b[0] * c[2])
+                                      + a[2] * (b[0] * c[1] - b[1] * c[0]))
     return det
 
 

@@ -72,7 +72,7 @@ def _load_path(path: str, filename: str, format: str | None, units: str | None) 
         vertices, faces = read_stl_file(fh, os.fstat(fh.fileno()).st_size)
     scale = 1.0 if units is None else length_scale(units)
     name = _stem(filename)
-    parts = (Part(name, MeshBody(vertices, faces, scale, name)),)
+    parts = (Part(name, MeshBody(vertices, faces, scale, name, welded=True)),)
     return Loaded(parts, filename, "stl", "mesh", units or "m", "request" if units else "default")
 
 
@@ -88,7 +88,7 @@ def _load_bytes(data: bytes, filename: str | None, format: str | None, units: st
         from .stl import read_stl
 
         vertices, faces = read_stl(data)
-        parts = [Part(_stem(filename), MeshBody(vertices, faces, scale, _stem(filename)))]
+        parts = [Part(_stem(filename), MeshBody(vertices, faces, scale, _stem(filename), welded=True))]
         kind = "mesh"
     elif fmt in POINT_FORMATS:
         from .points import read_points_file
@@ -128,7 +128,7 @@ def load_points(records: list[dict[str, object]], units: str | None = None) -> L
 def _rescaled(part: Part, scale: float) -> Part:
     body = part.body
     if isinstance(body, MeshBody):
-        new: Body = MeshBody(body.vertices, body.faces, scale, body.name, body.warnings)
+        new: Body = MeshBody(body.vertices, body.faces, scale, body.name, body.warnings, body.welded)
     elif isinstance(body, VolumeBody):
         new = VolumeBody(body.points, body.tets, body.cell_density, scale, body.name, body.warnings)
     else:

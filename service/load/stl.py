@@ -8,7 +8,8 @@ orientation.  Binary vertices are welded here, on the float32 bit patterns
 which is six times less data than welding the widened float64 copies and
 keeps peak memory near the file size; the distinct vertices are numbered in
 order of first appearance and widened exactly to float64.  ASCII vertices
-are returned unwelded (3 per triangle); ``topology.weld`` merges them.
+are parsed as float64 and welded with ``topology.weld``.  Either way the
+vertices come back welded, so ``solid.closed_surface`` need not weld again.
 """
 
 from __future__ import annotations
@@ -19,7 +20,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..errors import EmptyGeometryError, UnreadableFileError
-from ..topology import row_ids
+from ..topology import row_ids, weld
 
 __all__ = ["read_stl", "read_stl_file"]
 
@@ -28,7 +29,7 @@ _RECORD = np.dtype([("normal", "<f4", (3,)), ("vertices", "<f4", (3, 3)), ("attr
 
 
 def read_stl(data: bytes | memoryview) -> tuple[NDArray[np.float64], NDArray[np.int64]]:
-    """Vertices (3n, 3) and faces (n, 3) of a binary or ASCII STL file."""
+    """Distinct vertices (k, 3), numbered by first appearance, and faces (n, 3) of a binary or ASCII STL file."""
     buf = memoryview(data)
     if len(buf) >= 84:
         count = int(np.frombuffer(buf[80:84], dtype="<u4")[0])
@@ -94,4 +95,4 @@ def _ascii(data: bytes) -> tuple[NDArray[np.float64], NDArray[np.int64]]:
         coords = tokens[idx[:, None] + np.arange(1, 4)].astype(np.float64)
     except ValueError as exc:
         raise UnreadableFileError(f"the ASCII STL file has a malformed vertex line ({exc})") from exc
-    return coords, np.arange(len(idx), dtype=np.int64).reshape(-1, 3)
+    return weld(coords, np.arange(len(idx), dtype=np.int64).reshape(-1, 3))
