@@ -62,6 +62,12 @@ WINDOW_PER_THREAD = 4
 HEAD_START_BYTES = 1 << 20
 # What local workers fork from: a forkserver that has imported these once.
 WORKER_PRELOAD = ["distributed", "service.batch.tasks"]
+# One thread per worker for the numeric libraries, as Dask's default pre-spawn
+# environment sets (``distributed.nanny.pre-spawn-environ``); a value already
+# in the environment wins, as in Dask.  The forkserver must start with them,
+# since numpy reads them when the forkserver imports it: with OpenBLAS's own
+# threads, two workers on two cores ran at about half speed.
+WORKER_THREAD_LIMITS = ("OMP_NUM_THREADS", "MKL_NUM_THREADS", "OPENBLAS_NUM_THREADS")
 
 
 # Dask starts workers with MALLOC_TRIM_THRESHOLD_=65536 so that freed memory
@@ -138,7 +144,13 @@ def _start_forkserver() -> bool:
     from multiprocessing import forkserver
 
     multiprocessing.get_context("forkserver").set_forkserver_preload(WORKER_PRELOAD)
-    forkserver.ensure_running()
+    added = [k for k in WORKER_THREAD_LIMITS if k not in os.environ]
+    os.environ.update(dict.fromkeys(added, "1"))  # the forkserver inherits this environment
+    try:
+        forkserver.ensure_running()
+    finally:
+        for k in added:
+            del os.environ[k]
     return True
 
 

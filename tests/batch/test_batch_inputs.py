@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import io
 import json
+import multiprocessing
+import os
 import subprocess
 import sys
 import zipfile
@@ -205,3 +207,24 @@ def test_an_interrupted_head_start_still_closes_the_cluster_it_started(library: 
     with pytest.raises(KeyboardInterrupt):
         runner._run_local(list_sources([str(library[0])]), 2, AnalysisOptions(), _Collect())  # type: ignore[arg-type]
     assert cluster.closed
+
+
+FORKSERVER_ENV = """
+import json, multiprocessing, os
+from service.batch import runner
+runner._start_forkserver()
+with multiprocessing.get_context("forkserver").Pool(1) as pool:
+    seen = pool.map(os.getenv, runner.WORKER_THREAD_LIMITS)
+print(json.dumps([seen, [os.getenv(k) for k in runner.WORKER_THREAD_LIMITS]]))
+"""
+
+
+@pytest.mark.skipif("forkserver" not in multiprocessing.get_all_start_methods(), reason="no forkserver")
+def test_local_workers_fork_from_a_server_with_one_thread_per_numeric_library() -> None:
+    env = {k: v for k, v in os.environ.items() if k not in runner.WORKER_THREAD_LIMITS}
+    env["OMP_NUM_THREADS"] = "3"  # a value the user set wins
+    done = subprocess.run([sys.executable, "-c", FORKSERVER_ENV], env=env, capture_output=True, text=True,
+                          check=True, timeout=60)
+    in_forkserver, in_client = json.loads(done.stdout)
+    assert in_forkserver == ["3", "1", "1"]
+    assert in_client == ["3", None, None]  # this process's environment is left as it was
