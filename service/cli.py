@@ -7,6 +7,7 @@ from ``EXIT_CODES``.
 from __future__ import annotations
 
 import argparse
+import gc
 import json
 import sys
 from collections.abc import Sequence
@@ -109,6 +110,17 @@ def _parser() -> argparse.ArgumentParser:
     s.add_argument("--workers", type=int, default=1)
     s.add_argument("--log-level", default="info")
     return parser
+
+
+def console_main() -> int:
+    """The ``inertia`` command and ``python -m service``: ``main`` in a process that ends next."""
+    code = main()
+    # Nothing is allocated after this: move every object to the permanent
+    # generation, so the interpreter's final garbage collections do not walk
+    # the objects of every imported module (Dask, tornado, numpy): ~0.15 s
+    # of a batch run's exit.
+    gc.freeze()
+    return code
 
 
 def main(argv: Sequence[str] | None = None) -> int:
