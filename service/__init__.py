@@ -6,13 +6,40 @@ The pipeline: bytes -> ``load_body`` -> ``mass_properties`` -> ``principal_frame
 
 from __future__ import annotations
 
-from .classify import Classification, RotorClass, classify
-from .errors import ServiceError
-from .load import Loaded, load_body
-from .mass import InertiaTensor, MassProperties, mass_properties
-from .pipeline import AnalysisOptions, AnalysisResult, analyze, analyze_points, precession
-from .principal import PrincipalFrame, principal_frame
-from .tolerances import Tolerances
+import importlib
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    from .classify import Classification, RotorClass, classify
+    from .errors import ServiceError
+    from .load import Loaded, load_body
+    from .mass import InertiaTensor, MassProperties, mass_properties
+    from .pipeline import AnalysisOptions, AnalysisResult, analyze, analyze_points, precession
+    from .principal import PrincipalFrame, principal_frame
+    from .tolerances import Tolerances
+
+# Names are imported on first use (PEP 562), so ``import service`` and the CLI
+# start without numpy: ``inertia batch`` starts its workers' forkserver first.
+_HOME = {
+    "Classification": "classify", "RotorClass": "classify", "classify": "classify",
+    "ServiceError": "errors",
+    "Loaded": "load", "load_body": "load",
+    "InertiaTensor": "mass", "MassProperties": "mass", "mass_properties": "mass",
+    "AnalysisOptions": "pipeline", "AnalysisResult": "pipeline", "analyze": "pipeline",
+    "analyze_points": "pipeline", "precession": "pipeline",
+    "PrincipalFrame": "principal", "principal_frame": "principal",
+    "Tolerances": "tolerances",
+}
+
+
+def __getattr__(name: str) -> Any:
+    home = _HOME.get(name)
+    if home is None:
+        raise AttributeError(f"module 'service' has no attribute {name!r}")
+    value = getattr(importlib.import_module(f".{home}", __name__), name)
+    globals()[name] = value
+    return value
+
 
 __all__ = [
     "AnalysisOptions",

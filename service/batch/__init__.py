@@ -4,7 +4,8 @@
     tasks.py    Source + AnalysisOptions -> JSON line           [runs on a worker]
     rows.py     JSON line -> flat CSV/Parquet row
     sinks.py    rows -> .jsonl / .csv / .parquet; --resume reads the names back
-    runner.py   the Dask client: groups, bounded window, progress bar
+    runner.py   the Dask client: groups, bounded window, progress bar, head start
+    workers.py  the forkserver local workers fork from (imports neither numpy nor Dask)
 
 Every row is what ``pipeline.analyze`` gives for that file with the run's
 options, so numbers equal those of ``inertia analyze``.  Dask, tqdm and pyarrow
@@ -36,6 +37,10 @@ def run_batch_cli(args: argparse.Namespace) -> int:
     Files that fail are rows of the output, not a failure of the run; a bad
     option or a missing extra raises ``InvalidParameterError`` (exit 2).
     """
+    if args.scheduler is None:  # a local cluster: its workers' imports start now, beside this process's
+        from .workers import start_forkserver
+
+        start_forkserver()
     from ..cli import options_from_args
     from .runner import run_batch as _run_batch
 

@@ -24,7 +24,6 @@ from __future__ import annotations
 import contextlib
 import logging
 import math
-import multiprocessing
 import os
 import sys
 import time
@@ -41,6 +40,7 @@ from .rows import error_row
 from .sinks import Sink, done_names, open_sink, output_format
 from .sources import Source, list_sources
 from .tasks import InternalError, analyze_sources
+from .workers import start_forkserver
 
 __all__ = ["BatchSummary", "connect", "local_cluster", "run_batch"]
 
@@ -60,14 +60,6 @@ WINDOW_PER_THREAD = 4
 # to the cluster being ready, and large files wait for the workers, whose
 # memory the nanny watches.
 HEAD_START_BYTES = 1 << 20
-# What local workers fork from: a forkserver that has imported these once.
-WORKER_PRELOAD = ["distributed", "service.batch.tasks"]
-# One thread per worker for the numeric libraries, as Dask's default pre-spawn
-# environment sets (``distributed.nanny.pre-spawn-environ``); a value already
-# in the environment wins, as in Dask.  The forkserver must start with them,
-# since numpy reads them when the forkserver imports it: with OpenBLAS's own
-# threads, two workers on two cores ran at about half speed.
-WORKER_THREAD_LIMITS = ("OMP_NUM_THREADS", "MKL_NUM_THREADS", "OPENBLAS_NUM_THREADS")
 
 
 # Dask starts workers with MALLOC_TRIM_THRESHOLD_=65536 so that freed memory
@@ -110,7 +102,7 @@ def local_cluster(workers: int | None = None) -> Any:
     n = _worker_count(workers)
     import dask
 
-    method = "forkserver" if _start_forkserver() else "spawn"
+    method = "forkserver" if start_forkserver() else "spawn"
     environ = {k: v for k, v in dask.config.get("distributed.nanny.pre-spawn-environ", {}).items()
                if k not in DROPPED_ENV}
     settings = {"distributed.worker.multiprocessing-method": method, "distributed.nanny.pre-spawn-environ": environ,
@@ -127,31 +119,6 @@ def _worker_count(workers: int | None) -> int:
     if n < 1:
         raise InvalidParameterError(f"--workers must be at least 1, got {n}", parameter="workers")
     return n
-
-
-def _start_forkserver() -> bool:
-    """Start the forkserver local workers fork from, importing Dask and the pipeline once; False if none.
-
-    Called before this process imports Dask itself, so the server's imports
-    run beside the client's.  Each worker then starts in a fraction of a
-    second instead of importing everything again (as ``spawn`` does), which on
-    a small machine is most of a cluster's start-up.  The forkserver is one
-    per process: if one is already running (an HTTP server's compute pool, an
-    earlier cluster), workers fork from it and import what it lacks.
-    """
-    if "forkserver" not in multiprocessing.get_all_start_methods():
-        return False
-    from multiprocessing import forkserver
-
-    multiprocessing.get_context("forkserver").set_forkserver_preload(WORKER_PRELOAD)
-    added = [k for k in WORKER_THREAD_LIMITS if k not in os.environ]
-    os.environ.update(dict.fromkeys(added, "1"))  # the forkserver inherits this environment
-    try:
-        forkserver.ensure_running()
-    finally:
-        for k in added:
-            del os.environ[k]
-    return True
 
 
 def connect(scheduler: str | None, workers: int | None) -> tuple[Any, Any]:
@@ -194,7 +161,7 @@ def run_batch(
     if local:  # a bad --workers or a missing extra fails before any work too
         ensure_installed("distributed", **_DASK)
         _worker_count(workers)
-        _start_forkserver()  # its imports run while this process lists the inputs
+        start_forkserver()  # its imports run while this process lists the inputs
     sources = list_sources([_absolute(p) for p in paths])
     done = done_names(out) if resume else set()
     pending = [s for s in sources if s.name not in done]

@@ -15,7 +15,7 @@ from typing import Any
 import pytest
 from batchlib import N_FILES, box, stl_bytes, without_timing
 
-from service.batch import runner
+from service.batch import runner, workers
 from service.batch.sources import Source, iter_inputs, iter_zip_bytes, list_sources, read_source
 from service.batch.tasks import analyze_source, analyze_sources
 from service.cli import main
@@ -211,17 +211,17 @@ def test_an_interrupted_head_start_still_closes_the_cluster_it_started(library: 
 
 FORKSERVER_ENV = """
 import json, multiprocessing, os
-from service.batch import runner
-runner._start_forkserver()
+from service.batch import workers
+workers.start_forkserver()
 with multiprocessing.get_context("forkserver").Pool(1) as pool:
-    seen = pool.map(os.getenv, runner.WORKER_THREAD_LIMITS)
-print(json.dumps([seen, [os.getenv(k) for k in runner.WORKER_THREAD_LIMITS]]))
+    seen = pool.map(os.getenv, workers.WORKER_THREAD_LIMITS)
+print(json.dumps([seen, [os.getenv(k) for k in workers.WORKER_THREAD_LIMITS]]))
 """
 
 
 @pytest.mark.skipif("forkserver" not in multiprocessing.get_all_start_methods(), reason="no forkserver")
 def test_local_workers_fork_from_a_server_with_one_thread_per_numeric_library() -> None:
-    env = {k: v for k, v in os.environ.items() if k not in runner.WORKER_THREAD_LIMITS}
+    env = {k: v for k, v in os.environ.items() if k not in workers.WORKER_THREAD_LIMITS}
     env["OMP_NUM_THREADS"] = "3"  # a value the user set wins
     done = subprocess.run([sys.executable, "-c", FORKSERVER_ENV], env=env, capture_output=True, text=True,
                           check=True, timeout=60)
