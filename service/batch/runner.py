@@ -60,6 +60,8 @@ WINDOW_PER_THREAD = 4
 # to the cluster being ready, and large files wait for the workers, whose
 # memory the nanny watches.
 HEAD_START_BYTES = 1 << 20
+# Python's switch interval while the cluster starts beside the head start (the default is 5 ms).
+HEAD_START_SWITCH_S = 0.0005
 
 
 # Dask starts workers with MALLOC_TRIM_THRESHOLD_=65536 so that freed memory
@@ -212,25 +214,41 @@ class _Output:
 def _run_local(pending: list[Source], workers: int | None, options: AnalysisOptions, output: _Output) -> None:
     """Start a local cluster in the background, analyse small files here meanwhile, then hand over the rest.
 
-    The thread also imports Dask, so even that is not waited for.
+    Dask is imported first (the forkserver imports it at the same time, on the
+    other core).  While the cluster thread starts the scheduler and the
+    workers, Python's switch interval is cut to ``HEAD_START_SWITCH_S``: a
+    thread waiting for the GIL otherwise gets it only every 5 ms, and the
+    cluster's many short steps would each wait behind an analysis.
     """
+    distributed = _distributed()
     with ThreadPoolExecutor(max_workers=1, thread_name_prefix="inertia-local-cluster") as pool:
         starting = pool.submit(local_cluster, workers)
         try:
-            rest = _head_start(pending, starting.done, options, output)
+            with _switch_interval(HEAD_START_SWITCH_S):
+                rest = _head_start(pending, starting.done, options, output)
         except BaseException:
             _close_when_started(starting)
             raise
         cluster = starting.result()
     try:
         if rest:
-            client = _distributed().Client(cluster)
+            client = distributed.Client(cluster)
             try:
                 _distribute(client, rest, options, output)
             finally:
                 client.close()
     finally:
         cluster.close()
+
+
+@contextlib.contextmanager
+def _switch_interval(seconds: float) -> Iterator[None]:
+    previous = sys.getswitchinterval()
+    sys.setswitchinterval(seconds)
+    try:
+        yield
+    finally:
+        sys.setswitchinterval(previous)
 
 
 def _head_start(pending: list[Source], ready: Callable[[], bool], options: AnalysisOptions,

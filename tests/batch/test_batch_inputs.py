@@ -204,9 +204,11 @@ def test_an_interrupted_head_start_still_closes_the_cluster_it_started(library: 
 
     monkeypatch.setattr(runner, "local_cluster", slow_start)
     monkeypatch.setattr(runner, "analyze_sources", interrupted)
+    before = sys.getswitchinterval()
     with pytest.raises(KeyboardInterrupt):
         runner._run_local(list_sources([str(library[0])]), 2, AnalysisOptions(), _Collect())  # type: ignore[arg-type]
     assert cluster.closed
+    assert sys.getswitchinterval() == before  # the head start's shorter interval does not outlive it
 
 
 FORKSERVER_ENV = """
