@@ -59,7 +59,8 @@ def orient_axes(axes: NDArray[np.float64]) -> NDArray[np.float64]:
         k = int(np.argmax(np.abs(out[i])))  # argmax returns the first maximum
         if out[i, k] < 0:
             out[i] = -out[i]
-    out[2] = np.cross(out[0], out[1])
+    (a0, a1, a2), (b0, b1, b2) = out[0].tolist(), out[1].tolist()
+    out[2] = (a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0)  # a x b (np.cross costs 40 us here)
     out[2] /= np.linalg.norm(out[2])
     return out + 0.0  # -0.0 becomes 0.0: the same axis prints the same way
 
