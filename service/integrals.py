@@ -102,8 +102,9 @@ def _block_sums(xyz: Vec, cells: NDArray[np.int64], kind: str,
                 weight: NDArray[np.float64] | None) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """Sums over one block of simplices of every row, and of their absolute values.
 
-    Struct of arrays: each quantity is a contiguous (n,) array, summed as soon
-    as it is formed (numpy's pairwise summation).
+    Struct of arrays: each quantity is a contiguous (n,) row of one (10, n)
+    array of terms, summed row by row (numpy's pairwise summation along each
+    contiguous row, the same as summing each row alone) in one call.
     """
     corners = [[x.take(cells[:, k]) for x in xyz] for k in range(cells.shape[1])]
     raw, cond = _measure(corners, kind)
@@ -114,25 +115,27 @@ def _block_sums(xyz: Vec, cells: NDArray[np.int64], kind: str,
         dm *= weight
         noise *= np.abs(weight)
     s = [sum(c[k] for c in corners) for k in range(3)]
-    total, total_abs = np.empty(ROWS), np.empty(ROWS)
-
-    def put(row: int, terms: NDArray[np.float64]) -> None:
-        total[row] = terms.sum()
-        total_abs[row] = np.abs(terms).sum()
-
-    put(0, dm)
+    terms = np.empty((_NOISE, len(dm)))  # rows m0, m1 (x y z), m2 (xx yy zz xy xz yz)
+    errs = np.empty((3, len(dm)))
+    terms[0] = dm
+    f1_dm = f1 * dm
     for k in range(3):
-        put(1 + k, (f1 * dm) * s[k])
+        np.multiply(f1_dm, s[k], out=terms[1 + k])
+    f2_dm = f2 * dm
     # an element's diagonal term f2 dm acc errs by ~eps (|f2 dm| + f2 noise) acc: acc >= 0 is exact to a few eps
     err_factor = f2 * (np.abs(dm) + noise)
     for row, (i, j) in enumerate(_IJ, start=4):
         acc = s[i] * s[j]
         for c in corners:
             acc += c[i] * c[j]
-        put(row, (f2 * dm) * acc)
+        np.multiply(f2_dm, acc, out=terms[row])
         if i == j:
-            total[_ERR + i] = total_abs[_ERR + i] = (err_factor * acc).sum()
+            np.multiply(err_factor, acc, out=errs[i])
+    total, total_abs = np.empty(ROWS), np.empty(ROWS)
+    total[:_NOISE] = terms.sum(axis=1)
+    total_abs[:_NOISE] = np.abs(terms, out=terms).sum(axis=1)
     total[_NOISE] = total_abs[_NOISE] = noise.sum()
+    total[_ERR:_ERR + 3] = total_abs[_ERR:_ERR + 3] = errs.sum(axis=1)
     total[_MEASURE] = total_abs[_MEASURE] = (raw * f0).sum()
     return total, total_abs
 
