@@ -13,8 +13,8 @@ in the same run:
     ``mass_properties`` and ``is_watertight``, and one that calls numpy-stl's
     ``Mesh.from_file`` + ``get_mass_properties``.  Wall time and peak RSS
     (GNU time's %M for the tool's own process, else ``os.wait4``) are the median of ``--repeat`` runs.
-(b) our stages in process (read + weld of the STL, welding check, edge
-    topology, outward orientation, each integration pass), timed by
+(b) our stages in process (read + weld of the STL, edge topology, outward
+    orientation, each integration pass), timed by
     wrapping the stage functions around one ``pipeline.analyze`` call.
 (c) accuracy: principal moments per unit density of each tool, their
     relative differences, and our own error estimate.
@@ -163,7 +163,7 @@ def stage_breakdown(path: Path) -> dict[str, float]:
         passes[0] += 1
         return f"integration pass {passes[0]}"
 
-    patches = [(stl, "read_stl_file", "read STL + float32 weld"), (solid, "weld", "weld check (float64)"),
+    patches = [(stl, "read_stl_file", "read STL + float32 weld"),
                (solid, "surface_topology", "edge topology (watertight check)"),
                (solid, "_orient_outward", "outward orientation"), (mass._Geometry, "sums", pass_name)]
     saved = [(obj, attr, getattr(obj, attr)) for obj, attr, _ in patches]
