@@ -73,6 +73,13 @@ def test_cli_mesh_job_imports_no_web_stack() -> None:
     assert not {"fastapi", "uvicorn", "scipy.integrate"} & mods
 
 
+def test_the_cli_and_the_batch_forkserver_start_without_numpy_or_dask() -> None:
+    # inertia batch starts its workers' forkserver before it imports either, so the
+    # forkserver's imports run beside the command's own
+    mods = imported_after("import service, service.cli, service.batch.workers")
+    assert not {"numpy", "dask", "distributed"} & mods
+
+
 def test_result_holds_only_requested_sections() -> None:
     from service import analyze
 
