@@ -212,21 +212,23 @@ def test_an_interrupted_head_start_still_closes_the_cluster_it_started(library: 
 
 
 FORKSERVER_ENV = """
-import json, multiprocessing, os
+import gc, json, multiprocessing, os
 from service.batch import workers
 workers.start_forkserver()
 with multiprocessing.get_context("forkserver").Pool(1) as pool:
     seen = pool.map(os.getenv, workers.WORKER_THREAD_LIMITS)
-print(json.dumps([seen, [os.getenv(k) for k in workers.WORKER_THREAD_LIMITS]]))
+    frozen = pool.apply(gc.get_freeze_count)
+print(json.dumps([seen, [os.getenv(k) for k in workers.WORKER_THREAD_LIMITS], frozen]))
 """
 
 
 @pytest.mark.skipif("forkserver" not in multiprocessing.get_all_start_methods(), reason="no forkserver")
-def test_local_workers_fork_from_a_server_with_one_thread_per_numeric_library() -> None:
+def test_local_workers_fork_from_a_frozen_server_with_one_thread_per_numeric_library() -> None:
     env = {k: v for k, v in os.environ.items() if k not in workers.WORKER_THREAD_LIMITS}
     env["OMP_NUM_THREADS"] = "3"  # a value the user set wins
     done = subprocess.run([sys.executable, "-c", FORKSERVER_ENV], env=env, capture_output=True, text=True,
                           check=True, timeout=60)
-    in_forkserver, in_client = json.loads(done.stdout)
+    in_forkserver, in_client, frozen = json.loads(done.stdout)
     assert in_forkserver == ["3", "1", "1"]
     assert in_client == ["3", None, None]  # this process's environment is left as it was
+    assert frozen > 10_000  # Dask's and the pipeline's objects, frozen before the fork
