@@ -59,6 +59,7 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 DOC = ROOT / "docs" / "batch.md"
 SAMPLE_EVERY_S = 0.1  # worker memory sampling period: ~10 samples even for a 1 s run
+MEMORY_PASSES = 3  # the instrumented run analyses the data set this many times on the same workers
 TARGET = 1.8  # the target: files/s of the batch over the serial trimesh loop's, on small files
 ROUNDS = 6
 
@@ -265,6 +266,7 @@ class MemoryLog:
 
     samples: list[tuple[float, dict[str, int]]] = field(default_factory=list)
     peaks: dict[str, int] = field(default_factory=dict)
+    passes: list[tuple[float, float]] = field(default_factory=list)  # (start, end) of each pass over the files
 
 
 def _sample(address: str, log: MemoryLog, stop: threading.Event, t0: float) -> None:
@@ -294,6 +296,13 @@ def _child(folder: str, out: str, workers: int) -> None:
         run_s, client_cpu = time.perf_counter() - t1, time.process_time() - cpu1
         assert summary.errors == 0, f"{summary.errors} files failed"
         worker_cpu = sum(client.run(_cpu_s).values()) - sum(workers_cpu.values())
+        passes = [(t1 - t0, t1 - t0 + run_s)]
+        for k in range(1, MEMORY_PASSES):  # the same files again on the same workers: does memory grow?
+            again = f"{out}.pass{k}.jsonl"
+            start = time.perf_counter()
+            run_batch([folder], again, client=client, progress=False)
+            passes.append((start - t0, time.perf_counter() - t0))
+            os.remove(again)
         log.peaks = client.run(_peak_rss)
     finally:
         stop.set()
@@ -301,7 +310,7 @@ def _child(folder: str, out: str, workers: int) -> None:
         client.close()
         cluster.close()
     print(json.dumps({"run_s": run_s, "samples": log.samples, "peaks": log.peaks, "worker_cpu_s": worker_cpu,
-                      "client_cpu_s": client_cpu}))
+                      "client_cpu_s": client_cpu, "passes": passes}))
 
 
 @dataclass
@@ -331,7 +340,7 @@ def instrumented_run(folder: Path, out: Path, workers: int, files: list[Path]) -
         raise RuntimeError(f"instrumented batch failed:\n{done.stderr}")
     check_rows(out, files)
     doc = json.loads(done.stdout.strip().splitlines()[-1])
-    log = MemoryLog([(t, dict(s)) for t, s in doc["samples"]], dict(doc["peaks"]))
+    log = MemoryLog([(t, dict(s)) for t, s in doc["samples"]], dict(doc["peaks"]), [tuple(p) for p in doc["passes"]])
     return Instrumented(wall, doc["run_s"], log, doc["worker_cpu_s"], doc["client_cpu_s"])
 
 
@@ -368,23 +377,23 @@ def _ratio(x: float) -> str:
 
 
 def memory_table(rows: list[Row]) -> list[str]:
-    lines = [("| data set | worker | RSS, first sample (MiB) | RSS max, first half (MiB) | RSS max, last quarter (MiB) "
-              "| median (MiB) | peak RSS, ru_maxrss (MiB) | samples | grows |"),
-             "|---|---|---:|---:|---:|---:|---:|---:|---|"]
+    lines = [(f"| data set | worker | RSS, first sample (MiB) | RSS max, pass 1 (MiB) | RSS max, pass {MEMORY_PASSES} (MiB) "
+              f"| change, pass 1 to {MEMORY_PASSES} (MiB) | median (MiB) | peak RSS, ru_maxrss (MiB) | samples |"),
+             "|---|---|---:|---:|---:|---:|---:|---:|---:|"]
     for row in rows:
         log = row.instrumented.memory
-        if not log.samples:
+        if not log.samples or not log.passes:
             continue
-        t_end = log.samples[-1][0]
+        (a0, a1), (b0, b1) = log.passes[0], log.passes[-1]
         workers = sorted({w for _, s in log.samples for w in s})
         for k, worker in enumerate(workers):
             series = [(t, s[worker]) for t, s in log.samples if worker in s]
-            half = [r for t, r in series if t <= t_end / 2] or [series[0][1]]
-            last = [r for t, r in series if t >= 3 * t_end / 4] or [series[-1][1]]
-            grows = "yes" if max(last) > max(half) else "no"
-            lines.append(f"| {row.dataset} | {k + 1} | {_mb(series[0][1])} | {_mb(max(half))} | {_mb(max(last))} | "
-                         f"{_mb(statistics.median(r for _, r in series))} | {_mb(log.peaks.get(worker, 0))} | "
-                         f"{len(series)} | {grows} |")
+            first = [r for t, r in series if a0 <= t <= a1] or [series[0][1]]
+            last = [r for t, r in series if b0 <= t <= b1] or [series[-1][1]]
+            change = (max(last) - max(first)) / 2**20
+            lines.append(f"| {row.dataset} | {k + 1} | {_mb(series[0][1])} | {_mb(max(first))} | {_mb(max(last))} | "
+                         f"{change:+.1f} | {_mb(statistics.median(r for _, r in series))} | "
+                         f"{_mb(log.peaks.get(worker, 0))} | {len(series)} |")
     return lines
 
 
@@ -532,10 +541,11 @@ def render(rows: list[Row], workers: int, quick: bool, command: str, loads: list
         f"Resident set size of each worker process, sampled every {SAMPLE_EVERY_S} s by a second client",
         "(`client.run(psutil.Process().memory_info().rss)`) during the instrumented run with the shortest",
         "wall time, and the peak the worker reports at the end (`ru_maxrss`, which also catches peaks",
-        "between samples). The first files warm each worker's allocator, so the first sample is lower; after",
-        "that, memory does not grow with the number of files when the last quarter of the run reaches no",
-        "higher than the first half did (*grows*: no). On large files each sample shows the file being",
-        "analysed, and the peak is what one task needs.",
+        f"between samples). After its timed pass the instrumented run analyses the same files {MEMORY_PASSES - 1} more times",
+        f"on the same workers, so each worker sees {MEMORY_PASSES} times its share: if memory grew with the number of",
+        f"files, pass {MEMORY_PASSES} would reach higher than pass 1 by about twice that growth (the *change* column).",
+        "The first sample precedes the first file (the allocator's first few MiB); on large files each sample",
+        "shows the file being analysed.",
         "",
         *memory_table(rows),
         "",
