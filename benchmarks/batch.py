@@ -12,10 +12,10 @@ rotated from round to round, the best time of each reported):
   timed two ways: in this process with trimesh already imported, and as a whole
   fresh process (``python -c``: interpreter, ``import trimesh``, the same loop
   over the same file list), from launch to exit;
-- ``analyze loop``: ``service.pipeline.analyze(path)`` per file, serially
+- ``analyze loop``: ``inertia.pipeline.analyze(path)`` per file, serially
   (our exact pipeline without Dask: separates the pipeline's cost from
   scaling), timed the same two ways;
-- ``inertia batch``: the real command, ``python -m service batch DIR --out
+- ``inertia batch``: the real command, ``python -m inertia batch DIR --out
   rows.jsonl --workers N --no-progress``, in a fresh process from launch to
   exit (interpreter, imports, forkserver, cluster start-up in the background
   while the command analyses the first small files itself, and shutdown);
@@ -152,7 +152,7 @@ def trimesh_loop(files: list[Path]) -> tuple[float, float]:
 
 def analyze_loop(files: list[Path]) -> tuple[float, float]:
     """(wall s, CPU s) of the serial loop over our pipeline, in this process (import excluded)."""
-    from service.pipeline import analyze
+    from inertia.pipeline import analyze
 
     start, cpu = time.perf_counter(), time.process_time()
     for path in files:
@@ -175,7 +175,7 @@ print(len(files))
 
 ANALYZE_SCRIPT = """\
 import sys
-from service.pipeline import analyze
+from inertia.pipeline import analyze
 files = open(sys.argv[1], encoding="utf-8").read().splitlines()
 for path in files:
     analyze(path).as_dict()
@@ -210,7 +210,7 @@ def check_rows(out: Path, files: list[Path]) -> None:
 def cli_run(folder: Path, out: Path, workers: int, files: list[Path]) -> float:
     """Wall s of the real ``inertia batch`` command in a fresh process, from launch to exit."""
     out.unlink(missing_ok=True)
-    command = [sys.executable, "-m", "service", "batch", str(folder), "--out", str(out), "--workers", str(workers),
+    command = [sys.executable, "-m", "inertia", "batch", str(folder), "--out", str(out), "--workers", str(workers),
                "--no-progress"]
     t0 = time.perf_counter()
     done = subprocess.run(command, cwd=ROOT, capture_output=True, text=True, check=False)
@@ -281,7 +281,7 @@ def _sample(address: str, log: MemoryLog, stop: threading.Event, t0: float) -> N
 
 def _child(folder: str, out: str, workers: int) -> None:
     """In a fresh process: start the local cluster, run the batch on it, print timings and memory as JSON."""
-    from service.batch.runner import connect, run_batch
+    from inertia.batch.runner import connect, run_batch
 
     t0 = time.perf_counter()
     client, cluster = connect(None, workers)
@@ -507,10 +507,10 @@ def render(rows: list[Row], workers: int, quick: bool, command: str, loads: list
         "  *In-process*: the loop's time in the benchmark's process, trimesh already imported. *Whole process*:",
         "  a fresh `python -c` that imports trimesh and runs the same loop over the same file list, from",
         "  launch to exit.",
-        "- **analyze loop**: `service.pipeline.analyze(path).as_dict()` per file, serially: our pipeline",
+        "- **analyze loop**: `inertia.pipeline.analyze(path).as_dict()` per file, serially: our pipeline",
         "  without Dask (separates the pipeline's own cost from the scaling), timed the same two ways",
-        "  (the whole process imports `service.pipeline`).",
-        (f"- **inertia batch**: the real command, `python -m service batch DIR --out rows.jsonl --workers {workers} "
+        "  (the whole process imports `inertia.pipeline`).",
+        (f"- **inertia batch**: the real command, `python -m inertia batch DIR --out rows.jsonl --workers {workers} "
          "--no-progress`,"),
         "  in a fresh process from launch to exit: interpreter, imports, the forkserver the workers fork from,",
         f"  the start of a `LocalCluster` of {workers} single-threaded workers (in the background while the",
@@ -524,7 +524,7 @@ def render(rows: list[Row], workers: int, quick: bool, command: str, loads: list
         *throughput_table(rows, workers),
         "",
         "CPU and memory below come from a separate, instrumented run in each round, on an already-started",
-        "cluster: a fresh process starts the local cluster (`service.batch.runner.connect`), then calls",
+        "cluster: a fresh process starts the local cluster (`inertia.batch.runner.connect`), then calls",
         "`run_batch(client=...)` on it while a second client samples the workers' memory. That path has no",
         "head start (the cluster is up before the first file), so it is not a split of the command's wall",
         "time above; in it, interpreter, imports, cluster start-up and shutdown took " +

@@ -18,7 +18,7 @@ by adaptive quadrature (``mp.quad``) of L&L's phi_dot over whole periods plus
 the remainder, not from Carlson's R_J as the exact method does.
 
 Mesh section: icospheres and tori of growing triangle count through
-``service.mass.mass_properties`` against the exact moments of the solids
+``inertia.mass.mass_properties`` against the exact moments of the solids
 (sphere 8 pi R^5 / 15 at unit density; torus about its axis
 V (R^2 + 3 r^2 / 4), across V (R^2 / 2 + 5 r^2 / 8), V = 2 pi^2 R r^2).
 """
@@ -36,10 +36,10 @@ from pathlib import Path
 import mpmath as mp
 import numpy as np
 
-from service.motion.integrators import integrate_scipy, integrate_splitting
-from service.motion.invariants import RigidProblem, invariant_drifts
-from service.motion.jacobi import AsymmetricTop
-from service.motion import quaternions as quat
+from inertia.motion.integrators import integrate_scipy, integrate_splitting
+from inertia.motion.invariants import RigidProblem, invariant_drifts
+from inertia.motion.jacobi import AsymmetricTop
+from inertia.motion import quaternions as quat
 
 ROOT = Path(__file__).resolve().parents[1]
 DOC = ROOT / "docs" / "error-vs-runtime.md"
@@ -250,9 +250,9 @@ def torus(n_major: int, n_minor: int, R: float = 1.0, r: float = 0.4) -> tuple[n
 
 
 def mesh_moments(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
-    """Principal moments at unit density through service.mass."""
-    from service.body import MeshBody
-    from service.mass import mass_properties
+    """Principal moments at unit density through inertia.mass."""
+    from inertia.body import MeshBody
+    from inertia.mass import mass_properties
 
     props = mass_properties(MeshBody(vertices, faces), density=1.0)
     return np.sort(np.asarray(props.principal_moments))
@@ -381,7 +381,7 @@ def write_doc(runs: list[Run], per_sample: dict[float, float], meshes: list[tupl
         "## Meshes: tessellation error against triangle count",
         "",
         "Unit-density icospheres (radius 1, vertices on the sphere) and tori (R = 1, r = 0.4, vertices on the "
-        "surface) through `service.mass.mass_properties`, against the exact solids. The error is the polyhedron's "
+        "surface) through `inertia.mass.mass_properties`, against the exact solids. The error is the polyhedron's "
         "departure from the smooth solid (second order in the edge length, ~1/N), not a floating-point error.",
         "",
         "| shape | triangles | run time [s] | max relative error of principal moments |",

@@ -108,7 +108,7 @@ def run_process(cmd: list[str]) -> tuple[float, int, str]:
 def tool_commands(path: Path) -> dict[str, list[str]]:
     py = sys.executable
     inertia = Path(py).with_name("inertia")
-    ours = [str(inertia)] if inertia.exists() else [py, "-m", "service"]
+    ours = [str(inertia)] if inertia.exists() else [py, "-m", "inertia"]
     return {
         "inertia": ours + ["analyze", str(path), "--json"],
         "trimesh": [py, "-c", TRIMESH_SCRIPT, str(path)],
@@ -142,10 +142,10 @@ def measure_processes(path: Path, triangles: int, repeat: int) -> dict[str, dict
 
 def stage_breakdown(path: Path) -> dict[str, float]:
     """Seconds per stage of one in-process ``pipeline.analyze`` (after a warm-up run)."""
-    import service.load.stl as stl
-    import service.mass as mass
-    import service.solid as solid
-    from service import pipeline
+    import inertia.load.stl as stl
+    import inertia.mass as mass
+    import inertia.solid as solid
+    from inertia import pipeline
 
     times: dict[str, float] = defaultdict(float)
     passes = [0]

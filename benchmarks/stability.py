@@ -37,11 +37,11 @@ ROOT = Path(__file__).resolve().parents[1]
 if str(ROOT) not in sys.path:
     sys.path.insert(0, str(ROOT))
 
-from service.body import MeshBody, PointBody, VolumeBody  # noqa: E402
-from service.classify import RotorClass, classify  # noqa: E402
-from service.mass import mass_properties  # noqa: E402
-from service.motion import ideal_moments  # noqa: E402
-from service.principal import principal_frame  # noqa: E402
+from inertia.body import MeshBody, PointBody, VolumeBody  # noqa: E402
+from inertia.classify import RotorClass, classify  # noqa: E402
+from inertia.mass import mass_properties  # noqa: E402
+from inertia.motion import ideal_moments  # noqa: E402
+from inertia.principal import principal_frame  # noqa: E402
 from tests.exact import (exact_eigenvalues, exact_points, exact_solid, exact_tetrahedra,  # noqa: E402
                          relative_error)
 
@@ -415,7 +415,7 @@ def near_symmetric_flip(eps: float = 1e-9) -> dict[str, object]:
 
 def smallest_true_tolerance(moments: Array, true: RotorClass) -> float:
     """Smallest tolerance (to 1%) at which ``classify`` calls these moments ``true`` (inf: none)."""
-    from service.principal import PrincipalFrame
+    from inertia.principal import PrincipalFrame
 
     frame = PrincipalFrame.from_eigen(np.asarray(moments), np.eye(3))
     grid = 10.0 ** np.arange(-17.0, 0.0, 0.25)
@@ -612,7 +612,7 @@ def _elliptic_reference(I: list[mpmath.mpf], w: list[mpmath.mpf], t: Array) -> A
 def measure_motion(case: MotionCase, samples: int = 2001, reference_samples: int = 41,
                    run_scipy: bool = True) -> dict[str, object]:
     """Invariant drift of our exact method (and scipy DOP853) over 1e5 time units; Omega error vs mpmath."""
-    from service.pipeline import precession
+    from inertia.pipeline import precession
 
     start = time.perf_counter()
     result = precession(case.omega, principal_moments=case.moments, tolerance=case.tolerance,
@@ -642,7 +642,7 @@ def measure_motion(case: MotionCase, samples: int = 2001, reference_samples: int
 
 
 def _effective_moments(moments: Array, rotor: RotorClass) -> Array:
-    """The moments the exact motion is computed with (service.motion's ideal top)."""
+    """The moments the exact motion is computed with (inertia.motion's ideal top)."""
     return ideal_moments(moments, rotor)
 
 

@@ -18,7 +18,7 @@ if TYPE_CHECKING:
     from .principal import PrincipalFrame, principal_frame
     from .tolerances import Tolerances
 
-# Names are imported on first use (PEP 562), so ``import service`` and the CLI
+# Names are imported on first use (PEP 562), so ``import inertia`` and the CLI
 # start without numpy: ``inertia batch`` starts its workers' forkserver first.
 _HOME = {
     "Classification": "classify", "RotorClass": "classify", "classify": "classify",
@@ -35,7 +35,7 @@ _HOME = {
 def __getattr__(name: str) -> Any:
     home = _HOME.get(name)
     if home is None:
-        raise AttributeError(f"module 'service' has no attribute {name!r}")
+        raise AttributeError(f"module 'inertia' has no attribute {name!r}")
     value = getattr(importlib.import_module(f".{home}", __name__), name)
     globals()[name] = value
     return value

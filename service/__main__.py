@@ -1,4 +1,4 @@
-"""python -m service -> the CLI."""
+"""python -m inertia -> the CLI."""
 
 from .cli import console_main
 

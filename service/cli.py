@@ -113,7 +113,7 @@ def _parser() -> argparse.ArgumentParser:
 
 
 def console_main() -> int:
-    """The ``inertia`` command and ``python -m service``: ``main`` in a process that ends next."""
+    """The ``inertia`` command and ``python -m inertia``: ``main`` in a process that ends next."""
     code = main()
     # Nothing is allocated after this: move every object to the permanent
     # generation, so the interpreter's final garbage collections do not walk
@@ -156,8 +156,8 @@ def _analyze(args: argparse.Namespace) -> int:
 def _serve(args: argparse.Namespace) -> int:
     import uvicorn
 
-    # the service writes its own structured access line (service.api.access)
-    uvicorn.run("service.app:app", host=args.host, port=args.port, workers=args.workers,
+    # the service writes its own structured access line (inertia.api.access)
+    uvicorn.run(f"{__package__}.app:app", host=args.host, port=args.port, workers=args.workers,
                 log_level=args.log_level, access_log=False)
     return 0
 

@@ -12,7 +12,7 @@ from paths import ROOT, SAMPLES
 
 
 def run(*args: str) -> subprocess.CompletedProcess[str]:
-    return subprocess.run([sys.executable, "-m", "service", *args], capture_output=True, text=True, cwd=ROOT)
+    return subprocess.run([sys.executable, "-m", "inertia", *args], capture_output=True, text=True, cwd=ROOT)
 
 
 def test_analyze_prints_a_table() -> None:
@@ -58,30 +58,30 @@ def imported_after(code: str) -> set[str]:
 
 
 def test_mesh_analysis_imports_no_web_stack_or_ode_solver() -> None:
-    mods = imported_after(f"import service; service.analyze({str(SAMPLES / 'box.stl')!r})")
+    mods = imported_after(f"import inertia; inertia.analyze({str(SAMPLES / 'box.stl')!r})")
     assert not {"fastapi", "uvicorn", "scipy.integrate", "pydantic", "dask"} & mods
 
 
 def test_point_analysis_imports_no_mesh_library() -> None:
-    mods = imported_after("import service; service.analyze_points([{'mass': 1, 'position': [0, 0, 0]}, "
+    mods = imported_after("import inertia; inertia.analyze_points([{'mass': 1, 'position': [0, 0, 0]}, "
                           "{'mass': 2, 'position': [1, 1, 0]}])")
     assert not {"trimesh", "meshio", "fastapi", "scipy.integrate"} & mods
 
 
 def test_cli_mesh_job_imports_no_web_stack() -> None:
-    mods = imported_after(f"from service.cli import main; main(['analyze', {str(SAMPLES / 'box.stl')!r}, '--json'])")
+    mods = imported_after(f"from inertia.cli import main; main(['analyze', {str(SAMPLES / 'box.stl')!r}, '--json'])")
     assert not {"fastapi", "uvicorn", "scipy.integrate"} & mods
 
 
 def test_the_cli_and_the_batch_forkserver_start_without_numpy_or_dask() -> None:
     # inertia batch starts its workers' forkserver before it imports either, so the
     # forkserver's imports run beside the command's own
-    mods = imported_after("import service, service.cli, service.batch.workers")
+    mods = imported_after("import inertia, inertia.cli, inertia.batch.workers")
     assert not {"numpy", "dask", "distributed"} & mods
 
 
 def test_result_holds_only_requested_sections() -> None:
-    from service import analyze
+    from inertia import analyze
 
     doc = analyze(SAMPLES / "box.stl").as_dict()
     assert not {"reference_inertia", "precession", "parts"} & set(doc)

@@ -1,9 +1,9 @@
 """Black-box tests of the HTTP contract (API.md) and of the CLI.
 
 Only public surfaces are used: the ASGI app through ``fastapi.testclient``
-(``service.app.app``, or ``service.api.create_app()`` after setting the
+(``inertia.app.app``, or ``inertia.api.create_app()`` after setting the
 ``INERTIA_*`` environment variables the contract names) and the command line
-through ``python -m service``.  Every expected value is computed here, from
+through ``python -m inertia``.  Every expected value is computed here, from
 
 * closed formulas (box m(b²+c²)/12, parallel-axis theorem, dumbbell
   m1 m2 l²/(m1+m2), isosceles triatomic molecule, Landau & Lifshitz §§33-37),
@@ -56,7 +56,7 @@ UNIT_SCALE = {"m": 1.0, "cm": 1e-2, "mm": 1e-3, "um": 1e-6, "in": 0.0254, "ft": 
 
 @pytest.fixture(scope="module")
 def client() -> Iterator[TestClient]:
-    from service.app import app
+    from inertia.app import app
 
     with TestClient(app) as c:
         yield c
@@ -68,7 +68,7 @@ def configured_client(**env: str) -> Iterator[TestClient]:
     saved = {k: os.environ.get(k) for k in env}
     os.environ.update(env)
     try:
-        from service.api import create_app
+        from inertia.api import create_app
 
         app = create_app()
     finally:
@@ -1396,7 +1396,7 @@ def test_api_key_guards_v1_but_not_healthz():
 
 def run_cli(*args: str, cwd: Path = SAMPLES) -> subprocess.CompletedProcess:
     env = {k: v for k, v in os.environ.items() if not k.startswith("INERTIA_")}
-    return subprocess.run([sys.executable, "-m", "service", *args], cwd=cwd, env=env,
+    return subprocess.run([sys.executable, "-m", "inertia", *args], cwd=cwd, env=env,
                           capture_output=True, text=True, timeout=60)
 
 
@@ -1850,7 +1850,7 @@ def test_inertia_serve_starts_the_http_service(tmp_path):
         port = s.getsockname()[1]
     env = {k: v for k, v in os.environ.items() if not k.startswith("INERTIA_")}
     env["INERTIA_COMPUTE_PROCESSES"] = "1"
-    proc = subprocess.Popen([sys.executable, "-m", "service", "serve", "--host", "127.0.0.1", "--port", str(port)],
+    proc = subprocess.Popen([sys.executable, "-m", "inertia", "serve", "--host", "127.0.0.1", "--port", str(port)],
                             cwd=tmp_path, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     try:
         deadline = time.monotonic() + 30

@@ -10,9 +10,9 @@ import pytest
 import trimesh
 
 from generate import box
-from service.errors import EmptyGeometryError, UnreadableFileError, UnsupportedFormatError
-from service.mass import parallel_axis
-from service.pipeline import AnalysisOptions, analyze
+from inertia.errors import EmptyGeometryError, UnreadableFileError, UnsupportedFormatError
+from inertia.mass import parallel_axis
+from inertia.pipeline import AnalysisOptions, analyze
 
 BOX_MOMENTS = sorted([6000 * (4 + 9) / 12, 6000 * (1 + 9) / 12, 6000 * (1 + 4) / 12])
 

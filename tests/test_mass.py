@@ -8,9 +8,9 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 from generate import box, exact_solid, l_bracket, prism  # sample_meshes/generate.py
-from service.body import MeshBody, PointBody, VolumeBody
-from service.errors import InvalidParameterError, NotWatertightError, ZeroVolumeError
-from service.mass import mass_properties
+from inertia.body import MeshBody, PointBody, VolumeBody
+from inertia.errors import InvalidParameterError, NotWatertightError, ZeroVolumeError
+from inertia.mass import mass_properties
 
 GENERIC = Rotation.from_euler("zyx", [0.3, 0.7, 1.1]).as_matrix()
 
@@ -207,7 +207,7 @@ def test_reference_tensor_follows_parallel_axis_theorem() -> None:
 
 def test_two_material_volume_mesh_matches_composite_box() -> None:
     from generate import write_two_density_vtu  # noqa: F401  (same geometry as the sample)
-    from service.load import load_body
+    from inertia.load import load_body
     from paths import SAMPLES
 
     loaded = load_body(SAMPLES / "two_density.vtu")
@@ -237,8 +237,8 @@ def test_volume_mesh_density_ratio_of_a_million() -> None:
 
 
 def test_diatomic_molecule_is_a_linear_rotator() -> None:
-    from service.classify import RotorClass, classify
-    from service.principal import principal_frame
+    from inertia.classify import RotorClass, classify
+    from inertia.principal import principal_frame
 
     m1, m2, l = 1.0, 16.0, 1.2e-10
     props = mass_properties(PointBody(np.array([m1, m2]), np.array([[0, 0, 0], [l, 0, 0]], float)))
@@ -287,7 +287,7 @@ def test_results_are_bit_identical_across_processes(tmp_path) -> None:  # noqa: 
         "import sys; sys.path.insert(0, 'sample_meshes');"
         "from generate import l_bracket; import numpy as np;"
         "from scipy.spatial.transform import Rotation as R;"
-        "from service.body import MeshBody; from service.mass import mass_properties;"
+        "from inertia.body import MeshBody; from inertia.mass import mass_properties;"
         "v, f = l_bracket(2.0); v = v @ R.from_euler('xyz', [.1, .2, .3]).as_matrix().T + 1e5;"
         "p = mass_properties(MeshBody(v, f)); print(p.inertia.matrix.tobytes().hex(), p.center_of_mass.tobytes().hex())"
     )

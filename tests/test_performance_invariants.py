@@ -14,12 +14,12 @@ import struct
 import numpy as np
 import pytest
 
-import service.integrals as integrals
-import service.mass as mass
-import service.topology as topology
-from service.body import MeshBody
-from service.tolerances import EPS
-from service.load.stl import read_stl
+import inertia.integrals as integrals
+import inertia.mass as mass
+import inertia.topology as topology
+from inertia.body import MeshBody
+from inertia.tolerances import EPS
+from inertia.load.stl import read_stl
 
 from exact import exact_moments, exact_solid, relative_error
 

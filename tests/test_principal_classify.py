@@ -8,10 +8,10 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy.spatial.transform import Rotation
 
-from service.classify import RotorClass, classify, ray_asymmetry
-from service.conventions import matrix_from_quaternion
-from service.errors import InvalidParameterError
-from service.principal import PrincipalFrame, jacobi_eigh
+from inertia.classify import RotorClass, classify, ray_asymmetry
+from inertia.conventions import matrix_from_quaternion
+from inertia.errors import InvalidParameterError
+from inertia.principal import PrincipalFrame, jacobi_eigh
 
 
 def frame_of(moments: list[float], rotation: np.ndarray | None = None, tol: float = 1e-6) -> PrincipalFrame:

@@ -6,8 +6,8 @@ import numpy as np
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from service.body import MeshBody, PointBody
-from service.mass import mass_properties, parallel_axis
+from inertia.body import MeshBody, PointBody
+from inertia.mass import mass_properties, parallel_axis
 from strategies import boxes, convex_bodies, offsets, rotations
 
 FAST = settings(max_examples=40, deadline=None)

@@ -25,11 +25,11 @@ from benchmarks.stability import (BOUND_EXACT, BOUND_INVARIANT, BOUND_THIN, BOX_
                                   near_symmetric_flip, placed, point_case, prism, smallest_true_tolerance,
                                   sphere_with_triangles, two_material_case, box, DIRECTION)
 from exact import exact_eigenvalues, exact_solid  # noqa: E402
-from service.body import MeshBody  # noqa: E402
-from service.classify import RotorClass, classify  # noqa: E402
-from service.mass import mass_properties  # noqa: E402
-from service.principal import PrincipalFrame, principal_frame  # noqa: E402
-from service.tolerances import EPS  # noqa: E402
+from inertia.body import MeshBody  # noqa: E402
+from inertia.classify import RotorClass, classify  # noqa: E402
+from inertia.mass import mass_properties  # noqa: E402
+from inertia.principal import PrincipalFrame, principal_frame  # noqa: E402
+from inertia.tolerances import EPS  # noqa: E402
 
 GEOMETRY = {c.name: c for c in geometry_cases(quick=True)}
 

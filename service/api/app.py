@@ -25,7 +25,7 @@ rigid bodies, from meshes or point masses. All numbers are SI. Errors always com
 
 def _configure_logging() -> None:
     """Give the service's loggers a handler when the host (uvicorn, a test) did not."""
-    logger = logging.getLogger("service")
+    logger = logging.getLogger("inertia")
     if logger.level == logging.NOTSET:
         logger.setLevel(logging.INFO)
     if not logger.handlers and not logging.getLogger().handlers:

@@ -38,9 +38,10 @@ from .jobs import Job, run_job
 
 __all__ = ["ComputePool", "WorkerCrashError"]
 
-log = logging.getLogger("service.api")
+_ROOT = __name__.split(".")[0]  # "inertia" when installed; the folder's name when run from a checkout
+log = logging.getLogger("inertia.api")
 
-PRELOAD = ["service.api.jobs", "service.report", "service.load.stl", "service.load.meshes", "service.motion"]
+PRELOAD = [f"{_ROOT}.api.jobs", f"{_ROOT}.report", f"{_ROOT}.load.stl", f"{_ROOT}.load.meshes", f"{_ROOT}.motion"]
 KILL_GRACE_S = 5.0  # how long to wait for a killed process to be reaped
 
 

@@ -29,7 +29,7 @@ from ..errors import (
 
 __all__ = ["STATUS", "error_response", "install_error_handlers", "status_of"]
 
-log = logging.getLogger("service.api")
+log = logging.getLogger("inertia.api")
 
 # most specific class first is not needed: the lookup walks the class's MRO
 STATUS: dict[type[ServiceError], int] = {

@@ -15,7 +15,7 @@ from typing import Any
 from ..errors import InvalidParameterError
 from ..pipeline import AnalysisOptions, analyze, analyze_points, precession
 
-log = logging.getLogger("service.api")
+log = logging.getLogger("inertia.api")
 
 _OUT_OF_RANGE = ("the input's numbers are too large or too small to compute with in float64 "
                  "(the result would overflow or divide by zero); rescale the input, e.g. other units")

@@ -16,7 +16,7 @@ from .settings import Settings
 
 __all__ = ["AccessLog", "Guard"]
 
-access_log = logging.getLogger("service.api.access")
+access_log = logging.getLogger("inertia.api.access")
 
 PROTECTED_PREFIX = "/v1/"
 

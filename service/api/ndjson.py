@@ -24,7 +24,7 @@ from .uploads import Item
 
 __all__ = ["batch_lines"]
 
-log = logging.getLogger("service.api")
+log = logging.getLogger("inertia.api")
 
 
 def _line(doc: dict[str, Any]) -> bytes:

@@ -42,6 +42,8 @@ from .sources import Source, list_sources
 from .tasks import InternalError, analyze_sources
 from .workers import start_forkserver
 
+_ROOT = __name__.split(".")[0]  # "inertia" when installed; the folder's name when run from a checkout
+
 __all__ = ["BatchSummary", "connect", "local_cluster", "run_batch"]
 
 # A task groups files until it holds this much input: ~0.1 s of analysis at
@@ -112,7 +114,7 @@ def local_cluster(workers: int | None = None) -> Any:
     with dask.config.set(settings):
         return distributed.LocalCluster(
             n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None, silence_logs=logging.ERROR,
-            preload=["service.batch.tasks"],  # a no-op after a forkserver; spawned workers import it at start-up
+            preload=[f"{_ROOT}.batch.tasks"],  # a no-op after a forkserver; spawned workers import it at start-up
         )
 
 

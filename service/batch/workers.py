@@ -15,7 +15,8 @@ import os
 __all__ = ["WORKER_PRELOAD", "WORKER_THREAD_LIMITS", "start_forkserver"]
 
 # What local workers fork from: a forkserver that has imported these once.
-WORKER_PRELOAD = ["distributed", "service.batch.tasks", "service.batch._frozen"]
+_ROOT = __name__.split(".")[0]  # "inertia" when installed; the folder's name when run from a checkout
+WORKER_PRELOAD = ["distributed", f"{_ROOT}.batch.tasks", f"{_ROOT}.batch._frozen"]
 # One thread per worker for the numeric libraries, as Dask's default pre-spawn
 # environment sets (``distributed.nanny.pre-spawn-environ``); a value already
 # in the environment wins, as in Dask.  The forkserver must start with them,

@@ -1,4 +1,4 @@
-"""A real uvicorn server per configuration (``python -m service serve`` on a free loopback port),
+"""A real uvicorn server per configuration (``python -m inertia serve`` on a free loopback port),
 and an in-process TestClient where that is enough."""
 
 from __future__ import annotations
@@ -20,7 +20,7 @@ with warnings.catch_warnings():  # starlette deprecates httpx for TestClient in 
     warnings.filterwarnings("ignore", message="Using `httpx` with `starlette.testclient`")
     from fastapi.testclient import TestClient
 
-from service.api import Settings, create_app
+from inertia.api import Settings, create_app
 
 ROOT = Path(__file__).resolve().parents[2]
 STARTUP_S = 30.0
@@ -33,7 +33,7 @@ def _free_port() -> int:
 
 
 class LiveServer:
-    """One ``python -m service serve`` process with the given ``INERTIA_*`` environment."""
+    """One ``python -m inertia serve`` process with the given ``INERTIA_*`` environment."""
 
     def __init__(self, env: dict[str, str]) -> None:
         self.port = _free_port()
@@ -42,7 +42,7 @@ class LiveServer:
         full_env.update(env)
         self.log = open(ROOT / ".pytest_cache" / f"serve-{self.port}.log", "w+b")  # noqa: SIM115
         self.process = subprocess.Popen(
-            [sys.executable, "-m", "service", "serve", "--host", "127.0.0.1", "--port", str(self.port)],
+            [sys.executable, "-m", "inertia", "serve", "--host", "127.0.0.1", "--port", str(self.port)],
             cwd=ROOT, env=full_env, stdout=self.log, stderr=subprocess.STDOUT)
         self._wait_ready()
 

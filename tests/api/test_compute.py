@@ -8,10 +8,10 @@ import struct
 
 import pytest
 
-from service.api.compute import ComputePool
-from service.api.jobs import MeshJob
-from service.errors import ComputeTimeoutError, NotWatertightError
-from service.pipeline import AnalysisOptions
+from inertia.api.compute import ComputePool
+from inertia.api.jobs import MeshJob
+from inertia.errors import ComputeTimeoutError, NotWatertightError
+from inertia.pipeline import AnalysisOptions
 
 from .meshes import box_stl, torus_stl
 

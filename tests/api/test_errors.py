@@ -1,6 +1,6 @@
 """Every error code of the contract, provoked by one request each; the envelope is asserted every time.
 
-Table-driven from ``service.api.errors.STATUS``: each error class the API maps
+Table-driven from ``inertia.api.errors.STATUS``: each error class the API maps
 has at least one request here that produces it.
 """
 
@@ -14,9 +14,9 @@ from typing import Any
 import numpy as np
 import pytest
 
-from service import errors as E
-from service.api import Settings, create_app
-from service.api.errors import STATUS
+from inertia import errors as E
+from inertia.api import Settings, create_app
+from inertia.api.errors import STATUS
 
 from .meshes import box_stl, stl_bytes, torus_stl
 
@@ -144,7 +144,7 @@ def test_unexpected_exception_is_500_envelope_with_logged_traceback(caplog) -> N
     async def boom() -> None:
         raise RuntimeError("secret internal detail")
 
-    with caplog.at_level(logging.ERROR, logger="service.api"), \
+    with caplog.at_level(logging.ERROR, logger="inertia.api"), \
             TestClient(app, raise_server_exceptions=False) as c:
         error = assert_envelope(c.get("/boom"), "internal_error", 500)
     assert "secret" not in error["message"]

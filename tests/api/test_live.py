@@ -1,4 +1,4 @@
-"""Against a real uvicorn server (``python -m service serve`` on a free loopback port)."""
+"""Against a real uvicorn server (``python -m inertia serve`` on a free loopback port)."""
 
 from __future__ import annotations
 

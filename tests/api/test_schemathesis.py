@@ -17,7 +17,7 @@ import schemathesis
 from schemathesis import checks
 from hypothesis import HealthCheck, settings
 
-from service.api import Settings, create_app
+from inertia.api import Settings, create_app
 
 with warnings.catch_warnings():
     warnings.filterwarnings("ignore", message="Using `httpx` with `starlette.testclient`")

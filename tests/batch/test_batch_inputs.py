@@ -15,12 +15,12 @@ from typing import Any
 import pytest
 from batchlib import N_FILES, box, stl_bytes, without_timing
 
-from service.batch import runner, workers
-from service.batch.sources import Source, iter_inputs, iter_zip_bytes, list_sources, read_source
-from service.batch.tasks import analyze_source, analyze_sources
-from service.cli import main
-from service.errors import UnreadableFileError
-from service.pipeline import AnalysisOptions
+from inertia.batch import runner, workers
+from inertia.batch.sources import Source, iter_inputs, iter_zip_bytes, list_sources, read_source
+from inertia.batch.tasks import analyze_source, analyze_sources
+from inertia.cli import main
+from inertia.errors import UnreadableFileError
+from inertia.pipeline import AnalysisOptions
 
 Library = tuple[Path, dict[str, "str | None"]]
 
@@ -73,7 +73,7 @@ def test_a_missing_extra_says_what_to_install(module: str, out: str, hint: str, 
 
 
 def test_importing_the_service_and_the_sources_imports_no_dask() -> None:
-    code = ("import sys, service, service.cli, service.batch, service.batch.sources; "
+    code = ("import sys, inertia, inertia.cli, inertia.batch, inertia.batch.sources; "
             "bad = [m for m in ('dask', 'distributed', 'tqdm', 'pyarrow', 'fsspec') if m in sys.modules]; "
             "assert not bad, bad")
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=False)
@@ -118,7 +118,7 @@ def test_an_unexpected_exception_is_an_internal_error_row(monkeypatch: pytest.Mo
     def boom(*args: Any, **kwargs: Any) -> None:
         raise ZeroDivisionError("oops")
 
-    monkeypatch.setattr("service.batch.tasks.analyze", boom)
+    monkeypatch.setattr("inertia.batch.tasks.analyze", boom)
     rows = analyze_sources([Source("b.stl", str(path)), Source("c.stl", str(path))], AnalysisOptions())
     assert [r["error"]["code"] for r in rows] == ["internal_error", "internal_error"]
     assert "ZeroDivisionError" in rows[0]["error"]["message"]
@@ -213,7 +213,7 @@ def test_an_interrupted_head_start_still_closes_the_cluster_it_started(library: 
 
 FORKSERVER_ENV = """
 import gc, json, multiprocessing, os
-from service.batch import workers
+from inertia.batch import workers
 workers.start_forkserver()
 with multiprocessing.get_context("forkserver").Pool(1) as pool:
     seen = pool.map(os.getenv, workers.WORKER_THREAD_LIMITS)

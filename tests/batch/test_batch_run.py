@@ -13,10 +13,10 @@ from typing import Any
 import pytest
 from batchlib import BROKEN, N_FILES, box, by_name, read_jsonl, stl_bytes, without_timing
 
-from service.batch.rows import COLUMNS, FLOAT_COLUMNS, flat_row
-from service.cli import main
-from service.errors import ServiceError
-from service.pipeline import AnalysisOptions, analyze
+from inertia.batch.rows import COLUMNS, FLOAT_COLUMNS, flat_row
+from inertia.cli import main
+from inertia.errors import ServiceError
+from inertia.pipeline import AnalysisOptions, analyze
 
 Library = tuple[Path, dict[str, "str | None"]]
 
@@ -45,7 +45,7 @@ def local_rows(library: Library, tmp_path_factory: pytest.TempPathFactory) -> Pa
 @pytest.fixture(scope="module")
 def worker_rows(library: Library, tmp_path_factory: pytest.TempPathFactory) -> Path:
     """The same through the default engine with no head start: every file analysed on a worker."""
-    from service.batch import runner
+    from inertia.batch import runner
 
     out = tmp_path_factory.mktemp("workers") / "rows.jsonl"
     with pytest.MonkeyPatch.context() as mp:
@@ -273,7 +273,7 @@ def test_tasks_in_flight_stay_within_the_window(library: Library, cluster: Any, 
                                                 monkeypatch: pytest.MonkeyPatch) -> None:
     from distributed import Client
 
-    from service.batch import runner
+    from inertia.batch import runner
 
     monkeypatch.setattr(runner, "TASK_FILES", 1)  # one file per task: 50 tasks through a window of 2 x 2
     monkeypatch.setattr(runner, "WINDOW_PER_THREAD", 2)

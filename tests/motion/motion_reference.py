@@ -12,8 +12,8 @@ import mpmath as mp
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from service.classify import Classification, classify
-from service.principal import PrincipalFrame
+from inertia.classify import Classification, classify
+from inertia.principal import PrincipalFrame
 
 
 def body(moments, rotation=None, tolerance=1e-6) -> tuple[PrincipalFrame, Classification]:

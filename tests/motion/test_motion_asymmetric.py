@@ -7,8 +7,8 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 from motion_reference import body, euler_reference, ll_period, quaternion_matrix
-from service.conventions import orient_axes
-from service.motion import Regime, predict_motion
+from inertia.conventions import orient_axes
+from inertia.motion import Regime, predict_motion
 
 # principal axes as rows in the input frame, signs already by the convention's rule
 ROT = orient_axes(Rotation.from_euler("zyx", [0.3, 0.5, -0.7]).as_matrix())

@@ -9,17 +9,17 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from motion_reference import body, euler_reference
-from service.motion import MotionMethod, Regime, predict_motion
-from service.motion.elliptic import (
+from inertia.motion import MotionMethod, Regime, predict_motion
+from inertia.motion.elliptic import (
     complete_third_kind_rj,
     incomplete_first_kind,
     jacobi_sncndn,
     quarter_period,
     third_kind_rj,
 )
-from service.motion.integrators import SPLITTING_ORDER, integrate_splitting
-from service.motion.invariants import RigidProblem
-from service.tolerances import Tolerances
+from inertia.motion.integrators import SPLITTING_ORDER, integrate_splitting
+from inertia.motion.invariants import RigidProblem
+from inertia.tolerances import Tolerances
 
 MOMENTS, OMEGA = (1.0, 2.0, 3.0), (0.3, 0.2, 1.0)
 

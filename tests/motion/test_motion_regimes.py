@@ -12,9 +12,9 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 from motion_reference import body, euler_reference, quaternion_matrix
-from service.conventions import orient_axes
-from service.errors import InvalidParameterError, MotionError
-from service.motion import MAX_SAMPLES, MotionMethod, Regime, predict_motion
+from inertia.conventions import orient_axes
+from inertia.errors import InvalidParameterError, MotionError
+from inertia.motion import MAX_SAMPLES, MotionMethod, Regime, predict_motion
 
 # principal axes as rows in the input frame, signs already by the convention's rule
 ROT = orient_axes(Rotation.from_euler("xyz", [0.4, -0.2, 1.1]).as_matrix())
@@ -188,6 +188,6 @@ def test_splitting_refuses_a_horizon_beyond_its_step_budget():
 
 
 def test_importing_motion_does_not_import_scipy_integrate():
-    code = "import sys, service.motion; print('scipy.integrate' in sys.modules)"
+    code = "import sys, inertia.motion; print('scipy.integrate' in sys.modules)"
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.strip() == "False"
