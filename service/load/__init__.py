@@ -98,9 +98,9 @@ def _load_bytes(data: bytes, filename: str | None, format: str | None, units: st
         parts = [Part(_stem(filename), read_points_file(data, fmt, scale))]
         kind = "points"
     elif fmt in VOLUME_FORMATS:
-        from .meshes import read_meshio_parts
+        from .volume import read_volume_parts
 
-        parts = read_meshio_parts(data, fmt, scale)
+        parts = read_volume_parts(data, fmt, scale)
         kind = "volume"
     else:
         from .meshes import read_trimesh_parts
