@@ -58,7 +58,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ..classify import Classification, RotorClass
+from ..classification import Classification, RotorClass
 from ..errors import InvalidParameterError, MotionError
 from ..principal import PrincipalFrame
 from ..tolerances import DEFAULT_TOLERANCES, EPS, Tolerances
@@ -292,7 +292,7 @@ def motion_rotor(frame: PrincipalFrame, classification: Classification) -> Rotor
     Otherwise the class is decided again at that level, so a nearly symmetric
     top moves as the asymmetric top it is.
     """
-    from ..classify import classify
+    from ..classification import classify
 
     level = min(MOTION_ROUNDING, classification.tolerance)
     if classification.tolerance <= level:

@@ -10,9 +10,10 @@ from __future__ import annotations
 
 import mpmath as mp
 import numpy as np
-from inertia.classify import Classification, classify
-from inertia.principal import PrincipalFrame
 from scipy.integrate import solve_ivp
+
+from inertia.classification import Classification, classify
+from inertia.principal import PrincipalFrame
 
 
 def body(moments, rotation=None, tolerance=1e-6) -> tuple[PrincipalFrame, Classification]:
