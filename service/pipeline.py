@@ -155,6 +155,11 @@ def analyze_loaded(loaded: Loaded, options: AnalysisOptions, start: float | None
     start = time.perf_counter() if start is None else start
     if loaded.kind == "points" and options.model == Model.SHELL:
         raise InvalidParameterError("model=shell applies to surface meshes, not point masses", parameter="model")
+    if loaded.kind == "mesh" and len(loaded.parts) > 1 and options.model == Model.SOLID:
+        from .seams import join_open_parts
+
+        parts_joined, _ = join_open_parts(list(loaded.parts))
+        loaded = replace(loaded, parts=tuple(parts_joined))
     single = len(loaded.parts) == 1
     part_results = tuple(_part(p.name, p.body, options, single) for p in loaded.parts)
     factor = 1.0
