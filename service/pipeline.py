@@ -20,7 +20,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import NDArray
 
-from .classify import Classification, classify
+from .classification import Classification, classify
 from .conventions import length_scale
 from .errors import InvalidParameterError
 from .load import Loaded, load_body, load_points
@@ -133,15 +133,51 @@ class AnalysisResult:
 
 
 def analyze(
-    source: bytes | str | os.PathLike[str],
+    source: bytes | str | os.PathLike[str] | Any,
     *,
     filename: str | None = None,
     options: AnalysisOptions = AnalysisOptions(),
 ) -> AnalysisResult:
-    """Analyse a mesh or points file (bytes, or a path)."""
+    """Analyse a mesh or points file (bytes, or a path), a ``trimesh.Trimesh``, or ``(vertices, faces)`` arrays.
+
+    Arrays and mesh objects are in ``options.units`` (default metres): vertices (n, 3), faces (m, 3) of
+    vertex indices, a closed surface wound either way.
+    """
     start = time.perf_counter()
-    loaded = load_body(source, filename=filename, format=options.format, units=options.units)
+    if isinstance(source, (bytearray, memoryview)):
+        source = bytes(source)
+    if isinstance(source, (bytes, str, os.PathLike)):
+        loaded = load_body(source, filename=filename, format=options.format, units=options.units)
+    else:
+        loaded = _loaded_from_arrays(source, filename, options.units)
     return analyze_loaded(loaded, options, start)
+
+
+def _loaded_from_arrays(source: Any, filename: str | None, units: str | None) -> Loaded:
+    """A surface given in memory: an object with ``vertices`` and ``faces`` (trimesh's Trimesh) or a pair."""
+    from .body import MeshBody, Part
+
+    if hasattr(source, "vertices") and hasattr(source, "faces"):
+        vertices, faces, fmt = source.vertices, source.faces, type(source).__name__.lower()
+    elif isinstance(source, (tuple, list)) and len(source) == 2:
+        (vertices, faces), fmt = source, "arrays"
+    else:
+        raise InvalidParameterError(
+            f"cannot analyse a {type(source).__name__}: give a file path, the file's bytes, a trimesh.Trimesh "
+            "or a (vertices, faces) pair of arrays", parameter="source")
+    try:
+        v = np.array(vertices, dtype=np.float64)
+        f = np.array(faces)
+    except (TypeError, ValueError) as exc:
+        raise InvalidParameterError(f"vertices and faces must be numeric arrays: {exc}", parameter="source") from exc
+    if f.dtype.kind not in "iu" and not (f.dtype.kind == "f" and np.array_equal(f, np.round(f))):
+        raise InvalidParameterError("faces must hold whole vertex indices", parameter="source")
+    try:
+        body = MeshBody(v, f.astype(np.int64), length_scale(units or "m"), filename or "body")
+    except ValueError as exc:  # shapes
+        raise InvalidParameterError(f"{exc}; got vertices {v.shape} and faces {f.shape}", parameter="source") from exc
+    name = filename or "body"
+    return Loaded((Part(name, body),), filename, fmt, "mesh", units or "m", "request" if units else "default")
 
 
 def analyze_points(records: list[dict[str, Any]], options: AnalysisOptions = AnalysisOptions()) -> AnalysisResult:
@@ -155,7 +191,10 @@ def analyze_loaded(loaded: Loaded, options: AnalysisOptions, start: float | None
     start = time.perf_counter() if start is None else start
     if loaded.kind == "points" and options.model == Model.SHELL:
         raise InvalidParameterError("model=shell applies to surface meshes, not point masses", parameter="model")
-    if loaded.kind == "mesh" and len(loaded.parts) > 1 and options.model == Model.SOLID:
+    _check_part_names(loaded, options)
+    if loaded.kind == "mesh" and len(loaded.parts) > 1 and options.model == Model.SOLID and not options.densities:
+        # open parts that close together become one body (with per-part densities they stay apart, and
+        # an open part is refused by name: one body cannot hold two materials)
         from .seams import join_open_parts
 
         parts_joined, _ = join_open_parts(list(loaded.parts))
@@ -178,6 +217,9 @@ def analyze_loaded(loaded: Loaded, options: AnalysisOptions, start: float | None
     warnings = list(props.warnings)
     if loaded.units_from == "file":
         warnings.append(f"length unit {loaded.units!r} taken from the file")
+    warnings.extend(_unit_warning(loaded))
+    if options.model == Model.SHELL:
+        warnings.extend(_shell_thickness_warning(loaded, options))
     reference = None
     if options.reference is not None:
         reference = props.about(np.asarray(options.reference) * length_scale(loaded.units))
@@ -196,6 +238,68 @@ def analyze_loaded(loaded: Loaded, options: AnalysisOptions, start: float | None
         warnings=tuple(dict.fromkeys(warnings)),
         elapsed_s=time.perf_counter() - start,
     )
+
+
+def _check_part_names(loaded: Loaded, options: AnalysisOptions) -> None:
+    """Every name in ``densities`` must be a part of the file: a typo never falls back to the default."""
+    if not options.densities:
+        return
+    names = [p.name for p in loaded.parts]
+    unknown = sorted(set(options.densities) - set(names))
+    if unknown:
+        listed = ", ".join(repr(n) for n in names[:20]) + (" ..." if len(names) > 20 else "")
+        raise InvalidParameterError(
+            f"densities names {', '.join(repr(n) for n in unknown)}, which is not a part of this file; "
+            f"its parts are: {listed}", parameter="densities", unknown=unknown, parts=names[:100])
+
+
+def _extent(body: Any) -> NDArray[np.float64] | None:
+    """Bounding-box side lengths of a mesh or volume body [m]; None for point sets."""
+    coords = getattr(body, "vertices", None)
+    if coords is None:
+        coords = getattr(body, "points", None)
+    if coords is None or not len(coords):
+        return None
+    extent: NDArray[np.float64] = (coords.max(axis=0) - coords.min(axis=0)) * body.length_scale
+    return extent
+
+
+def _unit_warning(loaded: Loaded) -> list[str]:
+    """A file with no length unit, read as metres, that is implausibly large for a part: say so."""
+    if loaded.units_from != "default" or loaded.kind == "points":
+        return []
+    sizes = [e for e in (_extent(p.body) for p in loaded.parts) if e is not None]
+    if not sizes:
+        return []
+    diagonal = float(np.linalg.norm(np.max(sizes, axis=0)))
+    if diagonal <= DEFAULT_TOLERANCES.metres_plausible:
+        return []
+    return [f"the file declares no length unit and none was given, so it was read in metres: the part is "
+            f"{diagonal:.4g} m across; if it was drawn in millimetres, pass units=mm (CLI: --units mm), "
+            f"which divides the mass by 1e9"]
+
+
+def _shell_thickness_warning(loaded: Loaded, options: AnalysisOptions) -> list[str]:
+    """The thin-shell model needs a wall much thinner than the part: refuse a thicker one, warn near it."""
+    assert options.thickness is not None  # AnalysisOptions requires it for shells
+    thickness = options.thickness * length_scale(loaded.units)
+    out: list[str] = []
+    for part in loaded.parts:
+        extent = _extent(part.body)
+        if extent is None:
+            continue
+        size = float(np.linalg.norm(extent))
+        ratio = thickness / size
+        where = f" ({part.name})" if len(loaded.parts) > 1 else ""
+        if ratio >= DEFAULT_TOLERANCES.shell_thickness_max:
+            raise InvalidParameterError(
+                f"thickness {thickness:.4g} m is {ratio:.3g} times the part's size{where} ({size:.4g} m across): "
+                f"a thin shell needs a wall much thinner than the part; check thickness and units, or analyse "
+                f"it as a solid", parameter="thickness", thickness_m=thickness, size_m=size)
+        if ratio >= DEFAULT_TOLERANCES.shell_thickness_warn:
+            out.append(f"thickness {thickness:.4g} m is {100 * ratio:.2g}% of the part's size{where}: the thin-shell "
+                       f"model (mass = area x thickness x density) is only approximate for so thick a wall")
+    return out
 
 
 def _part_density(name: str, options: AnalysisOptions) -> float | None:

@@ -67,5 +67,18 @@ class Tolerances:
     """Cap on steps of the numerical methods (a pure-Python loop for splitting):
     beyond it predict_motion refuses and points to method='exact'."""
 
+    metres_plausible: float = 10.0
+    """A part read in metres by default (the file declares no unit and none was
+    given) that is more than this many metres across is most likely drawn in
+    millimetres (a 10 m part is a building, a 10 mm part is common): warn."""
+
+    shell_thickness_warn: float = 0.05
+    """model=shell: a wall thicker than this fraction of the part's bounding-box
+    diagonal is warned about; the thin-shell model's error grows like t/R."""
+
+    shell_thickness_max: float = 0.5
+    """model=shell: a wall at least half the part's diagonal is no wall (a box
+    of side 1 with thickness 2 weighs 12 solids): refused as invalid_parameter."""
+
 
 DEFAULT_TOLERANCES = Tolerances()

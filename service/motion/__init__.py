@@ -53,7 +53,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ..classify import Classification, RotorClass
+from ..classification import Classification, RotorClass
 from ..errors import InvalidParameterError, MotionError
 from ..principal import PrincipalFrame
 from ..tolerances import DEFAULT_TOLERANCES, EPS, Tolerances

@@ -12,7 +12,7 @@ import mpmath as mp
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from inertia.classify import Classification, classify
+from inertia.classification import Classification, classify
 from inertia.principal import PrincipalFrame
 
 
