@@ -8,6 +8,7 @@ from dataclasses import dataclass
 from ..body import Body, MeshBody, Part, PointBody, VolumeBody
 from ..conventions import length_scale
 from ..errors import EmptyGeometryError, UnreadableFileError
+from .guard import check_upload
 from .sniff import FORMATS, POINT_FORMATS, SCENE_FORMATS, SURFACE_FORMATS, VOLUME_FORMATS, sniff_format
 
 __all__ = ["Loaded", "load_body", "load_points", "FORMATS", "SURFACE_FORMATS", "VOLUME_FORMATS", "SCENE_FORMATS"]
@@ -80,6 +81,7 @@ def _load_bytes(data: bytes, filename: str | None, format: str | None, units: st
     if not len(data):
         raise EmptyGeometryError("the file is empty; send a mesh with geometry", filename=filename)
     fmt = sniff_format(filename, format, bytes(data[:512]))
+    check_upload(data, fmt)  # includes, external references, inflation bounds: before any reader
     requested = None if units is None else (units, length_scale(units))
     scale = requested[1] if requested else 1.0
 
