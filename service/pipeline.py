@@ -192,6 +192,13 @@ def analyze_loaded(loaded: Loaded, options: AnalysisOptions, start: float | None
     if loaded.kind == "points" and options.model == Model.SHELL:
         raise InvalidParameterError("model=shell applies to surface meshes, not point masses", parameter="model")
     _check_part_names(loaded, options)
+    if loaded.kind == "mesh" and len(loaded.parts) > 1 and options.model == Model.SOLID and not options.densities:
+        # open parts that close together become one body (with per-part densities they stay apart, and
+        # an open part is refused by name: one body cannot hold two materials)
+        from .seams import join_open_parts
+
+        parts_joined, _ = join_open_parts(list(loaded.parts))
+        loaded = replace(loaded, parts=tuple(parts_joined))
     single = len(loaded.parts) == 1
     part_results = tuple(_part(p.name, p.body, options, single) for p in loaded.parts)
     factor = 1.0
