@@ -221,13 +221,11 @@ def _physical_moments(geometry: _Geometry, values: NDArray[np.float64],
         low |= values <= 64 * EPS * float(np.max(values))
         if not np.any(low):
             return values, ()
-        if np.any(values < -errors) or bool(low[np.argmax(values)]):
-            raise InsufficientPrecisionError(
-                "the point masses' principal moments are below their own rounding error; "
-                "express the positions in other units or nearer the origin")
-        count = int(low.sum())
+        if bool(np.all(low)):  # a single point, or all the mass at one place: every moment is zero
+            return np.zeros(3), () if not np.any(values) else (
+                "all principal moments are zero within rounding (the mass is at one point) and are reported as 0",)
         return np.where(low, 0.0, values), (
-            f"{count} principal moment(s) are zero within rounding (the points lie on a line) and are reported as 0",)
+            "the smallest principal moment is zero within rounding (the points lie on a line) and is reported as 0",)
     order = np.sort(values)
     slack = float(errors.sum())
     if np.any(low) or order[0] + order[1] < order[2] - slack:
