@@ -24,6 +24,7 @@ EXIT_CODES = {
     "empty_geometry": 3,
     "not_watertight": 4,
     "zero_volume": 4,
+    "invalid_inertia": 4,
     "timeout": 5,
 }
 EXIT_INTERNAL = 1
@@ -39,6 +40,17 @@ def _triple(text: str) -> tuple[float, float, float]:
         raise argparse.ArgumentTypeError(f"expected three numbers x,y,z but got {text!r}") from None
 
 
+def _quaternion(text: str) -> tuple[float, float, float, float]:
+    parts = text.replace(" ", "").split(",")
+    try:
+        values = [float(v) for v in parts]
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected four numbers w,x,y,z but got {text!r}") from None
+    if len(values) != 4:
+        raise argparse.ArgumentTypeError(f"expected a quaternion w,x,y,z but got {text!r}")
+    return (values[0], values[1], values[2], values[3])
+
+
 def add_analysis_options(p: argparse.ArgumentParser) -> None:
     """Options shared by ``analyze`` and ``batch`` (the API's query parameters)."""
     p.add_argument("--format", help="file format; inferred from the name when absent")
@@ -51,6 +63,11 @@ def add_analysis_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("--tolerance", type=float, default=1e-6, help="relative tolerance for equal moments")
     p.add_argument("--reference", type=_triple, help="x,y,z point (file units): also report the tensor about it")
     p.add_argument("--densities", help="JSON file: part name -> density (kg/m^3) for files of several parts")
+    p.add_argument("--frame", type=_quaternion, metavar="W,X,Y,Z",
+                   help="unit quaternion carrying a named frame's axes into the file's: also report the centre of "
+                   "mass and tensors along that frame's axes")
+    p.add_argument("--isotopes", choices=("standard", "abundant"), default="standard",
+                   help="atoms named by element (.xyz): standard atomic weights or the most abundant isotope")
 
 
 def options_from_args(args: argparse.Namespace) -> Any:
@@ -79,6 +96,9 @@ def options_from_args(args: argparse.Namespace) -> Any:
         samples=getattr(args, "samples", None),
         method=getattr(args, "method", "exact"),
         densities=densities,
+        export=getattr(args, "export", None),
+        frame=getattr(args, "frame", None),
+        isotopes=getattr(args, "isotopes", "standard"),
     )
 
 
@@ -86,7 +106,7 @@ def _parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="inertia", description="Mass properties and free rotation of rigid bodies.")
     sub = parser.add_subparsers(dest="command", required=True)
 
-    a = sub.add_parser("analyze", help="analyse one mesh or points file (.json/.csv)")
+    a = sub.add_parser("analyze", help="analyse one mesh or points file (.json/.csv/.xyz)")
     a.add_argument("file")
     add_analysis_options(a)
     a.add_argument("--omega", type=_triple, help="wx,wy,wz initial angular velocity, rad/s, input frame")
@@ -94,6 +114,8 @@ def _parser() -> argparse.ArgumentParser:
     a.add_argument("--samples", type=int, help="number of time samples of the trajectory")
     a.add_argument("--method", default="exact", choices=("exact", "dop853", "rk45", "splitting"))
     a.add_argument("--json", action="store_true", help="print the API's JSON instead of a table")
+    a.add_argument("--export", choices=("urdf", "sdf", "mjcf"),
+                   help="print only the inertial element of a robot description format (SI units)")
 
     b = sub.add_parser("batch", help="analyse many files, folders or .zip archives into JSONL/CSV/Parquet")
     b.add_argument("paths", nargs="+")
@@ -146,6 +168,11 @@ def _analyze(args: argparse.Namespace) -> int:
 
     result = analyze(args.file, options=options_from_args(args))
     doc = result.as_dict()
+    if getattr(args, "export", None) and not args.json:
+        print(export_text(doc))
+        for w in doc.get("warnings", []):
+            print(f"warning: {w}", file=sys.stderr)
+        return 0
     if args.json:
         print(json.dumps(doc, indent=2))
     else:
@@ -170,6 +197,34 @@ def _vec(v: Sequence[float]) -> str:
     return "[" + ", ".join(_fmt(x) for x in v) + "]"
 
 
+def export_text(doc: dict[str, Any]) -> str:
+    """The export snippet alone; for several parts, each part's after the whole body's, named in a comment."""
+    export = doc["export"]
+    blocks = [export["text"]]
+    for part in export.get("parts", []):
+        blocks.append(f"<!-- part {part['name'].replace('--', '- -')} -->\n{part['text']}")
+    return "\n".join(blocks)
+
+
+def _v11_rows(doc: dict[str, Any]) -> list[tuple[str, str]]:
+    """Rows of the API 1.1 sections: rotational constants and the named frame."""
+    rows: list[tuple[str, str]] = []
+    rc = doc.get("rotational_constants")
+    if rc is not None:
+        names = "B" if len(rc["MHz"]) == 1 else "A, B, C"
+        rows.append((f"rotational {names}", ", ".join(f"{v:.9g}" for v in rc["MHz"]) + " MHz"))
+        rows.append(("", ", ".join(f"{v:.9g}" for v in rc["cm-1"]) + " cm^-1"))
+    fr = doc.get("frame")
+    if fr is not None:
+        rows.append(("frame quaternion", _vec(fr["quaternion"])))
+        rows.append(("  centre of mass", f"{_vec(fr['center_of_mass'])} m"))
+        for i, row in enumerate(fr["inertia_tensor"]):
+            rows.append(("  inertia tensor" if i == 0 else "", f"{_vec(row)} kg m^2"))
+        for i, row in enumerate(fr.get("reference_inertia", [])):
+            rows.append(("  about reference" if i == 0 else "", f"{_vec(row)} kg m^2"))
+    return rows
+
+
 def render_table(doc: dict[str, Any]) -> str:
     """A readable summary of an analysis result (SI units)."""
     src = doc["source"]
@@ -179,6 +234,8 @@ def render_table(doc: dict[str, Any]) -> str:
         rows.append(("volume", f"{_fmt(doc['volume'])} m^3"))
     if "density" in doc:
         rows.append(("density", f"{_fmt(doc['density'])} kg/m^3"))
+    if "surface_area" in doc:
+        rows.append(("surface area", f"{_fmt(doc['surface_area'])} m^2"))
     rows.append(("centre of mass", f"{_vec(doc['center_of_mass'])} m"))
     for i, row in enumerate(doc["inertia_tensor"]):
         rows.append(("inertia tensor" if i == 0 else "", f"{_vec(row)} kg m^2"))
@@ -186,12 +243,15 @@ def render_table(doc: dict[str, Any]) -> str:
     rows.append(("principal moments", f"{_vec(pr['moments'])} kg m^2"))
     for i, axis in enumerate(pr["axes"]):
         rows.append((f"axis {i + 1}", _vec(axis)))
+    if "radii_of_gyration" in pr:
+        rows.append(("radii of gyration", f"{_vec(pr['radii_of_gyration'])} m"))
     cls = doc["classification"]
     kind = cls["kind"] + (f" ({cls['shape']})" if "shape" in cls else "")
     rows.append(("class", kind))
     if "asymmetry" in cls:
         rows.append(("asymmetry kappa", _fmt(cls["asymmetry"])))
     rows.append(("planar", str(cls["planar"]).lower()))
+    rows += _v11_rows(doc)
     if "reference_inertia" in doc:
         ref = doc["reference_inertia"]
         for i, row in enumerate(ref["tensor"]):

@@ -24,6 +24,7 @@ __all__ = [
     "PayloadTooLargeError",
     "ComputeTimeoutError",
     "UnauthorizedError",
+    "InvalidInertiaError",
 ]
 
 
@@ -102,3 +103,9 @@ class ComputeTimeoutError(ServiceError):
 
 class UnauthorizedError(ServiceError):
     code = "unauthorized"
+
+
+class InvalidInertiaError(ServiceError):
+    """The body's inertia is one a simulator would refuse to load (robotics export)."""
+
+    code = "invalid_inertia"
