@@ -20,12 +20,12 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import NDArray
 
-from .classify import Classification, classify
+from .classification import Classification, classify
 from .conventions import length_scale
 from .errors import InvalidParameterError
 from .load import Loaded, load_body, load_points
 from .mass import InertiaTensor, MassProperties, Model, assembly_properties, mass_properties
-from .principal import PrincipalFrame, principal_frame
+from .principal import PrincipalFrame, principal_frame, tensor_frame
 from .tolerances import DEFAULT_TOLERANCES, EPS
 
 if TYPE_CHECKING:
@@ -165,15 +165,52 @@ class AnalysisResult:
 
 
 def analyze(
-    source: bytes | str | os.PathLike[str],
+    source: bytes | str | os.PathLike[str] | Any,
     *,
     filename: str | None = None,
     options: AnalysisOptions = AnalysisOptions(),
 ) -> AnalysisResult:
-    """Analyse a mesh or points file (bytes, or a path)."""
+    """Analyse a mesh or points file (bytes, or a path), a ``trimesh.Trimesh``, or ``(vertices, faces)`` arrays.
+
+    Arrays and mesh objects are in ``options.units`` (default metres): vertices (n, 3), faces (m, 3) of
+    vertex indices, a closed surface wound either way.
+    """
     start = time.perf_counter()
-    loaded = load_body(source, filename=filename, format=options.format, units=options.units, isotopes=options.isotopes)
+    if isinstance(source, (bytearray, memoryview)):
+        source = bytes(source)
+    if isinstance(source, (bytes, str, os.PathLike)):
+        loaded = load_body(source, filename=filename, format=options.format, units=options.units,
+                           isotopes=options.isotopes)
+    else:
+        loaded = _loaded_from_arrays(source, filename, options.units)
     return analyze_loaded(loaded, options, start)
+
+
+def _loaded_from_arrays(source: Any, filename: str | None, units: str | None) -> Loaded:
+    """A surface given in memory: an object with ``vertices`` and ``faces`` (trimesh's Trimesh) or a pair."""
+    from .body import MeshBody, Part
+
+    if hasattr(source, "vertices") and hasattr(source, "faces"):
+        vertices, faces, fmt = source.vertices, source.faces, type(source).__name__.lower()
+    elif isinstance(source, (tuple, list)) and len(source) == 2:
+        (vertices, faces), fmt = source, "arrays"
+    else:
+        raise InvalidParameterError(
+            f"cannot analyse a {type(source).__name__}: give a file path, the file's bytes, a trimesh.Trimesh "
+            "or a (vertices, faces) pair of arrays", parameter="source")
+    try:
+        v = np.array(vertices, dtype=np.float64)
+        f = np.array(faces)
+    except (TypeError, ValueError) as exc:
+        raise InvalidParameterError(f"vertices and faces must be numeric arrays: {exc}", parameter="source") from exc
+    if f.dtype.kind not in "iu" and not (f.dtype.kind == "f" and np.array_equal(f, np.round(f))):
+        raise InvalidParameterError("faces must hold whole vertex indices", parameter="source")
+    try:
+        body = MeshBody(v, f.astype(np.int64), length_scale(units or "m"), filename or "body")
+    except ValueError as exc:  # shapes
+        raise InvalidParameterError(f"{exc}; got vertices {v.shape} and faces {f.shape}", parameter="source") from exc
+    name = filename or "body"
+    return Loaded((Part(name, body),), filename, fmt, "mesh", units or "m", "request" if units else "default")
 
 
 def analyze_points(records: list[dict[str, Any]], options: AnalysisOptions = AnalysisOptions()) -> AnalysisResult:
@@ -188,6 +225,14 @@ def analyze_loaded(loaded: Loaded, options: AnalysisOptions, start: float | None
     start = time.perf_counter() if start is None else start
     if loaded.kind == "points" and options.model == Model.SHELL:
         raise InvalidParameterError("model=shell applies to surface meshes, not point masses", parameter="model")
+    _check_part_names(loaded, options)
+    if loaded.kind == "mesh" and len(loaded.parts) > 1 and options.model == Model.SOLID and not options.densities:
+        # open parts that close together become one body (with per-part densities they stay apart, and
+        # an open part is refused by name: one body cannot hold two materials)
+        from .seams import join_open_parts
+
+        parts_joined, _ = join_open_parts(list(loaded.parts))
+        loaded = replace(loaded, parts=tuple(parts_joined))
     single = len(loaded.parts) == 1
     part_results = tuple(_part(p.name, p.body, options, single) for p in loaded.parts)
     factor = 1.0
@@ -206,6 +251,9 @@ def analyze_loaded(loaded: Loaded, options: AnalysisOptions, start: float | None
     warnings = list(props.warnings)
     if loaded.units_from == "file":
         warnings.append(f"length unit {loaded.units!r} taken from the file")
+    warnings.extend(_unit_warning(loaded))
+    if options.model == Model.SHELL:
+        warnings.extend(_shell_thickness_warning(loaded, options))
     reference = None
     if options.reference is not None:
         reference = props.about(np.asarray(options.reference) * length_scale(loaded.units))
@@ -241,7 +289,7 @@ def _v11_sections(loaded: Loaded, props: MassProperties, frame: PrincipalFrame, 
     if all(a is not None for a in areas):
         out["surface_area"] = math.fsum(a for a in areas if a is not None)
     if any(p.extras.get("molecule") for p in loaded.parts):
-        from .classify import RotorClass
+        from .classification import RotorClass
         from .rotational import rotational_constants
 
         out["rotational_constants"] = rotational_constants(frame.moments, cls.rotor == RotorClass.LINEAR)
@@ -269,13 +317,75 @@ def _v11_sections(loaded: Loaded, props: MassProperties, frame: PrincipalFrame, 
 
 
 def _export(fmt: str, props: MassProperties, frame: PrincipalFrame, cls: Classification, name: str) -> Snippet:
-    from .classify import RotorClass
+    from .classification import RotorClass
     from .export import Inertial, inertial_snippet
 
     body = Inertial(props.mass, props.center_of_mass, props.inertia.matrix, frame.moments, frame.axes,
                     frame.quaternion, linear=cls.rotor == RotorClass.LINEAR,
                     relative_error=props.relative_error_estimate)
     return inertial_snippet(fmt, body, name)
+
+
+def _check_part_names(loaded: Loaded, options: AnalysisOptions) -> None:
+    """Every name in ``densities`` must be a part of the file: a typo never falls back to the default."""
+    if not options.densities:
+        return
+    names = [p.name for p in loaded.parts]
+    unknown = sorted(set(options.densities) - set(names))
+    if unknown:
+        listed = ", ".join(repr(n) for n in names[:20]) + (" ..." if len(names) > 20 else "")
+        raise InvalidParameterError(
+            f"densities names {', '.join(repr(n) for n in unknown)}, which is not a part of this file; "
+            f"its parts are: {listed}", parameter="densities", unknown=unknown, parts=names[:100])
+
+
+def _extent(body: Any) -> NDArray[np.float64] | None:
+    """Bounding-box side lengths of a mesh or volume body [m]; None for point sets."""
+    coords = getattr(body, "vertices", None)
+    if coords is None:
+        coords = getattr(body, "points", None)
+    if coords is None or not len(coords):
+        return None
+    extent: NDArray[np.float64] = (coords.max(axis=0) - coords.min(axis=0)) * body.length_scale
+    return extent
+
+
+def _unit_warning(loaded: Loaded) -> list[str]:
+    """A file with no length unit, read as metres, that is implausibly large for a part: say so."""
+    if loaded.units_from != "default" or loaded.kind == "points":
+        return []
+    sizes = [e for e in (_extent(p.body) for p in loaded.parts) if e is not None]
+    if not sizes:
+        return []
+    diagonal = float(np.linalg.norm(np.max(sizes, axis=0)))
+    if diagonal <= DEFAULT_TOLERANCES.metres_plausible:
+        return []
+    return [f"the file declares no length unit and none was given, so it was read in metres: the part is "
+            f"{diagonal:.4g} m across; if it was drawn in millimetres, pass units=mm (CLI: --units mm), "
+            f"which divides the mass by 1e9"]
+
+
+def _shell_thickness_warning(loaded: Loaded, options: AnalysisOptions) -> list[str]:
+    """The thin-shell model needs a wall much thinner than the part: refuse a thicker one, warn near it."""
+    assert options.thickness is not None  # AnalysisOptions requires it for shells
+    thickness = options.thickness * length_scale(loaded.units)
+    out: list[str] = []
+    for part in loaded.parts:
+        extent = _extent(part.body)
+        if extent is None:
+            continue
+        size = float(np.linalg.norm(extent))
+        ratio = thickness / size
+        where = f" ({part.name})" if len(loaded.parts) > 1 else ""
+        if ratio >= DEFAULT_TOLERANCES.shell_thickness_max:
+            raise InvalidParameterError(
+                f"thickness {thickness:.4g} m is {ratio:.3g} times the part's size{where} ({size:.4g} m across): "
+                f"a thin shell needs a wall much thinner than the part; check thickness and units, or analyse "
+                f"it as a solid", parameter="thickness", thickness_m=thickness, size_m=size)
+        if ratio >= DEFAULT_TOLERANCES.shell_thickness_warn:
+            out.append(f"thickness {thickness:.4g} m is {100 * ratio:.2g}% of the part's size{where}: the thin-shell "
+                       f"model (mass = area x thickness x density) is only approximate for so thick a wall")
+    return out
 
 
 def _part_density(name: str, options: AnalysisOptions) -> float | None:
@@ -414,7 +524,9 @@ def precession(
             matrix = np.asarray(inertia_tensor, dtype=np.float64)
         except (TypeError, ValueError) as exc:
             raise InvalidParameterError("inertia_tensor must be a 3x3 array of numbers", parameter="inertia_tensor") from exc
-        frame = PrincipalFrame.from_tensor(matrix, tolerance)
+        # the estimate comes from the eigenproblem's conditioning: ~17 eps I3 / Ii for moment i
+        solved = tensor_frame(matrix, tolerance)
+        frame, estimate, notes = solved.frame, solved.relative_error_estimate, solved.warnings
     else:
         try:
             moments = np.asarray(principal_moments, dtype=np.float64)
@@ -423,6 +535,8 @@ def precession(
         if moments.shape != (3,) or not np.all(np.isfinite(moments)):
             raise InvalidParameterError("principal_moments must be three finite numbers", parameter="principal_moments")
         frame = PrincipalFrame.from_tensor(np.diag(moments), tolerance)
+        estimate, notes = 8 * EPS, ()  # the moments as given: only the motion's own arithmetic
     cls = classify(frame)
     motion = _motion(frame, cls, options)
-    return PrecessionResult(frame, cls, motion, 8 * EPS, time.perf_counter() - start, tuple(motion.warnings))
+    warnings = tuple(dict.fromkeys((*notes, *motion.warnings)))
+    return PrecessionResult(frame, cls, motion, max(estimate, 8 * EPS), time.perf_counter() - start, warnings)

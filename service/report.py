@@ -8,7 +8,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 if TYPE_CHECKING:
-    from .classify import Classification
+    from .classification import Classification
     from .mass import MassProperties
     from .pipeline import AnalysisResult, PartResult, PrecessionResult
     from .principal import PrincipalFrame

@@ -8,7 +8,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy.spatial.transform import Rotation
 
-from inertia.classify import RotorClass, classify, ray_asymmetry
+from inertia.classification import RotorClass, classify, ray_asymmetry
 from inertia.conventions import matrix_from_quaternion
 from inertia.errors import InvalidParameterError
 from inertia.principal import PrincipalFrame, jacobi_eigh

@@ -8,6 +8,7 @@ from dataclasses import dataclass
 from ..body import Body, MeshBody, Part, PointBody, VolumeBody
 from ..conventions import length_scale
 from ..errors import EmptyGeometryError, UnreadableFileError
+from .guard import check_upload
 from .sniff import FORMATS, POINT_FORMATS, SCENE_FORMATS, SURFACE_FORMATS, VOLUME_FORMATS, sniff_format
 
 XYZ_UNIT = "angstrom"  # the XYZ format's length unit (coordinates in angstrom, as chemistry programs write them)
@@ -88,6 +89,7 @@ def _load_bytes(data: bytes, filename: str | None, format: str | None, units: st
     if not len(data):
         raise EmptyGeometryError("the file is empty; send a mesh with geometry", filename=filename)
     fmt = sniff_format(filename, format, bytes(data[:512]))
+    check_upload(data, fmt)  # includes, external references, inflation bounds: before any reader
     xyz_default = fmt == "xyz" and units is None
     if xyz_default:
         units = XYZ_UNIT
@@ -108,9 +110,9 @@ def _load_bytes(data: bytes, filename: str | None, format: str | None, units: st
         parts = [Part(_stem(filename), body, {"molecule": True} if molecule else {})]
         kind = "points"
     elif fmt in VOLUME_FORMATS:
-        from .meshes import read_meshio_parts
+        from .volume import read_volume_parts
 
-        parts = read_meshio_parts(data, fmt, scale)
+        parts = read_volume_parts(data, fmt, scale)
         kind = "volume"
     else:
         from .meshes import read_trimesh_parts
