@@ -25,7 +25,7 @@ from .conventions import length_scale
 from .errors import InvalidParameterError
 from .load import Loaded, load_body, load_points
 from .mass import InertiaTensor, MassProperties, Model, assembly_properties, mass_properties
-from .principal import PrincipalFrame, principal_frame
+from .principal import PrincipalFrame, principal_frame, tensor_frame
 from .tolerances import DEFAULT_TOLERANCES, EPS
 
 if TYPE_CHECKING:
@@ -192,6 +192,13 @@ def analyze_loaded(loaded: Loaded, options: AnalysisOptions, start: float | None
     if loaded.kind == "points" and options.model == Model.SHELL:
         raise InvalidParameterError("model=shell applies to surface meshes, not point masses", parameter="model")
     _check_part_names(loaded, options)
+    if loaded.kind == "mesh" and len(loaded.parts) > 1 and options.model == Model.SOLID and not options.densities:
+        # open parts that close together become one body (with per-part densities they stay apart, and
+        # an open part is refused by name: one body cannot hold two materials)
+        from .seams import join_open_parts
+
+        parts_joined, _ = join_open_parts(list(loaded.parts))
+        loaded = replace(loaded, parts=tuple(parts_joined))
     single = len(loaded.parts) == 1
     part_results = tuple(_part(p.name, p.body, options, single) for p in loaded.parts)
     factor = 1.0
@@ -431,7 +438,9 @@ def precession(
             matrix = np.asarray(inertia_tensor, dtype=np.float64)
         except (TypeError, ValueError) as exc:
             raise InvalidParameterError("inertia_tensor must be a 3x3 array of numbers", parameter="inertia_tensor") from exc
-        frame = PrincipalFrame.from_tensor(matrix, tolerance)
+        # the estimate comes from the eigenproblem's conditioning: ~17 eps I3 / Ii for moment i
+        solved = tensor_frame(matrix, tolerance)
+        frame, estimate, notes = solved.frame, solved.relative_error_estimate, solved.warnings
     else:
         try:
             moments = np.asarray(principal_moments, dtype=np.float64)
@@ -440,6 +449,8 @@ def precession(
         if moments.shape != (3,) or not np.all(np.isfinite(moments)):
             raise InvalidParameterError("principal_moments must be three finite numbers", parameter="principal_moments")
         frame = PrincipalFrame.from_tensor(np.diag(moments), tolerance)
+        estimate, notes = 8 * EPS, ()  # the moments as given: only the motion's own arithmetic
     cls = classify(frame)
     motion = _motion(frame, cls, options)
-    return PrecessionResult(frame, cls, motion, 8 * EPS, time.perf_counter() - start, tuple(motion.warnings))
+    warnings = tuple(dict.fromkeys((*notes, *motion.warnings)))
+    return PrecessionResult(frame, cls, motion, max(estimate, 8 * EPS), time.perf_counter() - start, warnings)
