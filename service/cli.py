@@ -128,7 +128,7 @@ def options_from_args(args: argparse.Namespace) -> Any:
 
 def _parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="inertia", description="Mass properties and free rotation of rigid bodies.")
-    parser.add_argument("--version", action="version", version=f"%(prog)s {_version()}")
+    parser.add_argument("--version", action="version", version=f"%(prog)s {_package_version()}")
     sub = parser.add_subparsers(dest="command", required=True)
 
     a = sub.add_parser("analyze", help="analyse one mesh or points file (.json/.csv/.xyz)")
@@ -176,13 +176,10 @@ def console_main() -> int:
     return code
 
 
-def _version() -> str:
-    from importlib.metadata import PackageNotFoundError, version
+def _package_version() -> str:
+    from . import __version__
 
-    try:
-        return version("inertia-service")
-    except PackageNotFoundError:  # run from a checkout that was never installed
-        return "unknown"
+    return str(__version__)
 
 
 def joined_negative_values(argv: Sequence[str]) -> list[str]:
