@@ -230,7 +230,7 @@ def test_motion_animates_and_shows_the_tennis_racket_flips(console_page: tuple[A
 def test_motion_without_duration_asks_for_a_few_periods(console_page: tuple[Any, Console], server: Server) -> None:
     page, _ = console_page
     open_page(page, server)
-    assert analyze(page, SAMPLES / "hex_prism.stl", omega="0.2,0.1,1") == "ready"
+    assert analyze(page, SAMPLES / "tetrahedron.stl", omega="0.2,0.1,1") == "ready"
     result = page.evaluate("window.inertiaPage.result")
     trajectory = page.evaluate("window.inertiaPage.trajectory")
     assert result["precession"]["regime"] == "regular_precession"
