@@ -225,7 +225,7 @@ export class Viewer {
         new THREE.LineDashedMaterial({ color: AXIS_COLORS[i], dashSize: 0.04 * R, gapSize: 0.03 * R }));
       back.computeLineDistances();
       this.layers.axes.add(back);
-      const tag = label(`I${i + 1}`, AXIS_COLORS[i], 0.22 * R);
+      const tag = label(`I${i + 1}`, AXIS_COLORS[i], 0.3 * R);
       tag.position.copy(dir.clone().multiplyScalar(L * 1.1));
       this.layers.axes.add(tag);
     });
@@ -273,7 +273,7 @@ export class Viewer {
     const omegaMax = Math.max(...traj.omega.map((w) => Math.hypot(...w)), 1e-300);
     if (M.length() > 0) {
       this.fixed.add(arrow(M, 1.5 * R, '#c2410c', 0.012 * R));
-      const tag = label('M', '#c2410c', 0.22 * R);
+      const tag = label('M', '#c2410c', 0.3 * R);
       tag.position.copy(M.clone().normalize().multiplyScalar(1.62 * R));
       this.fixed.add(tag);
     }
@@ -281,7 +281,7 @@ export class Viewer {
     const tips = traj.omega.map((w) => new THREE.Vector3(...w).multiplyScalar(1.15 * R / omegaMax));
     this.fixed.add(new THREE.Line(new THREE.BufferGeometry().setFromPoints(tips), new THREE.LineBasicMaterial({ color: '#7c3aed' })));
     this.omegaArrow = new THREE.Group();
-    this.omegaTag = label('Ω', '#7c3aed', 0.2 * R);
+    this.omegaTag = label('Ω', '#7c3aed', 0.28 * R);
     this.fixed.add(this.omegaArrow, this.omegaTag);
     const w0 = new THREE.Vector3(...traj.omega[0]);
     if (p.regime === 'regular_precession' && result.classification.symmetry_axis && M.length() > 0 && w0.length() > 0) {

@@ -346,3 +346,26 @@ def test_api_docs_render_offline(console_page: tuple[Any, Console], server: Serv
     for endpoint in ("/v1/analyze/points", "/v1/precession", "/v1/batch", "/v1/formats"):
         assert endpoint in page.inner_text("body")
     assert console.external == []
+
+
+WATER_XYZ = """3
+water, experimental equilibrium geometry (angstrom)
+O  0.000000  0.000000  0.117300
+H  0.000000  0.757200 -0.469200
+H  0.000000 -0.757200 -0.469200
+"""
+
+
+def test_a_pasted_xyz_molecule_is_the_apis_xyz_file(console_page: tuple[Any, Console], server: Server, tmp_path: Path) -> None:
+    page, _ = console_page
+    open_page(page, server)
+    page.click("#paste-box summary")
+    page.fill("#paste", WATER_XYZ)
+    assert analyze(page) == "ready"
+    path = tmp_path / "water.xyz"
+    path.write_text(WATER_XYZ)
+    result = api_mesh(server, path)
+    assert_numbers_match(page, {**result, "source": {**result["source"], "filename": "pasted.xyz"}})
+    if "rotational_constants" in result:
+        assert "MHz" in page.inner_text("[data-row=rotational_constants]")
+    assert page.evaluate("window.inertiaPage.viewer.layers.body.children.length") == 3  # one sphere per atom
