@@ -26,6 +26,7 @@ __all__ = [
     "PayloadTooLargeError",
     "ComputeTimeoutError",
     "UnauthorizedError",
+    "InvalidInertiaError",
     "ServerBusyError",
 ]
 
@@ -119,6 +120,12 @@ class ComputeTimeoutError(ServiceError):
 
 class UnauthorizedError(ServiceError):
     code = "unauthorized"
+
+
+class InvalidInertiaError(ServiceError):
+    """The body's inertia is one a simulator would refuse to load (robotics export)."""
+
+    code = "invalid_inertia"
 
 
 class ServerBusyError(ServiceError):

@@ -1,12 +1,7 @@
 """Principal frame: ascending principal moments, right-handed principal axes.
 
-The eigen-decomposition is a cyclic Jacobi method on the 3x3 tensor.  Jacobi
-rotations compute every eigenvalue of a positive (semi-)definite matrix to
-high *relative* accuracy (Demmel & Veselic, SIAM J. Matrix Anal. Appl. 13,
-1992), unlike a tridiagonal QR whose error is relative to the largest moment:
-that matters for the smallest moment of a needle, which can be 1e-12 of the
-largest.  It is also a fixed sequence of float operations, so results are
-bit-identical on every run.
+The eigen-decomposition is ``eigen.jacobi_eigh``, a cyclic Jacobi method with
+high relative accuracy for every moment, the smallest of a needle included.
 """
 
 from __future__ import annotations
@@ -19,13 +14,14 @@ from numpy.typing import NDArray
 
 from .arrays import freeze_fields
 from .conventions import orient_axes, quaternion_from_matrix
+from .eigen import jacobi_eigh
 from .errors import InvalidParameterError
-from .tolerances import DEFAULT_TOLERANCES, EPS, Tolerances
+from .tolerances import DEFAULT_TOLERANCES, EPS
 
 if TYPE_CHECKING:
     from .mass import MassProperties
 
-__all__ = ["PrincipalFrame", "principal_frame", "jacobi_eigh", "equal_moment_pairs", "TensorFrame", "tensor_frame",
+__all__ = ["PrincipalFrame", "principal_frame", "equal_moment_pairs", "TensorFrame", "tensor_frame",
            "TENSOR_ERROR_FACTOR"]
 
 TENSOR_ERROR_FACTOR = 17 * EPS
@@ -40,54 +36,6 @@ input's own entries (each float64 entry is within half an ulp of the tensor
 the user meant).  The Frobenius norm is at least the largest moment, so the
 bound is ~17 eps I3 whatever the orientation: relative to moment i it is
 ~17 eps I3 / Ii, large for the smallest moment of a needle-like tensor."""
-
-_PAIRS = ((0, 1), (0, 2), (1, 2))
-
-
-def jacobi_eigh(
-    matrix: NDArray[np.float64], tolerances: Tolerances = DEFAULT_TOLERANCES
-) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """Eigenvalues (unsorted) and eigenvectors (as rows) of a symmetric 3x3 matrix.
-
-    Cyclic Jacobi with the rotation formulas of Rutishauser (Numer. Math. 9,
-    1966): t = sgn(theta) / (|theta| + sqrt(theta^2 + 1)), which keeps |angle|
-    <= pi/4 so that nearly diagonal input is barely rotated.
-    """
-    a = np.array(matrix, dtype=np.float64)
-    a = 0.5 * (a + a.T)
-    v = np.eye(3)
-    for _ in range(tolerances.jacobi_max_sweeps):
-        if _off_diagonal_negligible(a, tolerances.jacobi_rel):
-            break
-        for p, q in _PAIRS:
-            _rotate(a, v, p, q)
-    return np.diag(a).copy(), v.T.copy()
-
-
-def _off_diagonal_negligible(a: NDArray[np.float64], rel: float) -> bool:
-    for p, q in _PAIRS:
-        scale = np.sqrt(abs(a[p, p] * a[q, q]))
-        if abs(a[p, q]) > rel * scale and a[p, q] != 0.0:
-            return False
-    return True
-
-
-def _rotate(a: NDArray[np.float64], v: NDArray[np.float64], p: int, q: int) -> None:
-    apq = a[p, q]
-    if apq == 0.0:
-        return
-    theta = (a[q, q] - a[p, p]) / (2.0 * apq)
-    t = np.copysign(1.0, theta) / (abs(theta) + np.sqrt(theta * theta + 1.0))
-    c = 1.0 / np.sqrt(t * t + 1.0)
-    s = t * c
-    rot = np.eye(3)
-    rot[p, p] = c
-    rot[q, q] = c
-    rot[p, q] = s
-    rot[q, p] = -s
-    a[:] = rot.T @ a @ rot
-    a[p, q] = a[q, p] = 0.0
-    v[:] = v @ rot
 
 
 @dataclass(frozen=True, slots=True)
