@@ -81,12 +81,12 @@ def row_ids(rows: NDArray[np.unsignedinteger] | Sequence[NDArray[np.unsignedinte
     is_head = np.zeros(n, dtype=bool)
     is_head[firsts] = True
     heads = np.flatnonzero(is_head)
-    index = np.int32 if n < 2**31 else np.int64
-    group_rank = np.cumsum(is_head, dtype=index)[firsts]  # hash-order group -> first-occurrence number + 1
-    group_rank -= 1
+    index: type[np.signedinteger] = np.int32 if n < 2**31 else np.int64
+    group_rank: NDArray[np.signedinteger] = np.cumsum(is_head, dtype=index)[firsts]
+    group_rank -= 1  # hash-order group -> its number in order of first occurrence
     del is_head, firsts
-    group = np.cumsum(new, dtype=index)  # hash-order group of each sorted row
-    group -= 1
+    group: NDArray[np.signedinteger] = np.cumsum(new, dtype=index)
+    group -= 1  # hash-order group of each sorted row
     del new
     ids = np.empty(n, dtype=np.int64)
     for start in range(0, n, SCATTER_CHUNK):
@@ -158,7 +158,7 @@ def _equal_neighbours(table: NDArray[np.unsignedinteger], order: NDArray[np.int6
     k = table.shape[1]
     records = table.view(np.dtype((np.void, table.dtype.itemsize * k))).reshape(-1)
     gathered = records.take(order).view(table.dtype).reshape(-1, k)
-    same = gathered[1:, 0] == gathered[:-1, 0]
+    same: NDArray[np.bool_] = gathered[1:, 0] == gathered[:-1, 0]
     for j in range(1, k):
         same &= gathered[1:, j] == gathered[:-1, j]
     return same
