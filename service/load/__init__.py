@@ -3,14 +3,16 @@
 from __future__ import annotations
 
 import os
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
 from ..body import Body, MeshBody, Part, PointBody, VolumeBody
 from ..conventions import length_scale
 from ..errors import EmptyGeometryError, UnreadableFileError
+from .files import split_upload, unzipped
 from .sniff import FORMATS, POINT_FORMATS, SCENE_FORMATS, SURFACE_FORMATS, VOLUME_FORMATS, sniff_format
 
-__all__ = ["Loaded", "load_body", "load_points", "FORMATS", "SURFACE_FORMATS", "VOLUME_FORMATS", "SCENE_FORMATS"]
+__all__ = ["Loaded", "load_body", "load_files", "load_points", "FORMATS", "SURFACE_FORMATS", "VOLUME_FORMATS", "SCENE_FORMATS"]
 
 
 @dataclass(frozen=True, slots=True)
@@ -39,19 +41,50 @@ class Loaded:
 
 
 def load_body(
-    source: bytes | str | os.PathLike[str],
+    source: bytes | str | os.PathLike[str] | Sequence[tuple[str, bytes]],
     *,
     filename: str | None = None,
     format: str | None = None,
     units: str | None = None,
 ) -> Loaded:
-    """Read a mesh or points file (bytes or a path) into bodies in file units."""
+    """Read a mesh or points file (bytes or a path) into bodies in file units.
+
+    source may also be several files of one upload, as (name, bytes) pairs, or
+    a ``.zip`` holding them (``filename`` ending in .zip, or ``format="zip"``):
+    one mesh and its companion files, such as a TetGen ``.ele`` with its
+    ``.node`` (see ``files.split_upload``).
+    """
     if isinstance(source, (str, os.PathLike)):
         path = os.fspath(source)
         filename = filename or os.path.basename(path)
+        if _is_zip(filename, format):
+            with open(path, "rb") as fh:
+                return load_files(unzipped(fh.read(), filename), format=None if format == "zip" else format, units=units)
         return _load_path(path, filename, format, units)
-    data = source if isinstance(source, bytes) else bytes(source)
-    return _load_bytes(data, filename, format, units)
+    if isinstance(source, (bytes, bytearray, memoryview)):
+        data = bytes(source)
+        if _is_zip(filename, format):
+            return load_files(unzipped(data, filename), format=None if format == "zip" else format, units=units)
+        return _load_bytes(data, filename, format, units)
+    return load_files(source, format=format, units=units)
+
+
+def load_files(files: Sequence[tuple[str, bytes]], *, format: str | None = None, units: str | None = None) -> Loaded:
+    """One mesh uploaded as several files: (name, bytes) pairs, the mesh and its companions.
+
+    The mesh is the one file whose name has a readable format (``format``
+    picks among several); the others are handed to its reader under their
+    own names (a TetGen ``.ele`` finds its ``.node``).
+    """
+    name, data, companions = split_upload(files, format)
+    return _load_bytes(data, name, format, units, companions)
+
+
+def _is_zip(filename: str | None, format: str | None) -> bool:
+    if format is not None:
+        return format.lower().lstrip(".") == "zip"
+    # by name only: a 3MF is a zip too
+    return bool(filename) and str(filename).lower().endswith(".zip")
 
 
 def _load_path(path: str, filename: str, format: str | None, units: str | None) -> Loaded:
@@ -76,7 +109,8 @@ def _load_path(path: str, filename: str, format: str | None, units: str | None) 
     return Loaded(parts, filename, "stl", "mesh", units or "m", "request" if units else "default")
 
 
-def _load_bytes(data: bytes, filename: str | None, format: str | None, units: str | None) -> Loaded:
+def _load_bytes(data: bytes, filename: str | None, format: str | None, units: str | None,
+                companions: Mapping[str, bytes] | None = None) -> Loaded:
     if not len(data):
         raise EmptyGeometryError("the file is empty; send a mesh with geometry", filename=filename)
     fmt = sniff_format(filename, format, bytes(data[:512]))
@@ -98,7 +132,7 @@ def _load_bytes(data: bytes, filename: str | None, format: str | None, units: st
     elif fmt in VOLUME_FORMATS:
         from .volume import read_volume_parts
 
-        parts = read_volume_parts(data, fmt, scale)
+        parts = read_volume_parts(data, fmt, scale, filename=filename, companions=companions)
         kind = "volume"
     else:
         from .meshes import read_trimesh_parts
@@ -130,7 +164,7 @@ def _rescaled(part: Part, scale: float) -> Part:
     if isinstance(body, MeshBody):
         new: Body = MeshBody(body.vertices, body.faces, scale, body.name, body.warnings, body.welded)
     elif isinstance(body, VolumeBody):
-        new = VolumeBody(body.points, body.tets, body.cell_density, scale, body.name, body.warnings)
+        new = VolumeBody(body.points, body.tets, body.cell_density, scale, body.name, body.warnings, body.cells)
     else:
         assert isinstance(body, PointBody)
         new = PointBody(body.masses, body.positions, scale, body.name, body.warnings)
