@@ -8,7 +8,8 @@ files with raw, base64, zlib and lzma data, but
 - drops voxel cells (VTK type 11) without a word, so a voxel file came back
   as "no 3-D cells",
 - raises ``KeyError`` on quadratic wedges and pyramids (types 26, 27) in both
-  legacy and XML files,
+  legacy and XML files (its table of cell dimensions lacks them; for the
+  other formats we add the two entries, see ``_MESHIO_MISSING_DIMENSIONS``),
 - refuses (or, with other counts, misreads) a legacy file whose cell lists
   hold more node ids than the cell type uses, which VTK reads with the
   first ids of each list,
@@ -40,6 +41,7 @@ import io
 import os
 import re
 import tempfile
+import threading
 import warnings
 from collections.abc import Iterator, Mapping
 from dataclasses import dataclass, field
@@ -177,6 +179,9 @@ def _reason(exc: BaseException, printed: str, tmp_paths: tuple[str, ...]) -> str
 # VTK files through VTK
 
 
+_VTK_LOCK = threading.Lock()
+
+
 def _vtk_missing(label: str, fmt: str) -> UnsupportedFormatError:
     return UnsupportedFormatError(
         f"reading {label} needs VTK's own reader, the optional extra 'vtk': "
@@ -196,8 +201,8 @@ def _read_vtk(data: bytes, fmt: str, label: str) -> _Mesh:
         raise _vtk_missing(label, fmt) from exc
 
     window = vtkStringOutputWindow()
-    previous = vtkOutputWindow.GetInstance()
-    with _upload_dir(data, fmt, None, None) as path:
+    with _VTK_LOCK, _upload_dir(data, fmt, None, None) as path:  # the output window is process-wide
+        previous = vtkOutputWindow.GetInstance()
         try:
             vtkOutputWindow.SetInstance(window)
             # VTK's logger writes errors to stderr beside the output window; it stays off for the process
@@ -217,17 +222,22 @@ def _read_vtk(data: bytes, fmt: str, label: str) -> _Mesh:
         except KeyboardInterrupt:
             raise
         except BaseException as exc:  # VTK's wrappers raise whatever the C++ side threw
-            raise UnreadableFileError(f"could not read {label}: {_reason(exc, window.GetOutput(), (path,))}; "
+            raise UnreadableFileError(f"could not read {label}: {_reason(exc, _text(window.GetOutput()), (path,))}; "
                                       "check that it is a complete VTK file", format=fmt) from exc
         finally:
             vtkOutputWindow.SetInstance(previous)
-        log = _vtk_errors(window.GetOutput(), path)
+        log = _vtk_errors(_text(window.GetOutput()), path)
     if grid is None or (log and grid.GetNumberOfCells() == 0):
         raise UnreadableFileError(f"could not read {label}: {log or 'VTK found no data set in it'}; "
                                   "check that it is a complete, uncorrupted VTK file", format=fmt)
     if log:
         raise UnreadableFileError(f"{label} is damaged: VTK reported '{log}'; re-export it", format=fmt)
     return _mesh_from_grid(grid, vtk_to_numpy, label)
+
+
+def _text(output: str | bytes) -> str:
+    """VTK's log as text (the wrapper hands back bytes when the file's own bytes are in it)."""
+    return output.decode("utf-8", "replace") if isinstance(output, bytes) else output
 
 
 def _vtk_errors(text: str, path: str) -> str:
@@ -312,9 +322,20 @@ def _vtk_density(grid: Any, to_numpy: Any, n_cells: int, label: str) -> NDArray[
 # Other formats through meshio
 
 
+# meshio 5.3.5's table of cell dimensions lacks these 3-D types, so reading them raised KeyError in
+# every format (its readers and node orders know them); the entries are added, never changed
+_MESHIO_MISSING_DIMENSIONS = {"wedge15": 3, "pyramid13": 3, "hexahedron24": 3}
+
+
 def _read_meshio(data: bytes, fmt: str, label: str, filename: str | None,
                  companions: Mapping[str, bytes] | None) -> _Mesh:
     import meshio
+    from meshio import _mesh
+
+    table = getattr(_mesh, "topological_dimension", None)
+    if isinstance(table, dict):
+        for key, dim in _MESHIO_MISSING_DIMENSIONS.items():
+            table.setdefault(key, dim)
 
     with _upload_dir(data, fmt, filename, companions) as path, _quiet() as printed:
         try:
