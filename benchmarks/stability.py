@@ -38,7 +38,7 @@ if str(ROOT) not in sys.path:
     sys.path.insert(0, str(ROOT))
 
 from inertia.body import MeshBody, PointBody, VolumeBody  # noqa: E402
-from inertia.classify import RotorClass, classify  # noqa: E402
+from inertia.classification import RotorClass, classify  # noqa: E402
 from inertia.mass import mass_properties  # noqa: E402
 from inertia.motion import ideal_moments  # noqa: E402
 from inertia.principal import principal_frame  # noqa: E402

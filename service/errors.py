@@ -14,6 +14,7 @@ __all__ = [
     "LoadError",
     "UnsupportedFormatError",
     "UnreadableFileError",
+    "ExternalReferenceError",
     "EmptyGeometryError",
     "InvalidMeshError",
     "NotWatertightError",
@@ -24,6 +25,8 @@ __all__ = [
     "PayloadTooLargeError",
     "ComputeTimeoutError",
     "UnauthorizedError",
+    "InvalidInertiaError",
+    "ServerBusyError",
 ]
 
 
@@ -58,6 +61,12 @@ class UnsupportedFormatError(LoadError):
 
 class UnreadableFileError(LoadError):
     code = "unreadable_file"
+
+
+class ExternalReferenceError(UnreadableFileError):
+    """The file names another file (an include, an external buffer) that did not come with it."""
+
+    code = "external_reference"
 
 
 class EmptyGeometryError(LoadError):
@@ -102,3 +111,15 @@ class ComputeTimeoutError(ServiceError):
 
 class UnauthorizedError(ServiceError):
     code = "unauthorized"
+
+
+class InvalidInertiaError(ServiceError):
+    """The body's inertia is one a simulator would refuse to load (robotics export)."""
+
+    code = "invalid_inertia"
+
+
+class ServerBusyError(ServiceError):
+    """Every compute process is busy and the queue of waiting jobs is full; retry later."""
+
+    code = "server_busy"

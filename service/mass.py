@@ -29,9 +29,9 @@ from .arrays import freeze_fields
 from .body import Body, PointBody, VolumeBody
 from .conventions import DEFAULT_DENSITY
 from .ddouble import rotated
+from .eigen import jacobi_eigh
 from .errors import InvalidParameterError, ZeroVolumeError
 from .integrals import Sums, local_origin, point_sums, simplex_sums
-from .principal import jacobi_eigh
 from .solid import closed_surface
 from .tolerances import DEFAULT_TOLERANCES, EPS, Tolerances
 

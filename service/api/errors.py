@@ -18,6 +18,7 @@ from starlette.responses import JSONResponse
 from ..errors import (
     ComputeTimeoutError,
     DegenerateBodyError,
+    InvalidInertiaError,
     InvalidMeshError,
     InvalidParameterError,
     LoadError,
@@ -38,6 +39,7 @@ STATUS: dict[type[ServiceError], int] = {
     InvalidMeshError: 422,
     DegenerateBodyError: 422,
     InvalidParameterError: 422,
+    InvalidInertiaError: 422,
     PayloadTooLargeError: 413,
     UnauthorizedError: 401,
     ComputeTimeoutError: 503,

@@ -10,7 +10,10 @@ from ..body import Body, MeshBody, Part, PointBody, VolumeBody
 from ..conventions import length_scale
 from ..errors import EmptyGeometryError, UnreadableFileError
 from .files import split_upload, unzipped
+from .guard import check_upload
 from .sniff import FORMATS, POINT_FORMATS, SCENE_FORMATS, SURFACE_FORMATS, VOLUME_FORMATS, sniff_format
+
+XYZ_UNIT = "angstrom"  # the XYZ format's length unit (coordinates in angstrom, as chemistry programs write them)
 
 __all__ = ["Loaded", "load_body", "load_files", "load_points", "FORMATS", "SURFACE_FORMATS", "VOLUME_FORMATS", "SCENE_FORMATS"]
 
@@ -46,30 +49,35 @@ def load_body(
     filename: str | None = None,
     format: str | None = None,
     units: str | None = None,
+    isotopes: str = "standard",
 ) -> Loaded:
     """Read a mesh or points file (bytes or a path) into bodies in file units.
+
+    isotopes : masses of atoms named by element (XYZ, points files): "standard"
+        atomic weights or the most "abundant" isotope.
 
     source may also be several files of one upload, as (name, bytes) pairs, or
     a ``.zip`` holding them (``filename`` ending in .zip, or ``format="zip"``):
     one mesh and its companion files, such as a TetGen ``.ele`` with its
-    ``.node`` (see ``files.split_upload``).
+    ``.node`` (see ``load_files``).
     """
     if isinstance(source, (str, os.PathLike)):
         path = os.fspath(source)
         filename = filename or os.path.basename(path)
         if _is_zip(filename, format):
             with open(path, "rb") as fh:
-                return load_files(unzipped(fh.read(), filename), format=None if format == "zip" else format, units=units)
-        return _load_path(path, filename, format, units)
+                return load_files(unzipped(fh.read(), filename), format=_inner(format), units=units, isotopes=isotopes)
+        return _load_path(path, filename, format, units, isotopes)
     if isinstance(source, (bytes, bytearray, memoryview)):
         data = bytes(source)
         if _is_zip(filename, format):
-            return load_files(unzipped(data, filename), format=None if format == "zip" else format, units=units)
-        return _load_bytes(data, filename, format, units)
-    return load_files(source, format=format, units=units)
+            return load_files(unzipped(data, filename), format=_inner(format), units=units, isotopes=isotopes)
+        return _load_bytes(data, filename, format, units, isotopes)
+    return load_files(source, format=format, units=units, isotopes=isotopes)
 
 
-def load_files(files: Sequence[tuple[str, bytes]], *, format: str | None = None, units: str | None = None) -> Loaded:
+def load_files(files: Sequence[tuple[str, bytes]], *, format: str | None = None, units: str | None = None,
+               isotopes: str = "standard") -> Loaded:
     """One mesh uploaded as several files: (name, bytes) pairs, the mesh and its companions.
 
     The mesh is the one file whose name has a readable format (``format``
@@ -77,7 +85,7 @@ def load_files(files: Sequence[tuple[str, bytes]], *, format: str | None = None,
     own names (a TetGen ``.ele`` finds its ``.node``).
     """
     name, data, companions = split_upload(files, format)
-    return _load_bytes(data, name, format, units, companions)
+    return _load_bytes(data, name, format, units, isotopes, companions)
 
 
 def _is_zip(filename: str | None, format: str | None) -> bool:
@@ -87,7 +95,12 @@ def _is_zip(filename: str | None, format: str | None) -> bool:
     return bool(filename) and str(filename).lower().endswith(".zip")
 
 
-def _load_path(path: str, filename: str, format: str | None, units: str | None) -> Loaded:
+def _inner(format: str | None) -> str | None:
+    """The format of the mesh inside a zip (``format="zip"`` says nothing about it)."""
+    return None if format is None or format.lower().lstrip(".") == "zip" else format
+
+
+def _load_path(path: str, filename: str, format: str | None, units: str | None, isotopes: str = "standard") -> Loaded:
     """A file on disk; a binary STL is read in blocks, never held whole beside its vertices."""
     try:
         fh = open(path, "rb")  # noqa: SIM115  (closed by the with below; only opening errors are caught here)
@@ -98,7 +111,7 @@ def _load_path(path: str, filename: str, format: str | None, units: str | None) 
         fmt = sniff_format(filename, format, head) if head else None
         if fmt != "stl":
             fh.seek(0)
-            return _load_bytes(fh.read(), filename, format, units)
+            return _load_bytes(fh.read(), filename, format, units, isotopes)
         from .stl import read_stl_file
 
         fh.seek(0)
@@ -110,10 +123,14 @@ def _load_path(path: str, filename: str, format: str | None, units: str | None) 
 
 
 def _load_bytes(data: bytes, filename: str | None, format: str | None, units: str | None,
-                companions: Mapping[str, bytes] | None = None) -> Loaded:
+                isotopes: str = "standard", companions: Mapping[str, bytes] | None = None) -> Loaded:
     if not len(data):
         raise EmptyGeometryError("the file is empty; send a mesh with geometry", filename=filename)
     fmt = sniff_format(filename, format, bytes(data[:512]))
+    check_upload(data, fmt, tuple(companions or ()))  # includes, external references, inflation bounds: before any reader
+    xyz_default = fmt == "xyz" and units is None
+    if xyz_default:
+        units = XYZ_UNIT
     requested = None if units is None else (units, length_scale(units))
     scale = requested[1] if requested else 1.0
 
@@ -125,9 +142,10 @@ def _load_bytes(data: bytes, filename: str | None, format: str | None, units: st
         parts = [Part(_stem(filename), MeshBody(vertices, faces, scale, _stem(filename), welded=True))]
         kind = "mesh"
     elif fmt in POINT_FORMATS:
-        from .points import read_points_file
+        from .points import read_points
 
-        parts = [Part(_stem(filename), read_points_file(data, fmt, scale))]
+        body, molecule = read_points(data, fmt, scale, isotopes=isotopes)
+        parts = [Part(_stem(filename), body, {"molecule": True} if molecule else {})]
         kind = "points"
     elif fmt in VOLUME_FORMATS:
         from .volume import read_volume_parts
@@ -140,7 +158,9 @@ def _load_bytes(data: bytes, filename: str | None, format: str | None, units: st
         parts, declared = read_trimesh_parts(data, fmt, scale)
         kind = "mesh"
 
-    if requested:
+    if xyz_default:
+        unit, units_from = XYZ_UNIT, "default"
+    elif requested:
         unit, units_from = requested[0], "request"
     elif declared:
         unit, units_from = declared, "file"
@@ -150,13 +170,15 @@ def _load_bytes(data: bytes, filename: str | None, format: str | None, units: st
     return Loaded(tuple(parts), filename, fmt, kind, unit, units_from)
 
 
-def load_points(records: list[dict[str, object]], units: str | None = None) -> Loaded:
-    """Point masses given as records ``{"mass": m, "position": [x, y, z]}``."""
-    from .points import points_from_records
+def load_points(records: list[dict[str, object]], units: str | None = None, *,
+                isotopes: str = "standard", mass_unit: str = "kg") -> Loaded:
+    """Point masses given as records ``{"mass": m, "position": [x, y, z]}`` (or ``"element"``)."""
+    from .points import names_elements, points_from_records
 
     unit = units or "m"
-    body = points_from_records(records, length_scale(unit))
-    return Loaded((Part("points", body),), None, "points", "points", unit, "request" if units else "default")
+    body = points_from_records(records, length_scale(unit), isotopes=isotopes, mass_unit=mass_unit)
+    extras: dict[str, object] = {"molecule": True} if names_elements(records) else {}
+    return Loaded((Part("points", body, extras),), None, "points", "points", unit, "request" if units else "default")
 
 
 def _rescaled(part: Part, scale: float) -> Part:

@@ -7,6 +7,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+
 from inertia import load_body
 from inertia.body import VolumeBody
 from inertia.mass import mass_properties

@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
+
 from inertia.body import CellBlock, VolumeBody
 from inertia.cells import CELL_NODES, cell_rule, shape_functions
 from inertia.mass import assembly_properties, mass_properties

@@ -17,6 +17,7 @@ from pathlib import Path
 import meshio
 import numpy as np
 import pytest
+
 from inertia import load_body
 from inertia.errors import EmptyGeometryError, LoadError, UnreadableFileError, UnsupportedFormatError
 from inertia.load.volume import VTK_CELL_TYPES
