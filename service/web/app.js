@@ -140,10 +140,13 @@ function pointsBody(points, extra = {}) {
 }
 
 // the current input as a request; `extra` adds options (omega, duration, samples, export)
-function buildRequest(extra) {
-  const headers = {};
+function authHeaders() {
   const key = $('apikey').value;
-  if (key) headers['X-API-Key'] = key;
+  return key ? { 'X-API-Key': key } : {};
+}
+
+function buildRequest(extra) {
+  const headers = authHeaders();
   const src = state.source;
   if (src.kind === 'mesh') {
     const form = new FormData();
@@ -217,7 +220,8 @@ async function analyze() {
     const samples = Number(number('samples') ?? DEFAULT_SAMPLES);
     const rq = { inertia_tensor: body.inertia_tensor, omega: motion.omega, duration, samples, method: $('method').value };
     if (number('tolerance') !== undefined) rq.tolerance = Number(number('tolerance'));
-    const answer = await call('v1/precession', { method: 'POST', headers: { 'Content-Type': 'application/json' }, body: JSON.stringify(rq) });
+    const headers = { ...authHeaders(), 'Content-Type': 'application/json' };
+    const answer = await call('v1/precession', { method: 'POST', headers, body: JSON.stringify(rq) });
     if (answer.error) showError(fieldOf(answer.error, 'precession'), `motion: ${answer.error.message} (${answer.error.code})`);
     else trajectory = answer.body.precession.trajectory;
   }
@@ -433,8 +437,14 @@ function stop() {
 // ---------- start-up ----------
 
 async function loadFormats() {
-  const { body, error } = await call('v1/formats', {});
-  if (error) { $('formats').textContent = '(the list is not available)'; return; }
+  const { body, error } = await call('v1/formats', { headers: authHeaders() });
+  if (error) {
+    const hint = error.code === 'unauthorized' ? ': this server needs an API key (under "Server")' : '';
+    $('formats').textContent = `(the list is not available${hint})`;
+    if (hint) $('apikey').closest('details').open = true;
+    return;
+  }
+  $('format').length = 1;
   state.formats = body.formats.map((f) => f.format);
   $('formats').textContent = state.formats.join(', ');
   for (const f of body.formats) {
@@ -483,6 +493,7 @@ function wire() {
     const T = state.trajectory.t[state.trajectory.t.length - 1];
     seek(Number($('time').value) / 1000 * T);
   });
+  $('apikey').addEventListener('change', () => { if (state.formats.length === 0) loadFormats(); });
   for (const id of ['body', 'axes', 'ellipsoid', 'cones']) {
     $(`show-${id}`).addEventListener('change', () => state.viewer && state.viewer.setVisible(id, $(`show-${id}`).checked));
   }

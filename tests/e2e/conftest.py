@@ -42,13 +42,14 @@ def chromium_path() -> str | None:
 class Server:
     """``python -m inertia serve`` on a free loopback port."""
 
-    def __init__(self) -> None:
+    def __init__(self, **settings: str) -> None:
         with socket.socket() as s:
             s.bind(("127.0.0.1", 0))
             self.port = int(s.getsockname()[1])
         self.url = f"http://127.0.0.1:{self.port}"
         env = {k: v for k, v in os.environ.items() if not k.startswith("INERTIA_")}
         env["INERTIA_COMPUTE_PROCESSES"] = "1"
+        env.update(settings)
         (ROOT / ".pytest_cache").mkdir(exist_ok=True)
         self.log = open(ROOT / ".pytest_cache" / f"e2e-serve-{self.port}.log", "w+b")  # noqa: SIM115
         self.process = subprocess.Popen(

@@ -369,3 +369,39 @@ def test_a_pasted_xyz_molecule_is_the_apis_xyz_file(console_page: tuple[Any, Con
     if "rotational_constants" in result:
         assert "MHz" in page.inner_text("[data-row=rotational_constants]")
     assert page.evaluate("window.inertiaPage.viewer.layers.body.children.length") == 3  # one sphere per atom
+
+
+def test_a_dropped_file_is_analysed(console_page: tuple[Any, Console], server: Server) -> None:
+    page, _ = console_page
+    open_page(page, server)
+    data = list((SAMPLES / "tetrahedron.stl").read_bytes())
+    transfer = page.evaluate_handle("""(bytes) => {
+      const dt = new DataTransfer();
+      dt.items.add(new File([new Uint8Array(bytes)], 'tetrahedron.stl'));
+      return dt;
+    }""", data)
+    page.dispatch_event("#drop", "dragover", {"dataTransfer": transfer})
+    page.dispatch_event("#drop", "drop", {"dataTransfer": transfer})
+    page.wait_for_selector("body[data-state=ready]")
+    assert_numbers_match(page, api_mesh(server, SAMPLES / "tetrahedron.stl"))
+    assert "tetrahedron.stl" in page.inner_text("#file-formats")
+
+
+def test_a_server_with_an_api_key_is_used_with_the_key(browser: Any, tmp_path: Path) -> None:
+    server = Server(INERTIA_API_KEY="sesame")
+    try:
+        context = browser.new_context()
+        page = context.new_page()
+        console = Console(page, server)
+        open_page(page, server)
+        assert "API key" in page.inner_text("#file-formats")
+        page.fill("#apikey", "sesame")
+        page.dispatch_event("#apikey", "change")
+        page.wait_for_function("window.inertiaPage.formats.length > 0")
+        assert analyze(page, SAMPLES / "box.stl", omega="0.01,1,0.01") == "ready"
+        assert page.evaluate("window.inertiaPage.trajectory.t.length") == 600
+        context.close()
+        assert console.errors == []
+        assert all("401" in e for e in console.http_errors)  # the first look, before the key was given
+    finally:
+        server.stop()
