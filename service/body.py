@@ -39,6 +39,10 @@ class MeshBody:
     vertices : (n, 3) float64, file units.  faces : (m, 3) int64 indices.
     welded : the reader already merged vertices with bit-identical coordinates
         (as ``topology.weld`` does), so the solid path need not weld again.
+    coordinate_eps : unit roundoff of the file's coordinate storage: 2**-24 for
+        float32 (binary STL), 2**-53 by default; each stored coordinate x may be
+        |x| x this from the value the exporter had (``mass`` refuses a body whose
+        volume or moments are within what that resolution can change).
     """
 
     vertices: NDArray[np.float64]
@@ -47,6 +51,7 @@ class MeshBody:
     name: str | None = None
     warnings: tuple[str, ...] = ()
     welded: bool = False
+    coordinate_eps: float = 2.0**-53
 
     def __post_init__(self) -> None:
         v = _frozen(self.vertices, np.float64)

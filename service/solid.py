@@ -39,7 +39,9 @@ def closed_surface(body: MeshBody) -> tuple[NDArray[np.float64], NDArray[np.int6
     if np.any(degenerate):
         faces = faces[~degenerate]  # zero-area faces contribute nothing to any integral
     if len(faces) == 0:
-        raise ZeroVolumeError("every triangle of the mesh is degenerate; the file holds no solid")
+        cause = ("; its float32 coordinates are too coarse at that distance from the origin: export it in float64 "
+                 "or nearer the origin") if body.coordinate_eps >= 2.0**-24 else ""
+        raise ZeroVolumeError(f"every triangle of the mesh is degenerate; the file holds no solid{cause}")
     topo = surface_topology(faces, len(vertices))
     warnings: list[str] = []
     if topo.open_edges:
