@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 from exact import exact_solid
 from generate import box, icosahedron
+
 from inertia.body import MeshBody, Part
 from inertia.errors import NotWatertightError, ZeroVolumeError
 from inertia.mass import mass_properties
