@@ -61,7 +61,8 @@ OFFSET = np.array([0.25, -1.5, 2.0])
 def test_rotated_body_seen_in_its_own_frame_is_the_unrotated_body(client: Any) -> None:
     R = ROTATION.as_matrix()
     x, y, z, w = ROTATION.as_quat()  # scipy: scalar last
-    doc = _post(client, _box_obj(R, R @ OFFSET), frame=f"{float(w)!r},{float(x)!r},{float(y)!r},{float(z)!r}", reference="0.1,0.2,0.3")
+    frame_text = ",".join(repr(float(v)) for v in (w, x, y, z))
+    doc = _post(client, _box_obj(R, R @ OFFSET), frame=frame_text, reference="0.1,0.2,0.3")
     m, tensor = _box_tensor()
     frame = doc["frame"]
     scale = np.abs(tensor).max()
