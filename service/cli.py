@@ -34,6 +34,7 @@ EXIT_CODES = {
     "empty_geometry": 3,
     "not_watertight": 4,
     "zero_volume": 4,
+    "insufficient_precision": 4,
     "invalid_inertia": 4,
     "timeout": 5,
 }
@@ -230,7 +231,12 @@ def _analyze(args: argparse.Namespace) -> int:
             print(f"warning: {w}", file=sys.stderr)
         return 0
     if args.json:
-        print(json.dumps(doc, indent=2, allow_nan=False))
+        try:
+            text = json.dumps(doc, indent=2, allow_nan=False)
+        except ValueError as exc:  # a non-finite number is a bug: say so, never print Infinity or NaN
+            raise InvalidParameterError("the result holds a number that is not finite, which JSON cannot carry; "
+                                        "please report the input") from exc
+        print(text)
     else:
         print(render_table(doc, args.output_units))
     return 0

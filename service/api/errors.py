@@ -37,7 +37,7 @@ STATUS: dict[type[ServiceError], int] = {
     UnsupportedFormatError: 415,
     LoadError: 422,
     InvalidMeshError: 422,
-    DegenerateBodyError: 422,
+    DegenerateBodyError: 422,  # zero_volume, insufficient_precision
     InvalidParameterError: 422,
     InvalidInertiaError: 422,
     PayloadTooLargeError: 413,
