@@ -12,9 +12,10 @@ from fastapi.security import APIKeyHeader
 
 from .compute import ComputePool
 from .errors import install_error_handlers
-from .middleware import AccessLog, Guard
+from .middleware import AccessLog, Guard, LastResort
 from .routes import health, v1
 from .settings import Settings
+from .uploads import Workspace
 
 __all__ = ["create_app"]
 
@@ -37,7 +38,8 @@ def _configure_logging() -> None:
 def create_app(settings: Settings | None = None) -> FastAPI:
     settings = settings or Settings()  # type: ignore[call-arg]  # fields come from INERTIA_* variables
     _configure_logging()
-    pool = ComputePool(settings.compute_processes, settings.timeout_s)
+    pool = ComputePool(settings.compute_processes, settings.timeout_s, settings.max_waiting)
+    workspace = Workspace()
 
     @asynccontextmanager
     async def lifespan(app: FastAPI) -> AsyncIterator[None]:
@@ -46,15 +48,18 @@ def create_app(settings: Settings | None = None) -> FastAPI:
             yield
         finally:
             pool.close()
+            workspace.close()
 
     app = FastAPI(title="inertia", version="1", description=DESCRIPTION, lifespan=lifespan)
     app.state.settings = settings
     app.state.pool = pool
+    app.state.workspace = workspace
     install_error_handlers(app)
     # the key is checked by Guard before the body is read; the dependency only documents it
     security = [Depends(APIKeyHeader(name="X-API-Key", auto_error=False))] if settings.api_key else []
     app.include_router(health)
     app.include_router(v1, dependencies=security)
+    app.add_middleware(LastResort)
     app.add_middleware(Guard, settings=settings)
     app.add_middleware(AccessLog)
     return app
