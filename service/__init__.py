@@ -33,6 +33,13 @@ _HOME = {
 
 
 def __getattr__(name: str) -> Any:
+    if name == "__version__":  # one source: the distribution's metadata, from pyproject.toml
+        from importlib.metadata import PackageNotFoundError, version
+
+        try:
+            return version("inertia-service")
+        except PackageNotFoundError:  # a checkout that was never installed
+            return "0+unknown"
     home = _HOME.get(name)
     if home is None:
         raise AttributeError(f"module 'inertia' has no attribute {name!r}")

@@ -34,6 +34,8 @@ EXIT_CODES = {
     "empty_geometry": 3,
     "not_watertight": 4,
     "zero_volume": 4,
+    "insufficient_precision": 4,
+    "invalid_inertia": 4,
     "timeout": 5,
 }
 EXIT_INTERNAL = 1
@@ -62,6 +64,17 @@ def _triple(text: str) -> tuple[float, float, float]:
         raise argparse.ArgumentTypeError(f"expected three numbers x,y,z but got {text!r}") from None
 
 
+def _quaternion(text: str) -> tuple[float, float, float, float]:
+    parts = text.replace(" ", "").split(",")
+    try:
+        values = [float(v) for v in parts]
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected four numbers w,x,y,z but got {text!r}") from None
+    if len(values) != 4:
+        raise argparse.ArgumentTypeError(f"expected a quaternion w,x,y,z but got {text!r}")
+    return (values[0], values[1], values[2], values[3])
+
+
 def add_analysis_options(p: argparse.ArgumentParser) -> None:
     """Options shared by ``analyze`` and ``batch`` (the API's query parameters)."""
     p.add_argument("--format", help="file format; inferred from the name when absent")
@@ -75,6 +88,11 @@ def add_analysis_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("--reference", type=_triple, metavar="X,Y,Z",
                    help="point (file units): also report the tensor about it; negative values as written: -1,0,0")
     p.add_argument("--densities", help="JSON file: part name -> density (kg/m^3) for files of several parts")
+    p.add_argument("--frame", type=_quaternion, metavar="W,X,Y,Z",
+                   help="unit quaternion carrying a named frame's axes into the file's: also report the centre of "
+                   "mass and tensors along that frame's axes")
+    p.add_argument("--isotopes", choices=("standard", "abundant"), default="standard",
+                   help="atoms named by element (.xyz): standard atomic weights or the most abundant isotope")
 
 
 def options_from_args(args: argparse.Namespace) -> Any:
@@ -103,16 +121,19 @@ def options_from_args(args: argparse.Namespace) -> Any:
         samples=getattr(args, "samples", None),
         method=getattr(args, "method", "exact"),
         densities=densities,
+        export=getattr(args, "export", None),
+        frame=getattr(args, "frame", None),
+        isotopes=getattr(args, "isotopes", "standard"),
     )
 
 
 def _parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="inertia", description="Mass properties and free rotation of rigid bodies.")
-    parser.add_argument("--version", action="version", version=f"%(prog)s {_version()}")
+    parser.add_argument("--version", action="version", version=f"%(prog)s {_package_version()}")
     sub = parser.add_subparsers(dest="command", required=True)
 
-    a = sub.add_parser("analyze", help="analyse one mesh or points file (.json/.csv)")
-    a.add_argument("file", help="mesh, volume mesh or points file (.json/.csv); the format from its name or --format")
+    a = sub.add_parser("analyze", help="analyse one mesh or points file (.json/.csv/.xyz)")
+    a.add_argument("file", help="mesh, volume mesh or points file (.json/.csv/.xyz); the format from its name or --format")
     add_analysis_options(a)
     a.add_argument("--omega", type=_triple, metavar="WX,WY,WZ",
                    help="initial angular velocity, rad/s, input frame (adds the precession section)")
@@ -124,6 +145,8 @@ def _parser() -> argparse.ArgumentParser:
     a.add_argument("--output-units", choices=tuple(OUTPUT_UNITS), default="si",
                    help="units of the table: si (kg, m, kg m^2; default), kg-mm (kg mm^2), g-mm (g mm^2) or g-cm "
                         "(g cm^2); --json stays SI")
+    a.add_argument("--export", choices=("urdf", "sdf", "mjcf"),
+                   help="print only the inertial element of a robot description format (SI units)")
 
     b = sub.add_parser("batch", help="analyse many files, folders or .zip archives into JSONL/CSV/Parquet")
     b.add_argument("paths", nargs="+", help="files, folders (read recursively) or .zip archives")
@@ -154,13 +177,10 @@ def console_main() -> int:
     return code
 
 
-def _version() -> str:
-    from importlib.metadata import PackageNotFoundError, version
+def _package_version() -> str:
+    from . import __version__
 
-    try:
-        return version("inertia-service")
-    except PackageNotFoundError:  # run from a checkout that was never installed
-        return "unknown"
+    return str(__version__)
 
 
 def joined_negative_values(argv: Sequence[str]) -> list[str]:
@@ -204,8 +224,18 @@ def _analyze(args: argparse.Namespace) -> int:
 
     result = analyze(args.file, options=options_from_args(args))
     doc = result.as_dict()
+    if getattr(args, "export", None) and not args.json:
+        print(export_text(doc))
+        for w in doc.get("warnings", []):
+            print(f"warning: {w}", file=sys.stderr)
+        return 0
     if args.json:
-        print(json.dumps(doc, indent=2, allow_nan=False))
+        try:
+            text = json.dumps(doc, indent=2, allow_nan=False)
+        except ValueError as exc:  # a non-finite number is a bug: say so, never print Infinity or NaN
+            raise InvalidParameterError("the result holds a number that is not finite, which JSON cannot carry; "
+                                        "please report the input") from exc
+        print(text)
     else:
         print(render_table(doc, args.output_units))
     return 0
@@ -249,6 +279,33 @@ def _vec(v: Sequence[float]) -> str:
     return "[" + ", ".join(_fmt(x) for x in v) + "]"
 
 
+def export_text(doc: dict[str, Any]) -> str:
+    """The export snippet alone; for several parts, each part's after the whole body's, named in a comment."""
+    export = doc["export"]
+    blocks = [export["text"]]
+    for part in export.get("parts", []):
+        blocks.append(f"<!-- part {part['name'].replace('--', '- -')} -->\n{part['text']}")
+    return "\n".join(blocks)
+
+
+def _v11_rows(doc: dict[str, Any], length: Any, tensor_rows: Any) -> list[tuple[str, str]]:
+    """Rows of the API 1.1 sections: rotational constants and the named frame (in the table's units)."""
+    rows: list[tuple[str, str]] = []
+    rc = doc.get("rotational_constants")
+    if rc is not None:
+        names = "B" if len(rc["MHz"]) == 1 else "A, B, C"
+        rows.append((f"rotational {names}", ", ".join(f"{v:.9g}" for v in rc["MHz"]) + " MHz"))
+        rows.append(("", ", ".join(f"{v:.9g}" for v in rc["cm-1"]) + " cm^-1"))
+    fr = doc.get("frame")
+    if fr is not None:
+        rows.append(("frame (w,x,y,z)", _vec(fr["quaternion"])))
+        rows.append(("  centre of mass", length(fr["center_of_mass"])))
+        rows += tensor_rows("  inertia tensor", fr["inertia_tensor"])
+        if "reference_inertia" in fr:
+            rows += tensor_rows("  about reference", fr["reference_inertia"])
+    return rows
+
+
 def render_table(doc: dict[str, Any], output_units: str = "si") -> str:
     """A readable summary of an analysis result, in ``OUTPUT_UNITS[output_units]`` (SI by default)."""
     (ln, lu), (mn, mu) = OUTPUT_UNITS[output_units]
@@ -269,18 +326,23 @@ def render_table(doc: dict[str, Any], output_units: str = "si") -> str:
         rows.append(("volume", f"{_fmt(doc['volume'] / lu**3)} {ln}^3"))
     if "density" in doc:
         rows.append(("density", f"{_fmt(doc['density'] / mu * lu**3)} {mn}/{ln}^3"))
+    if "surface_area" in doc:
+        rows.append(("surface area", f"{_fmt(doc['surface_area'] / lu**2)} {ln}^2"))
     rows.append(("centre of mass", length(doc["center_of_mass"])))
     rows += tensor_rows("inertia tensor", doc["inertia_tensor"])
     pr = doc["principal"]
     rows.append(("principal moments", f"{_vec([x / (mu * lu * lu) for x in pr['moments']])} {inertia_unit}"))
     for i, axis in enumerate(pr["axes"]):
         rows.append((f"axis {i + 1}", _vec(axis)))
+    if "radii_of_gyration" in pr:
+        rows.append(("radii of gyration", length(pr["radii_of_gyration"])))
     cls = doc["classification"]
     kind = cls["kind"] + (f" ({cls['shape']})" if "shape" in cls else "")
     rows.append(("class", kind))
     if "asymmetry" in cls:
         rows.append(("asymmetry kappa", _fmt(cls["asymmetry"])))
     rows.append(("planar", str(cls["planar"]).lower()))
+    rows += _v11_rows(doc, length, tensor_rows)
     if "reference_inertia" in doc:
         ref = doc["reference_inertia"]
         rows += tensor_rows(f"tensor about {length(ref['point'])}", ref["tensor"])

@@ -20,11 +20,13 @@ __all__ = [
     "NotWatertightError",
     "DegenerateBodyError",
     "ZeroVolumeError",
+    "InsufficientPrecisionError",
     "InvalidParameterError",
     "MotionError",
     "PayloadTooLargeError",
     "ComputeTimeoutError",
     "UnauthorizedError",
+    "InvalidInertiaError",
     "ServerBusyError",
 ]
 
@@ -90,6 +92,14 @@ class ZeroVolumeError(DegenerateBodyError):
     code = "zero_volume"
 
 
+class InsufficientPrecisionError(DegenerateBodyError):
+    """The stored coordinates cannot represent the body: its volume or a moment is within the
+    change their resolution allows (float32 far from the origin, degenerate shells), or the
+    polyhedron they make has a zero or negative principal moment."""
+
+    code = "insufficient_precision"
+
+
 class InvalidParameterError(ServiceError):
     code = "invalid_parameter"
 
@@ -110,6 +120,12 @@ class ComputeTimeoutError(ServiceError):
 
 class UnauthorizedError(ServiceError):
     code = "unauthorized"
+
+
+class InvalidInertiaError(ServiceError):
+    """The body's inertia is one a simulator would refuse to load (robotics export)."""
+
+    code = "invalid_inertia"
 
 
 class ServerBusyError(ServiceError):

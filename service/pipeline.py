@@ -25,11 +25,14 @@ from .conventions import length_scale
 from .errors import InvalidParameterError
 from .load import Loaded, load_body, load_points
 from .mass import InertiaTensor, MassProperties, Model, assembly_properties, mass_properties
-from .principal import PrincipalFrame, principal_frame
+from .principal import PrincipalFrame, principal_frame, tensor_frame
 from .tolerances import DEFAULT_TOLERANCES, EPS
 
 if TYPE_CHECKING:
+    from .export import Snippet
+    from .frames import NamedFrame
     from .motion import FreeMotion
+    from .rotational import RotationalConstants
 
 __all__ = ["AnalysisOptions", "AnalysisResult", "PartResult", "analyze", "analyze_points",
            "analyze_loaded", "PrecessionResult", "precession"]
@@ -77,6 +80,10 @@ class AnalysisOptions:
     samples: int | None = None
     method: str = "exact"
     densities: Mapping[str, float] | None = None
+    export: str | None = None
+    frame: tuple[float, float, float, float] | None = None
+    isotopes: str = "standard"
+    mass_unit: str = "kg"
 
     def __post_init__(self) -> None:
         if self.units is not None:
@@ -102,6 +109,25 @@ class AnalysisOptions:
         if self.densities is not None:
             for name, rho in self.densities.items():
                 _positive(f"densities[{name!r}]", rho)
+        _check_v11(self)
+
+
+def _check_v11(options: AnalysisOptions) -> None:
+    """The options of API 1.1: export, frame, isotopes, mass_unit."""
+    from .export import EXPORT_FORMATS
+    from .frames import frame_rotation
+
+    if options.export is not None and options.export not in EXPORT_FORMATS:
+        raise InvalidParameterError(f"export must be one of {', '.join(EXPORT_FORMATS)}, got {options.export!r}",
+                                    parameter="export")
+    if options.frame is not None:
+        q, _ = frame_rotation(options.frame)
+        object.__setattr__(options, "frame", tuple(float(v) for v in q))
+    if options.isotopes not in ("standard", "abundant"):
+        raise InvalidParameterError(f"isotopes must be 'standard' or 'abundant', got {options.isotopes!r}",
+                                    parameter="isotopes")
+    if options.mass_unit not in ("kg", "u"):
+        raise InvalidParameterError(f"mass_unit must be 'kg' or 'u', got {options.mass_unit!r}", parameter="mass_unit")
 
 
 @dataclass(frozen=True, slots=True)
@@ -110,6 +136,8 @@ class PartResult:
     props: MassProperties
     frame: PrincipalFrame
     classification: Classification
+    surface_area: float | None = None
+    export: Snippet | None = None
 
 
 @dataclass(frozen=True, slots=True)
@@ -125,6 +153,10 @@ class AnalysisResult:
     parts: tuple[PartResult, ...] | None = None
     warnings: tuple[str, ...] = ()
     elapsed_s: float = 0.0
+    surface_area: float | None = None
+    rotational_constants: RotationalConstants | None = None
+    named_frame: NamedFrame | None = None
+    export: Snippet | None = None
 
     def as_dict(self) -> dict[str, Any]:
         from .report import analysis_dict
@@ -147,7 +179,8 @@ def analyze(
     if isinstance(source, (bytearray, memoryview)):
         source = bytes(source)
     if isinstance(source, (bytes, str, os.PathLike)):
-        loaded = load_body(source, filename=filename, format=options.format, units=options.units)
+        loaded = load_body(source, filename=filename, format=options.format, units=options.units,
+                           isotopes=options.isotopes)
     else:
         loaded = _loaded_from_arrays(source, filename, options.units)
     return analyze_loaded(loaded, options, start)
@@ -181,9 +214,10 @@ def _loaded_from_arrays(source: Any, filename: str | None, units: str | None) ->
 
 
 def analyze_points(records: list[dict[str, Any]], options: AnalysisOptions = AnalysisOptions()) -> AnalysisResult:
-    """Analyse point masses ``[{"mass": m, "position": [x, y, z]}, ...]``."""
+    """Analyse point masses ``[{"mass": m, "position": [x, y, z]}, ...]`` (or ``"element"`` for ``mass``)."""
     start = time.perf_counter()
-    return analyze_loaded(load_points(records, options.units), options, start)
+    loaded = load_points(records, options.units, isotopes=options.isotopes, mass_unit=options.mass_unit)
+    return analyze_loaded(loaded, options, start)
 
 
 def analyze_loaded(loaded: Loaded, options: AnalysisOptions, start: float | None = None) -> AnalysisResult:
@@ -192,6 +226,13 @@ def analyze_loaded(loaded: Loaded, options: AnalysisOptions, start: float | None
     if loaded.kind == "points" and options.model == Model.SHELL:
         raise InvalidParameterError("model=shell applies to surface meshes, not point masses", parameter="model")
     _check_part_names(loaded, options)
+    if loaded.kind == "mesh" and len(loaded.parts) > 1 and options.model == Model.SOLID and not options.densities:
+        # open parts that close together become one body (with per-part densities they stay apart, and
+        # an open part is refused by name: one body cannot hold two materials)
+        from .seams import join_open_parts
+
+        parts_joined, _ = join_open_parts(list(loaded.parts))
+        loaded = replace(loaded, parts=tuple(parts_joined))
     single = len(loaded.parts) == 1
     part_results = tuple(_part(p.name, p.body, options, single) for p in loaded.parts)
     factor = 1.0
@@ -220,6 +261,9 @@ def analyze_loaded(loaded: Loaded, options: AnalysisOptions, start: float | None
     if options.omega is not None:
         motion = _motion(frame, cls, options)
         warnings.extend(motion.warnings)
+    extra = _v11_sections(loaded, props, frame, cls, reference, parts, options, warnings)
+    if parts is not None:
+        parts = extra.pop("parts")
     return AnalysisResult(
         source=_source(loaded, part_results),
         props=props,
@@ -230,7 +274,56 @@ def analyze_loaded(loaded: Loaded, options: AnalysisOptions, start: float | None
         parts=parts,
         warnings=tuple(dict.fromkeys(warnings)),
         elapsed_s=time.perf_counter() - start,
+        **extra,
     )
+
+
+def _v11_sections(loaded: Loaded, props: MassProperties, frame: PrincipalFrame, cls: Classification,
+                  reference: InertiaTensor | None, parts: tuple[PartResult, ...] | None,
+                  options: AnalysisOptions, warnings: list[str]) -> dict[str, Any]:
+    """surface_area, rotational_constants, frame and export (API.md 1.1), each only when it applies."""
+    from .surface import part_surface_area
+
+    areas = [part_surface_area(p) for p in loaded.parts]
+    out: dict[str, Any] = {}
+    if all(a is not None for a in areas):
+        out["surface_area"] = math.fsum(a for a in areas if a is not None)
+    if any(p.extras.get("molecule") for p in loaded.parts):
+        from .classification import RotorClass
+        from .rotational import rotational_constants
+
+        out["rotational_constants"] = rotational_constants(frame.moments, cls.rotor == RotorClass.LINEAR)
+        if out["rotational_constants"] is None:
+            warnings.append("rotational constants need positive principal moments; a single atom has none")
+    if options.frame is not None:
+        from .frames import named_frame
+
+        out["named_frame"] = named_frame(
+            options.frame, props.center_of_mass, props.inertia.matrix,
+            None if reference is None else reference.point, None if reference is None else reference.matrix)
+    if options.export is not None:
+        out["export"] = _export(options.export, props, frame, cls, "")
+        warnings.extend(out["export"].warnings)
+    if parts is not None:
+        new_parts = []
+        for part, area in zip(parts, areas):
+            snippet = None if options.export is None else _export(options.export, part.props, part.frame,
+                                                                  part.classification, part.name)
+            if snippet is not None:
+                warnings.extend(snippet.warnings)
+            new_parts.append(replace(part, surface_area=area, export=snippet))
+        out["parts"] = tuple(new_parts)
+    return out
+
+
+def _export(fmt: str, props: MassProperties, frame: PrincipalFrame, cls: Classification, name: str) -> Snippet:
+    from .classification import RotorClass
+    from .export import Inertial, inertial_snippet
+
+    body = Inertial(props.mass, props.center_of_mass, props.inertia.matrix, frame.moments, frame.axes,
+                    frame.quaternion, linear=cls.rotor == RotorClass.LINEAR,
+                    relative_error=props.relative_error_estimate)
+    return inertial_snippet(fmt, body, name)
 
 
 def _check_part_names(loaded: Loaded, options: AnalysisOptions) -> None:
@@ -369,7 +462,8 @@ def _source(loaded: Loaded, parts: Sequence[PartResult]) -> dict[str, Any]:
     elif loaded.kind == "volume":
         vols = [b for b in bodies if isinstance(b, VolumeBody)]
         out["points"] = len(vols[0].points)
-        out["tetrahedra"] = int(sum(len(b.tets) for b in vols))
+        out["tetrahedra"] = int(sum(len(b.tets) for b in vols))  # linear tetrahedra
+        out["cells"] = int(sum(b.cell_count for b in vols))  # every 3-D cell, each integrated as its element
     else:
         out["points"] = int(sum(len(b.masses) for b in bodies if isinstance(b, PointBody)))
     if loaded.is_assembly:
@@ -431,7 +525,9 @@ def precession(
             matrix = np.asarray(inertia_tensor, dtype=np.float64)
         except (TypeError, ValueError) as exc:
             raise InvalidParameterError("inertia_tensor must be a 3x3 array of numbers", parameter="inertia_tensor") from exc
-        frame = PrincipalFrame.from_tensor(matrix, tolerance)
+        # the estimate comes from the eigenproblem's conditioning: ~17 eps I3 / Ii for moment i
+        solved = tensor_frame(matrix, tolerance)
+        frame, estimate, notes = solved.frame, solved.relative_error_estimate, solved.warnings
     else:
         try:
             moments = np.asarray(principal_moments, dtype=np.float64)
@@ -440,6 +536,8 @@ def precession(
         if moments.shape != (3,) or not np.all(np.isfinite(moments)):
             raise InvalidParameterError("principal_moments must be three finite numbers", parameter="principal_moments")
         frame = PrincipalFrame.from_tensor(np.diag(moments), tolerance)
+        estimate, notes = 8 * EPS, ()  # the moments as given: only the motion's own arithmetic
     cls = classify(frame)
     motion = _motion(frame, cls, options)
-    return PrecessionResult(frame, cls, motion, 8 * EPS, time.perf_counter() - start, tuple(motion.warnings))
+    warnings = tuple(dict.fromkeys((*notes, *motion.warnings)))
+    return PrecessionResult(frame, cls, motion, max(estimate, 8 * EPS), time.perf_counter() - start, warnings)

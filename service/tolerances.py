@@ -25,6 +25,14 @@ class Tolerances:
     """A solid has zero volume when |V| is at most this times the volume of its
     bounding box: flat or degenerate meshes land near 1e-16 (rounding only)."""
 
+    seam_rel: float = 1e-12
+    """Two vertices on open edges of a surface are one seam vertex when they are
+    at most this times the diagonal of the part's bounding box apart.  CAD
+    exporters write one point twice with different rounding (``0.0`` in one
+    triangle, ``-2.7e-16`` in the next): gaps of a few ulps of the coordinates,
+    ~1e-16 of the size; 1e-12 is far above that and far below any real
+    feature or gap a part can have (a 1 m part: 1 pm)."""
+
     jacobi_rel: float = 4 * EPS
     """Off-diagonal entries below this times the geometric mean of their
     diagonal pair are zero in the 3x3 Jacobi eigen-solver (relative accuracy,

@@ -13,6 +13,7 @@ from fastapi.security import APIKeyHeader
 from .compute import ComputePool
 from .errors import install_error_handlers
 from .middleware import AccessLog, Guard, LastResort
+from .pages import install_pages
 from .routes import health, v1
 from .settings import Settings
 from .uploads import Workspace
@@ -50,7 +51,8 @@ def create_app(settings: Settings | None = None) -> FastAPI:
             pool.close()
             workspace.close()
 
-    app = FastAPI(title="inertia", version="1", description=DESCRIPTION, lifespan=lifespan)
+    # docs_url/redoc_url off: install_pages serves both with vendored assets (no CDN)
+    app = FastAPI(title="inertia", version="1", description=DESCRIPTION, lifespan=lifespan, docs_url=None, redoc_url=None)
     app.state.settings = settings
     app.state.pool = pool
     app.state.workspace = workspace
@@ -59,6 +61,7 @@ def create_app(settings: Settings | None = None) -> FastAPI:
     security = [Depends(APIKeyHeader(name="X-API-Key", auto_error=False))] if settings.api_key else []
     app.include_router(health)
     app.include_router(v1, dependencies=security)
+    install_pages(app)
     app.add_middleware(LastResort)
     app.add_middleware(Guard, settings=settings)
     app.add_middleware(AccessLog)

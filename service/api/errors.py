@@ -18,6 +18,7 @@ from starlette.responses import JSONResponse
 from ..errors import (
     ComputeTimeoutError,
     DegenerateBodyError,
+    InvalidInertiaError,
     InvalidMeshError,
     InvalidParameterError,
     LoadError,
@@ -37,8 +38,9 @@ STATUS: dict[type[ServiceError], int] = {
     UnsupportedFormatError: 415,
     LoadError: 422,
     InvalidMeshError: 422,
-    DegenerateBodyError: 422,
+    DegenerateBodyError: 422,  # zero_volume, insufficient_precision
     InvalidParameterError: 422,
+    InvalidInertiaError: 422,
     PayloadTooLargeError: 413,
     UnauthorizedError: 401,
     ComputeTimeoutError: 503,

@@ -45,9 +45,10 @@ INLINE_MAX_POINTS = 1000
 
 @dataclass(frozen=True, slots=True)
 class MeshJob:
-    """One mesh file: its bytes (library and tests) or the path of the parent's private copy (the API)."""
+    """One mesh file: its bytes (library and tests) or the path of the parent's private copy (the API);
+    or several files of one upload (a model and its companions) as ``((client name, path), ...)``."""
 
-    source: bytes | str
+    source: bytes | str | tuple[tuple[str, str], ...]
     filename: str | None
     options: AnalysisOptions
     workdir: str | None = None
@@ -65,15 +66,15 @@ class MeshJob:
 
 def _without_paths(exc: ServiceError, job: MeshJob) -> ServiceError:
     """The error with the server's own file and folder names replaced by the client's file name."""
-    ours = [p for p in (job.source if isinstance(job.source, str) else None, job.workdir,
-                        tempfile.gettempdir()) if p]
     label = job.filename or "the upload"
+    files = job.source if isinstance(job.source, tuple) else ((label, job.source),) if isinstance(job.source, str) \
+        else ()
+    ours = [(path, name) for name, path in files] + [(p, "<temp>") for p in (job.workdir, tempfile.gettempdir()) if p]
 
     def scrub(value: Any) -> Any:
         if isinstance(value, str):
-            for path in ours:
-                value = value.replace(path, label if path != tempfile.gettempdir() else "<temp>")
-            return value
+            for path, name in ours:
+                value = value.replace(path, name)
         return value
 
     exc.message = scrub(exc.message)
@@ -127,10 +128,20 @@ def _temporary_files_in(workdir: str | None) -> Iterator[None]:
         tempfile.tempdir = previous
 
 
-def _load(source: bytes | str, filename: str | None, options: AnalysisOptions) -> Any:
+def _read_files(files: tuple[tuple[str, str], ...]) -> list[tuple[str, bytes]]:
+    out = []
+    for name, path in files:
+        with open(path, "rb") as fh:
+            out.append((name, fh.read()))
+    return out
+
+
+def _load(source: bytes | str | tuple[tuple[str, str], ...], filename: str | None, options: AnalysisOptions) -> Any:
     from ..load import load_body
 
     try:
+        if isinstance(source, tuple):
+            return load_body(_read_files(source), format=options.format, units=options.units)
         return load_body(source, filename=filename, format=options.format, units=options.units)
     except (ServiceError, MemoryError):
         raise

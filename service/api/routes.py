@@ -48,7 +48,9 @@ Pool = Annotated[ComputePool, Depends(_pool)]
 Config = Annotated[Settings, Depends(_settings)]
 Folders = Annotated[Workspace, Depends(_workspace)]
 Options = Annotated[MeshQuery, Query()]
-MeshFile = Annotated[UploadFile, File(description="the mesh file (any format of GET /v1/formats)")]
+MeshFile = Annotated[list[UploadFile], File(description="the mesh file (any format of GET /v1/formats); for a model "
+                                              "with companion files (.gltf + .bin, TetGen .ele + .node), one "
+                                              "'file' part each, or one .zip of them")]
 MeshFiles = Annotated[list[UploadFile], File(description="mesh files, or one .zip of them")]
 
 health = APIRouter()
@@ -89,12 +91,16 @@ async def analyze_mesh(file: MeshFile, query: Options, pool: Pool, settings: Con
                        workspace: Folders) -> dict[str, Any]:
     """Mass properties, principal frame and class of one uploaded mesh (and its precession with omega)."""
     options = query.as_options()
-    name = client_name(file.filename)
     folder = workspace.folder()
-    try:  # the upload goes to a private file in blocks; the compute process gets its path
-        path, size = await run_in_threadpool(save, file.file, folder, 0, settings.max_upload_bytes)
-        limit = memory_limit(size, name, settings.max_job_memory_bytes)
-        return await pool.run(MeshJob(path, name, options, folder, limit))
+    try:  # the upload goes to private files in blocks; the compute process gets their paths
+        saved = [await run_in_threadpool(save, part.file, folder, i, settings.max_upload_bytes)
+                 for i, part in enumerate(file)]
+        names = [client_name(part.filename) for part in file]
+        size = sum(s for _, s in saved)
+        limit = memory_limit(size, names[0] if len(names) == 1 else ".zip", settings.max_job_memory_bytes)
+        source: str | tuple[tuple[str, str], ...] = saved[0][0] if len(saved) == 1 else \
+            tuple((name or f"file-{i}", path) for i, (name, (path, _)) in enumerate(zip(names, saved)))
+        return await pool.run(MeshJob(source, names[0] if len(saved) == 1 else None, options, folder, limit))
     finally:  # after success, error, timeout or a killed process alike: the job's process has stopped using it
         workspace.remove(folder)
 

@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-import os
-
 from pydantic import Field
 from pydantic_settings import BaseSettings, SettingsConfigDict
 
@@ -13,8 +11,10 @@ MIB = 1024 * 1024
 
 
 def _default_processes() -> int:
-    # one compute process per core: the work is CPU-bound numpy
-    return max(1, os.cpu_count() or 1)
+    # one compute process per usable core (the container's CPU quota included): the work is CPU-bound numpy
+    from ..cpus import available_cpus
+
+    return available_cpus()
 
 
 class Settings(BaseSettings):

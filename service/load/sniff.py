@@ -24,7 +24,7 @@ VOLUME_FORMATS = {
 }
 # formats that can hold several named bodies
 SCENE_FORMATS = ("glb", "gltf", "3mf", "obj", "vtu", "vtk", "msh", "mesh", "inp", "xdmf", "med")
-POINT_FORMATS = ("json", "csv")
+POINT_FORMATS = ("json", "csv", "xyz")  # xyz: atoms by element, in angstrom
 FORMATS = SURFACE_FORMATS + tuple(VOLUME_FORMATS)
 
 _ALIASES = {"gmsh": "msh", "stla": "stl", "stlb": "stl", "ascii_stl": "stl"}

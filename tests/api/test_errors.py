@@ -50,7 +50,7 @@ ONE = [{"mass": 1.0, "position": [0, 0, 0]}]
 
 # (error class, code, status, request); the default-settings client
 CASES: list[tuple[type[E.ServiceError], str, int, Callable[[Any], Any]]] = [
-    (E.UnsupportedFormatError, "unsupported_format", 415, mesh(BOX, "part.xyz")),
+    (E.UnsupportedFormatError, "unsupported_format", 415, mesh(BOX, "part.xyz123")),
     (E.UnsupportedFormatError, "unsupported_format", 415, mesh(BOX, format="dwg")),
     (E.UnreadableFileError, "unreadable_file", 422, mesh(TRUNCATED)),
     (E.ExternalReferenceError, "external_reference", 422,
@@ -82,6 +82,7 @@ CASES: list[tuple[type[E.ServiceError], str, int, Callable[[Any], Any]]] = [
     (E.InvalidParameterError, "invalid_parameter", 422, raw("/v1/analyze/points", b'{"points": [')),
     (E.InvalidParameterError, "invalid_parameter", 422,
      raw("/v1/analyze/mesh", b"--x\r\nnot multipart", "multipart/form-data; boundary=y")),
+    (E.InvalidInertiaError, "invalid_inertia", 422, points({"points": ONE, "export": "mjcf"})),
     (E.InvalidParameterError, "invalid_parameter", 422, prec({"omega": [0, 0, 1]})),
     (E.InvalidParameterError, "invalid_parameter", 422,
      prec({"principal_moments": [1, 1, 5], "omega": [0, 0, 1]})),

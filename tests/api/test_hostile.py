@@ -325,3 +325,30 @@ def test_workspace_is_empty_after_requests(client: Any) -> None:
     client.post("/v1/batch", files=[("files", ("a.stl", BOX)), ("files", ("b.zip", b"PK broken"))])
     root = client.app.state.workspace.root
     assert os.listdir(root) == []
+
+
+# --- several files in one upload --------------------------------------------------------------------------
+
+def test_gltf_with_its_buffer_as_a_second_file_part_is_read(client: Any) -> None:
+    import base64
+
+    name, embedded = H.gltf()
+    doc = json.loads(embedded)
+    buffer = base64.b64decode(doc["buffers"][0]["uri"].split(",", 1)[1])
+    doc["buffers"][0]["uri"] = "tet.bin"
+    files = [("file", ("tet.gltf", json.dumps(doc).encode())), ("file", ("tet.bin", buffer))]
+    response = client.post("/v1/analyze/mesh", files=files)
+    assert response.status_code == 200, response.text
+    assert response.json()["mass"] == pytest.approx(1000 / 6, rel=1e-6)  # unit right tetrahedron, float32 corners
+    alone = client.post("/v1/analyze/mesh", files=[files[0]])
+    error_of(alone, 422, "external_reference")
+
+
+def test_abaqus_include_that_comes_in_the_same_upload_is_followed(client: Any) -> None:
+    _, part = H.abaqus()
+    main = b"*HEADING\nassembly\n*INCLUDE, INPUT=part.inc\n"
+    files = [("file", ("deck.inp", main)), ("file", ("part.inc", part))]
+    response = client.post("/v1/analyze/mesh", files=files)
+    assert response.status_code == 200, response.text
+    assert response.json()["mass"] == pytest.approx(1000 / 6, rel=1e-12)  # the unit right tetrahedron
+    error_of(client.post("/v1/analyze/mesh", files=[files[0]]), 422, "external_reference")

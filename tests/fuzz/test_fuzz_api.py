@@ -31,7 +31,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from inertia.api import Settings, create_app
-from inertia.api.compute import MEMORY_FLOOR_BYTES, MEMORY_FACTOR
+from inertia.api.compute import MEMORY_FLOOR_BYTES
 
 from . import hostile as H
 from .corpus import mutate, seeds
