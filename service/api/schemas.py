@@ -100,7 +100,8 @@ class MeshQuery(_Request):
 
     format: str | None = Field(None, description="file format (stl, obj, ply, off, glb, gltf, 3mf, vtu, vtk, msh, "
                                "...); inferred from the file name when absent", examples=["stl"])
-    units: str | None = Field(None, description="length unit of the file: m, cm, mm, um, in, ft (default m)",
+    units: str | None = Field(None, description="length unit of the file: m, cm, mm, um, in, ft, angstrom "
+                              "(default m; angstrom for xyz)",
                               examples=["m"])
     density: float | None = Field(None, gt=0, le=MAX_MAGNITUDE,
                                   description="density [kg/m^3] (default 1000); exclusive with mass")
