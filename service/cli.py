@@ -34,6 +34,7 @@ EXIT_CODES = {
     "empty_geometry": 3,
     "not_watertight": 4,
     "zero_volume": 4,
+    "insufficient_precision": 4,
     "invalid_inertia": 4,
     "timeout": 5,
 }
@@ -77,7 +78,8 @@ def _quaternion(text: str) -> tuple[float, float, float, float]:
 def add_analysis_options(p: argparse.ArgumentParser) -> None:
     """Options shared by ``analyze`` and ``batch`` (the API's query parameters)."""
     p.add_argument("--format", help="file format; inferred from the name when absent")
-    p.add_argument("--units", help="length unit of the file: m, cm, mm, um, in, ft (default: the file's, else m)")
+    p.add_argument("--units", help="length unit of the file: m, cm, mm, um, in, ft, angstrom "
+                   "(default: the file's; angstrom for .xyz; else m)")
     group = p.add_mutually_exclusive_group()
     group.add_argument("--density", type=float, help="density in kg/m^3 (default 1000)")
     group.add_argument("--mass", type=float, help="total mass in kg (density is derived)")
@@ -229,7 +231,12 @@ def _analyze(args: argparse.Namespace) -> int:
             print(f"warning: {w}", file=sys.stderr)
         return 0
     if args.json:
-        print(json.dumps(doc, indent=2, allow_nan=False))
+        try:
+            text = json.dumps(doc, indent=2, allow_nan=False)
+        except ValueError as exc:  # a non-finite number is a bug: say so, never print Infinity or NaN
+            raise InvalidParameterError("the result holds a number that is not finite, which JSON cannot carry; "
+                                        "please report the input") from exc
+        print(text)
     else:
         print(render_table(doc, args.output_units))
     return 0

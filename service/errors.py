@@ -20,6 +20,7 @@ __all__ = [
     "NotWatertightError",
     "DegenerateBodyError",
     "ZeroVolumeError",
+    "InsufficientPrecisionError",
     "InvalidParameterError",
     "MotionError",
     "PayloadTooLargeError",
@@ -89,6 +90,14 @@ class DegenerateBodyError(ServiceError):
 
 class ZeroVolumeError(DegenerateBodyError):
     code = "zero_volume"
+
+
+class InsufficientPrecisionError(DegenerateBodyError):
+    """The stored coordinates cannot represent the body: its volume or a moment is within the
+    change their resolution allows (float32 far from the origin, degenerate shells), or the
+    polyhedron they make has a zero or negative principal moment."""
+
+    code = "insufficient_precision"
 
 
 class InvalidParameterError(ServiceError):

@@ -12,9 +12,10 @@ import itertools
 import mpmath as mp
 import numpy as np
 import pytest
+from scipy.stats import special_ortho_group
+
 from inertia import precession
 from inertia.errors import InvalidParameterError
-from scipy.stats import special_ortho_group
 
 EPS = np.finfo(float).eps
 

@@ -2,10 +2,12 @@
 
 from __future__ import annotations
 
-import inspect
 import os
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, replace
+
+import numpy as np
+from numpy.typing import NDArray
 
 from ..body import Body, MeshBody, Part, PointBody, VolumeBody
 from ..conventions import length_scale
@@ -111,7 +113,7 @@ def _load_path(path: str, filename: str, format: str | None, units: str | None, 
         vertices, faces = read_stl_file(fh, os.fstat(fh.fileno()).st_size)
     scale = 1.0 if units is None else length_scale(units)
     name = _stem(filename)
-    parts = (Part(name, MeshBody(vertices, faces, scale, name, welded=True)),)
+    parts = (Part(name, MeshBody(vertices, faces, scale, name, welded=True, coordinate_eps=stl_eps(vertices))),)
     return Loaded(parts, filename, "stl", "mesh", units or "m", "request" if units else "default")
 
 
@@ -133,7 +135,8 @@ def _load_bytes(data: bytes, filename: str | None, format: str | None, units: st
         from .stl import read_stl
 
         vertices, faces = read_stl(data)
-        parts = [Part(_stem(filename), MeshBody(vertices, faces, scale, _stem(filename), welded=True))]
+        parts = [Part(_stem(filename), MeshBody(vertices, faces, scale, _stem(filename), welded=True,
+                                              coordinate_eps=stl_eps(vertices)))]
         kind = "mesh"
     elif fmt in POINT_FORMATS:
         from .points import read_points
@@ -144,10 +147,7 @@ def _load_bytes(data: bytes, filename: str | None, format: str | None, units: st
     elif fmt in VOLUME_FORMATS:
         from .volume import read_volume_parts
 
-        if companions and "companions" in inspect.signature(read_volume_parts).parameters:
-            parts = read_volume_parts(data, fmt, scale, companions=companions)  # type: ignore[call-arg]
-        else:
-            parts = read_volume_parts(data, fmt, scale)
+        parts = read_volume_parts(data, fmt, scale, filename=filename, companions=companions)
         kind = "volume"
     else:
         from .meshes import read_surface_parts
@@ -185,13 +185,20 @@ def load_points(records: list[dict[str, object]], units: str | None = None, *,
 def _rescaled(part: Part, scale: float) -> Part:
     body = part.body
     if isinstance(body, MeshBody):
-        new: Body = MeshBody(body.vertices, body.faces, scale, body.name, body.warnings, body.welded)
+        new: Body = MeshBody(body.vertices, body.faces, scale, body.name, body.warnings, body.welded,
+                             body.coordinate_eps)
     elif isinstance(body, VolumeBody):
-        new = VolumeBody(body.points, body.tets, body.cell_density, scale, body.name, body.warnings)
+        new = VolumeBody(body.points, body.tets, body.cell_density, scale, body.name, body.warnings, body.cells)
     else:
         assert isinstance(body, PointBody)
         new = PointBody(body.masses, body.positions, scale, body.name, body.warnings)
     return Part(part.name, new, part.extras)
+
+
+def stl_eps(vertices: NDArray[np.float64]) -> float:
+    """Unit roundoff of an STL file's coordinates: float32 (binary STL, or ASCII written from
+    float32) when every coordinate is a float32 value, else float64 (decimal text)."""
+    return 2.0**-24 if bool(np.array_equal(vertices.astype(np.float32), vertices)) else 2.0**-53
 
 
 def _stem(filename: str | None) -> str:

@@ -10,8 +10,9 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from inertia import precession
 from motion_reference import elliptic_reference, euler_taylor_reference
+
+from inertia import precession
 
 EPS = np.finfo(float).eps
 
