@@ -78,7 +78,8 @@ def _quaternion(text: str) -> tuple[float, float, float, float]:
 def add_analysis_options(p: argparse.ArgumentParser) -> None:
     """Options shared by ``analyze`` and ``batch`` (the API's query parameters)."""
     p.add_argument("--format", help="file format; inferred from the name when absent")
-    p.add_argument("--units", help="length unit of the file: m, cm, mm, um, in, ft (default: the file's, else m)")
+    p.add_argument("--units", help="length unit of the file: m, cm, mm, um, in, ft, angstrom "
+                   "(default: the file's; angstrom for .xyz; else m)")
     group = p.add_mutually_exclusive_group()
     group.add_argument("--density", type=float, help="density in kg/m^3 (default 1000)")
     group.add_argument("--mass", type=float, help="total mass in kg (density is derived)")

@@ -126,9 +126,11 @@ class _Geometry:
     """Points + cells of one body in a form the passes can re-integrate."""
 
     def __init__(self, points: NDArray[np.float64], cells: NDArray[np.int64], kind: str,
-                 weight: NDArray[np.float64] | None, coordinate_eps: float = 2.0**-53) -> None:
+                 weight: NDArray[np.float64] | None, coordinate_eps: float = 2.0**-53,
+                 blocks: tuple[QuadBlock, ...] = ()) -> None:
         self.points, self.cells, self.kind, self.weight = points, cells, kind, weight
         self.coordinate_eps = coordinate_eps  # unit roundoff of the stored coordinates (float32: 2**-24)
+        self.blocks = blocks  # volume cells other than linear tetrahedra: (type, nodes, weight), by quadrature
 
     @property
     def referenced_points(self) -> int:
@@ -142,12 +144,30 @@ class _Geometry:
                 if self.kind == "points":
                     assert self.weight is not None
                     return point_sums(self.weight, x)
-                return simplex_sums(x, self.cells, self.kind, self.weight)
+                if not self.blocks:
+                    return simplex_sums(x, self.cells, self.kind, self.weight)
+                return _volume_sums(x, self.cells, self.weight, self.blocks)
         except FloatingPointError as exc:
             raise InvalidParameterError(
                 "the coordinates or masses are so large that the inertia integrals overflow floating point; "
                 "express the input in other units"
             ) from exc
+
+
+QuadBlock = tuple[str, NDArray[np.int64], NDArray[np.float64] | None]
+
+
+def _volume_sums(x: NDArray[np.float64], tets: NDArray[np.int64], weight: NDArray[np.float64] | None,
+                 blocks: tuple[QuadBlock, ...]) -> Sums:
+    """Linear tetrahedra in closed form plus every other cell by its exact quadrature (``cells``)."""
+    from .cells import cell_sums, combined
+
+    total = simplex_sums(x, tets, "tet", weight) if len(tets) else None
+    for name, nodes, w in blocks:
+        part = cell_sums(x, name, nodes, w)
+        total = part if total is None else combined(total, part)
+    assert total is not None
+    return total
 
 
 @dataclass(frozen=True, slots=True)
@@ -337,11 +357,24 @@ def _geometry(body: Body, model: str, thickness: float | None, tolerances: Toler
     if isinstance(body, VolumeBody):
         if model == Model.SHELL:
             raise InvalidParameterError("model=shell needs a surface mesh; a volume mesh is always a solid", parameter="model")
-        return _Geometry(body.points, body.tets, "tet", body.cell_density), ()
+        blocks = tuple((b.type, b.nodes, b.density) for b in body.cells)
+        return _Geometry(body.points, body.tets, "tet", body.cell_density, blocks=blocks), _tangled_warning(body)
     if model == Model.SHELL:
         return _Geometry(body.vertices, body.faces, "tri", None), ()
     vertices, faces, warnings = closed_surface(body)
     return _Geometry(vertices, faces, "apex", None, body.coordinate_eps), warnings
+
+
+def _tangled_warning(body: VolumeBody) -> tuple[str, ...]:
+    if not body.cells:
+        return ()
+    from .cells import tangled_cells
+
+    count = sum(tangled_cells(body.points, b.type, b.nodes) for b in body.cells)
+    if not count:
+        return ()
+    return (f"{count} of {body.cell_count} cells fold over themselves (their Jacobian changes sign); "
+            "each was integrated with its signed Jacobian, so a folded region counts negatively: check the mesh",)
 
 
 def mass_properties(
@@ -381,7 +414,7 @@ def mass_properties(
     else:
         area = None
         volume = s.m0 * L**3
-        weighted = isinstance(body, VolumeBody) and body.cell_density is not None
+        weighted = isinstance(body, VolumeBody) and body.weighted
         if weighted:
             volume = s.measure * L**3
             measure_to_mass = 1.0 if mass is None else mass / (s.m0 * L**3)
@@ -440,7 +473,10 @@ def assembly_properties(
     warnings: list[str] = []
     for body, density in parts:
         geometry, more = _geometry(body, model, thickness, tolerances)
-        geoms.append((geometry, _element_weights(geometry, density, model, thickness, L) * factor))
+        weights = _element_weights(geometry, density, model, thickness, L) * factor
+        geometry.blocks = tuple((name, nodes, _block_weights(w, len(nodes), density) * factor)
+                                for name, nodes, w in geometry.blocks)
+        geoms.append((geometry, weights))
         warnings.extend(more)
     kinds = {g.kind for g, _ in geoms}
     if len(kinds) != 1:
@@ -453,6 +489,7 @@ def assembly_properties(
         kind,
         np.concatenate([w for _, w in geoms]),
         max(g.coordinate_eps for g, _ in geoms),
+        tuple((name, nodes + off, w) for (g, _), off in zip(geoms, offsets) for name, nodes, w in g.blocks),
     )
     refined = _refine(whole, tolerances)
     s, com, tensor, moments, axes, estimate = (refined.sums, refined.com, refined.tensor, refined.moments,
@@ -483,6 +520,13 @@ def _element_weights(geometry: _Geometry, density: float | None, model: str, thi
         assert thickness is not None
         rho = rho * thickness * L
     return np.full(n, rho)
+
+
+def _block_weights(weight: NDArray[np.float64] | None, count: int, density: float | None) -> NDArray[np.float64]:
+    """Density of each cell of a block: its own, or the part's uniform density."""
+    if weight is not None:
+        return np.asarray(weight, dtype=np.float64)
+    return np.full(count, DEFAULT_DENSITY if density is None else density)
 
 
 def _check_finite_results(mass: float, com: NDArray[np.float64], tensor: NDArray[np.float64]) -> None:

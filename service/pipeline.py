@@ -462,7 +462,8 @@ def _source(loaded: Loaded, parts: Sequence[PartResult]) -> dict[str, Any]:
     elif loaded.kind == "volume":
         vols = [b for b in bodies if isinstance(b, VolumeBody)]
         out["points"] = len(vols[0].points)
-        out["tetrahedra"] = int(sum(len(b.tets) for b in vols))
+        out["tetrahedra"] = int(sum(len(b.tets) for b in vols))  # linear tetrahedra
+        out["cells"] = int(sum(b.cell_count for b in vols))  # every 3-D cell, each integrated as its element
     else:
         out["points"] = int(sum(len(b.masses) for b in bodies if isinstance(b, PointBody)))
     if loaded.is_assembly:

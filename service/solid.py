@@ -106,10 +106,11 @@ def _orient_outward(
             return faces[:, [0, 2, 1]], ["inverted winding corrected (all faces pointed inward)"]
         return faces, []
     depth = _nesting_depth(x, faces, label, count)
-    if depth is None:  # a shell touches another: nesting undecidable, keep the file's orientation
+    if isinstance(depth, str):  # nesting undecidable: keep the file's orientation
         if total < 0 and np.all(vol <= 0):
             return faces[:, [0, 2, 1]], ["inverted winding corrected (all faces pointed inward)"]
-        return faces, []
+        return faces, [f"the {count} shells are kept as the file winds them ({depth}, so nesting was not tested); "
+                       f"{int(np.count_nonzero(vol < 0))} of them enclose negative volume (cavities)"]
     want_positive = depth % 2 == 0
     flip_shell = ((vol > 0) != want_positive) & ~flat
     if not np.any(flip_shell):
@@ -129,26 +130,40 @@ def winding_numbers(x: NDArray[np.float64], faces: NDArray[np.int64], points: ND
     The sum of the signed solid angles of the triangles seen from the point
     over 4 pi (van Oosterom & Strackee 1983: tan(Omega/2) = a.(b x c) /
     (|a||b||c| + (a.b)|c| + (a.c)|b| + (b.c)|a|)); an integer for a closed
-    surface and a point off it.
+    surface and a point off it; NaN for a point on (or within 1e-12 of the
+    size of) one of the triangles, where it is undefined.  Evaluated in blocks of points x faces of at
+    most ``_WINDING_BLOCK`` pairs.
     """
-    out = np.empty(len(points))
-    for i, p in enumerate(points):
-        total = 0.0
-        for start in range(0, len(faces), CHUNK):
-            block = faces[start : start + CHUNK]
-            a, b, c = (x[block[:, k]] - p for k in range(3))
-            la, lb, lc = (np.sqrt(np.einsum("ij,ij->i", v, v)) for v in (a, b, c))
-            num = np.einsum("ij,ij->i", a, np.cross(b, c))
-            den = (la * lb * lc + np.einsum("ij,ij->i", a, b) * lc + np.einsum("ij,ij->i", a, c) * lb
-                   + np.einsum("ij,ij->i", b, c) * la)
-            total += float(np.sum(np.arctan2(num, den)))
-        out[i] = total / (2 * np.pi)
-    return out
+    points = np.asarray(points, dtype=np.float64).reshape(-1, 3)
+    out = np.zeros(len(points))
+    tri = [x[faces[:, k]] for k in range(3)]
+    step = max(1, _WINDING_BLOCK // max(1, len(points)))
+    for start in range(0, len(faces), step):
+        a, b, c = (t[None, start : start + step, :] - points[:, None, :] for t in tri)
+        la, lb, lc = (np.sqrt(np.einsum("pfi,pfi->pf", v, v)) for v in (a, b, c))
+        num = np.einsum("pfi,pfi->pf", a, np.cross(b, c))
+        den = (la * lb * lc + np.einsum("pfi,pfi->pf", a, b) * lc + np.einsum("pfi,pfi->pf", a, c) * lb
+               + np.einsum("pfi,pfi->pf", b, c) * la)
+        out += np.arctan2(num, den).sum(axis=1)
+        scale = la * lb * lc
+        on = (np.abs(num) <= 1e-12 * scale) & (den <= 1e-12 * scale)  # in a triangle's plane and inside it
+        out[np.any(on, axis=1)] = np.nan
+    return out / (2 * np.pi)
+
+
+_WINDING_BLOCK = 1 << 18  # point-face pairs per block: ~50 MB of temporaries
+NESTING_WORK_LIMIT = 400_000_000
+"""Most point-triangle pairs the nesting test evaluates (a few seconds); past it, shells keep their stored orientation
+with a warning rather than the request stalling (a part with many thousands of cavities inside a fine outer skin)."""
 
 
 def _nesting_depth(x: NDArray[np.float64], faces: NDArray[np.int64], label: NDArray[np.int64],
-                   count: int) -> NDArray[np.int64] | None:
-    """How many other shells contain each shell; None when a test point lies on another shell."""
+                   count: int) -> NDArray[np.int64] | str:
+    """How many other shells contain each shell, or why that cannot be decided.
+
+    A shell's test point is the centroid of its largest triangle; only shells
+    whose bounding box holds that point are evaluated.
+    """
     lo = np.full((count, 3), np.inf)
     hi = np.full((count, 3), -np.inf)
     for k in range(3):
@@ -156,22 +171,39 @@ def _nesting_depth(x: NDArray[np.float64], faces: NDArray[np.int64], label: NDAr
             coord = x[faces[:, corner], k]
             np.minimum.at(lo[:, k], label, coord)
             np.maximum.at(hi[:, k], label, coord)
+    tri = x[faces]
+    area = np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]), axis=1)
+    by_shell = np.lexsort((-area, label))  # per shell, its faces from the largest down
     order = np.argsort(label, kind="stable")
-    starts = np.searchsorted(label[order], np.arange(count))
+    bounds = np.searchsorted(label[order], np.arange(count + 1))
+    sizes = np.diff(bounds)
     depth = np.zeros(count, dtype=np.int64)
-    for shell in range(count):
-        # a test point: the centroid of the shell's largest face (well inside the shell's surface)
-        own = order[starts[shell] : starts[shell + 1] if shell + 1 < count else len(order)]
-        tri = x[faces[own]]
-        area = np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]), axis=1)
-        point = tri[int(np.argmax(area))].mean(axis=0)
-        holders = np.flatnonzero(np.all(lo <= point, axis=1) & np.all(hi >= point, axis=1))
-        for other in holders:
-            if other == shell:
+    todo = np.arange(count)
+    spent = 0
+    for attempt in range(_NESTING_ATTEMPTS):  # a test point on another shell: try the shell's next largest face
+        todo = todo[sizes[todo] > attempt]
+        if len(todo) == 0:
+            return depth
+        points = tri[by_shell[bounds[todo] + attempt]].mean(axis=1)
+        inside = [np.flatnonzero(np.all(lo[t] <= points, axis=1) & np.all(hi[t] >= points, axis=1)) for t in range(count)]
+        inside = [i[todo[i] != t] for t, i in enumerate(inside)]
+        spent += sum(len(i) * int(sizes[t]) for t, i in enumerate(inside))
+        if spent > NESTING_WORK_LIMIT:
+            return f"{spent:.2g} point-triangle tests would be needed"
+        found = np.zeros(len(todo), dtype=np.int64)
+        unclear = np.zeros(len(todo), dtype=bool)
+        for t, i in enumerate(inside):
+            if len(i) == 0:
                 continue
-            theirs = order[starts[other] : starts[other + 1] if other + 1 < count else len(order)]
-            w = float(winding_numbers(x, faces[theirs], point[None, :])[0])
-            if abs(w - round(w)) > 0.25:
-                return None  # the point lies on the other shell: they touch or overlap
-            depth[shell] += round(w) != 0
-    return depth
+            w = winding_numbers(x, faces[order[bounds[t] : bounds[t + 1]]], points[i])
+            bad = ~(np.abs(w - np.round(w)) <= 0.25)  # NaN (on the shell) or far from an integer
+            unclear[i[bad]] = True
+            found[i[~bad]] += np.round(w[~bad]) != 0
+        depth[todo[~unclear]] = found[~unclear]
+        todo = todo[unclear]
+        if len(todo) == 0:
+            return depth
+    return "shells touch or overlap"
+
+
+_NESTING_ATTEMPTS = 4

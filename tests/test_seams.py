@@ -158,3 +158,22 @@ def test_close_pairs_agree_with_brute_force() -> None:
     d = np.linalg.norm(pts[:, None] - pts[None], axis=2)
     i, j = np.nonzero(np.triu(d <= 1e-12, 1))
     assert got == set(zip(i.tolist(), j.tolist()))
+
+
+def test_a_stacked_inverted_cube_touching_another_is_turned_outward() -> None:
+    # the second cube's largest faces include the shared one: its test point must move off it
+    a_v, a_f = box(1.0, 1.0, 1.0)
+    b_v, b_f = box(1.0, 1.0, 1.0, origin=(0.0, 0.0, 1.0))
+    v = np.vstack([a_v, b_v])
+    f = np.vstack([a_f, b_f[:, [0, 2, 1]] + 8])
+    props = mass_properties(MeshBody(v, f, welded=True), density=1.0)
+    assert props.mass == pytest.approx(2.0, rel=1e-15)
+
+
+def test_winding_numbers_agree_point_by_point() -> None:
+    v, f = sphere_shell(1.0)
+    pts = np.array([[0.0, 0.0, 0.0], [0.5, 0.1, 0.0], [2.0, 0.0, 0.0], [0.0, -3.0, 1.0]])
+    together = winding_numbers(v, f, pts)
+    alone = [winding_numbers(v, f, p[None, :])[0] for p in pts]
+    np.testing.assert_allclose(together, alone, atol=1e-12)
+    np.testing.assert_allclose(np.abs(together), [1, 1, 0, 0], atol=1e-12)

@@ -19,6 +19,7 @@ from ..pipeline import METHODS, AnalysisOptions
 __all__ = [
     "MeshQuery", "PointIn", "PointsRequest", "PrecessionRequest",
     "AnalysisOut", "PrecessionOut", "PrecessionResponse", "ErrorOut", "HealthOut", "FormatsOut",
+    "UnavailableFormatOut",
     "ERROR_RESPONSES",
 ]
 
@@ -84,6 +85,9 @@ def _densities(text: str | None) -> dict[str, float] | None:
     except ValueError as exc:
         raise InvalidParameterError(f"densities must be a JSON object of finite numbers: {exc}",
                                     parameter="densities") from None
+    except RecursionError:
+        raise InvalidParameterError('densities nests too deeply; send a flat JSON object {"part name": density}',
+                                    parameter="densities") from None
     if not isinstance(value, dict) or not all(
             isinstance(v, (int, float)) and not isinstance(v, bool) for v in value.values()):
         raise InvalidParameterError('densities must be a JSON object {"part name": density in kg/m^3}',
@@ -96,7 +100,8 @@ class MeshQuery(_Request):
 
     format: str | None = Field(None, description="file format (stl, obj, ply, off, glb, gltf, 3mf, vtu, vtk, msh, "
                                "...); inferred from the file name when absent", examples=["stl"])
-    units: str | None = Field(None, description="length unit of the file: m, cm, mm, um, in, ft (default m)",
+    units: str | None = Field(None, description="length unit of the file: m, cm, mm, um, in, ft, angstrom "
+                              "(default m; angstrom for xyz)",
                               examples=["m"])
     density: float | None = Field(None, gt=0, le=MAX_MAGNITUDE,
                                   description="density [kg/m^3] (default 1000); exclusive with mass")
@@ -363,12 +368,19 @@ class FormatOut(BaseModel):
     parts: bool = Field(description="whether a file can hold several bodies (scene or assembly)")
 
 
+class UnavailableFormatOut(BaseModel):
+    format: str
+    needs: str = Field(description="what to install to read it (an extra of this package, or a package)")
+
+
 class FormatsOut(BaseModel):
     formats: list[FormatOut]
     surface: list[str] = Field(description="formats of surface meshes")
     volume: list[str] = Field(description="formats of volume meshes (tetrahedra, hexahedra, ...)")
     scene: list[str] = Field(description="formats that can hold several parts")
     points: list[str] = Field(description="formats of point-mass tables")
+    unavailable: list[UnavailableFormatOut] = Field(
+        default_factory=list, description="formats known to the service that this installation cannot read")
 
 
 def _error(description: str) -> dict[str, Any]:

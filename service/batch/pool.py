@@ -17,7 +17,9 @@ file that kills its worker again is known for sure and becomes an
 
 from __future__ import annotations
 
+import contextlib
 import multiprocessing
+import signal
 from collections.abc import Callable, Iterator
 from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
 from concurrent.futures.process import BrokenProcessPool
@@ -35,9 +37,24 @@ __all__ = ["run_pool"]
 Rendered = list[tuple[Any, bool]]
 
 
+def _ignore_interrupts() -> None:
+    """Workers leave Ctrl-C to the command, which stops them (no traceback from each worker)."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+
 def _new_pool(workers: int) -> ProcessPoolExecutor:
     method = "forkserver" if start_forkserver() else "spawn"
-    return ProcessPoolExecutor(max_workers=workers, mp_context=multiprocessing.get_context(method))
+    return ProcessPoolExecutor(max_workers=workers, mp_context=multiprocessing.get_context(method),
+                               initializer=_ignore_interrupts)
+
+
+def _stop(pool: ProcessPoolExecutor) -> None:
+    """Stop a pool now: pending tasks cancelled, running ones killed with their workers."""
+    processes = list(getattr(pool, "_processes", {}).values())  # not public API: tolerate its absence
+    pool.shutdown(wait=False, cancel_futures=True)
+    for proc in processes:
+        with contextlib.suppress(Exception):
+            proc.terminate()
 
 
 Task = Callable[[list[Source], AnalysisOptions, str], Rendered]
@@ -60,28 +77,32 @@ def run_pool(groups: Iterator[list[Source]], workers: int, window: int, options:
                     break
                 in_flight[pool.submit(task, group, options, fmt)] = group
             if not in_flight:
-                return
+                break
             done, _ = wait(in_flight, return_when=FIRST_COMPLETED)
             broken = False
             for future in done:
                 group = in_flight.pop(future)
                 try:
-                    write(future.result())
+                    rows = future.result()
                 except BrokenProcessPool:
                     broken = True
                     suspects.extend(group)
+                    continue
                 except Exception as exc:  # the task itself failed (e.g. a row that cannot be pickled)
-                    write([_failed(src, exc, fmt) for src in group])
+                    rows = [_failed(src, exc, fmt) for src in group]
+                write(rows)
             if broken:
                 for group in in_flight.values():
                     suspects.extend(group)
                 in_flight.clear()
-                pool.shutdown(wait=False, cancel_futures=True)
+                _stop(pool)
                 pool = _new_pool(workers)
                 pool = _isolate(pool, suspects, workers, options, fmt, write, task)
                 suspects = []
-    finally:
-        pool.shutdown(wait=not in_flight, cancel_futures=True)
+    except BaseException:  # Ctrl-C or an error writing rows: stop the workers rather than wait for them
+        _stop(pool)
+        raise
+    pool.shutdown(wait=True)
 
 
 def _isolate(pool: ProcessPoolExecutor, suspects: list[Source], workers: int, options: AnalysisOptions, fmt: str,
@@ -89,13 +110,14 @@ def _isolate(pool: ProcessPoolExecutor, suspects: list[Source], workers: int, op
     """Analyse the files that were in flight when a worker died, one at a time; returns the (new) pool."""
     for src in suspects:
         try:
-            write(pool.submit(task, [src], options, fmt).result())
+            rows = pool.submit(task, [src], options, fmt).result()
         except BrokenProcessPool as exc:
-            write([_failed(src, exc, fmt)])
-            pool.shutdown(wait=False, cancel_futures=True)
+            rows = [_failed(src, exc, fmt)]
+            _stop(pool)
             pool = _new_pool(workers)
         except Exception as exc:
-            write([_failed(src, exc, fmt)])
+            rows = [_failed(src, exc, fmt)]
+        write(rows)
     return pool
 
 

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import inspect
 import os
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, replace
@@ -148,10 +147,7 @@ def _load_bytes(data: bytes, filename: str | None, format: str | None, units: st
     elif fmt in VOLUME_FORMATS:
         from .volume import read_volume_parts
 
-        if companions and "companions" in inspect.signature(read_volume_parts).parameters:
-            parts = read_volume_parts(data, fmt, scale, companions=companions)  # type: ignore[call-arg]
-        else:
-            parts = read_volume_parts(data, fmt, scale)
+        parts = read_volume_parts(data, fmt, scale, filename=filename, companions=companions)
         kind = "volume"
     else:
         from .meshes import read_surface_parts
@@ -192,7 +188,7 @@ def _rescaled(part: Part, scale: float) -> Part:
         new: Body = MeshBody(body.vertices, body.faces, scale, body.name, body.warnings, body.welded,
                              body.coordinate_eps)
     elif isinstance(body, VolumeBody):
-        new = VolumeBody(body.points, body.tets, body.cell_density, scale, body.name, body.warnings)
+        new = VolumeBody(body.points, body.tets, body.cell_density, scale, body.name, body.warnings, body.cells)
     else:
         assert isinstance(body, PointBody)
         new = PointBody(body.masses, body.positions, scale, body.name, body.warnings)

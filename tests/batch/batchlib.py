@@ -97,3 +97,13 @@ def crashing_task(group: list[Any], options: Any, fmt: str) -> list[tuple[Any, b
     if any(src.name.rsplit("/", 1)[-1].startswith("crash") for src in group):
         os._exit(9)
     return render_sources(group, options, fmt)
+
+
+def cli_error(stderr: str) -> dict[str, str]:
+    """The error the command printed on stderr: ``error: <message> (<code>)`` (or the JSON envelope)."""
+    text = stderr.strip().splitlines()[-1]
+    if text.startswith("{"):
+        return dict(json.loads(text)["error"])
+    assert text.startswith("error: ") and text.endswith(")"), text
+    message, code = text[len("error: "):-1].rsplit(" (", 1)
+    return {"code": code, "message": message}

@@ -13,7 +13,8 @@ from pathlib import Path
 from typing import Any
 
 import pytest
-from batchlib import N_FILES, box, stl_bytes, without_timing
+from batchlib import N_FILES, box, cli_error, stl_bytes, without_timing
+
 from inertia.batch import runner, workers
 from inertia.batch.sources import Source, iter_inputs, iter_zip_bytes, list_sources, read_source
 from inertia.batch.tasks import analyze_source, analyze_sources
@@ -46,7 +47,7 @@ def test_the_same_file_twice_is_one_input_and_clashing_names_stay_unique(library
 def test_a_missing_path_fails_before_any_work(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     code = main(["batch", str(tmp_path / "nope"), "--out", str(tmp_path / "o.jsonl"), "--no-progress"])
     assert code == 2
-    err = json.loads(capsys.readouterr().err)["error"]
+    err = cli_error(capsys.readouterr().err)
     assert err["code"] == "invalid_parameter" and "no such file or folder" in err["message"]
 
 
@@ -54,7 +55,7 @@ def test_an_unknown_output_extension_is_invalid_parameter(library: Library, tmp_
                                                           capsys: pytest.CaptureFixture[str]) -> None:
     code = main(["batch", str(library[0]), "--out", str(tmp_path / "o.xlsx"), "--no-progress"])
     assert code == 2
-    assert ".jsonl, .csv or .parquet" in json.loads(capsys.readouterr().err)["error"]["message"]
+    assert ".jsonl, .csv or .parquet" in cli_error(capsys.readouterr().err)["message"]
 
 
 @pytest.mark.parametrize(("module", "out", "more", "hint"), [
@@ -67,7 +68,7 @@ def test_a_missing_extra_says_what_to_install(module: str, out: str, more: list[
     monkeypatch.setitem(sys.modules, module, None)  # import raises ImportError
     code = main(["batch", str(library[0]), "--out", str(tmp_path / out), "--no-progress", *more])
     assert code == 2
-    err = json.loads(capsys.readouterr().err)["error"]
+    err = cli_error(capsys.readouterr().err)
     assert err["code"] == "invalid_parameter" and hint in err["message"]
 
 

@@ -11,7 +11,8 @@ from pathlib import Path
 from typing import Any
 
 import pytest
-from batchlib import BROKEN, N_FILES, box, by_name, read_jsonl, stl_bytes, without_timing
+from batchlib import BROKEN, N_FILES, box, by_name, cli_error, read_jsonl, stl_bytes, without_timing
+
 from inertia.batch.rows import COLUMNS, FLOAT_COLUMNS, flat_row
 from inertia.cli import main
 from inertia.errors import ServiceError
@@ -232,7 +233,9 @@ def test_options_pass_through_unchanged(library: Library, cluster: Any, tmp_path
     for path, name in zip(paths, names):
         base = name.rsplit("/", 1)[-1]  # a file given by itself is named by its base name
         assert rows[base] == reference(Path(path), base, options)
-        assert "reference_inertia" in rows[base]
+    assert "reference_inertia" in rows["part_00.stl"]
+    # the other files have no part named part_00: --densities naming it is their error, as in analyze
+    assert rows["part_01.stl"]["error"]["details"]["parameter"] == "densities"
 
 
 def test_progress_bar_shows_rate_on_stderr(library: Library, cluster: Any, tmp_path: Path,
@@ -272,6 +275,7 @@ class _CountingClient:
 def test_tasks_in_flight_stay_within_the_window(library: Library, cluster: Any, tmp_path: Path,
                                                 monkeypatch: pytest.MonkeyPatch) -> None:
     from distributed import Client
+
     from inertia.batch import runner
 
     monkeypatch.setattr(runner, "MAX_TASK_BYTES", 1)  # one file per task: 50 tasks through a window of 2 x 2
@@ -288,12 +292,13 @@ def test_workers_and_scheduler_together_are_refused(library: Library, tmp_path: 
                                                     capsys: pytest.CaptureFixture[str]) -> None:
     code = batch(str(library[0]), "--out", str(tmp_path / "o.jsonl"), "--workers", "2", "--scheduler", "tcp://x:1")
     assert code == 2
-    assert "not both" in json.loads(capsys.readouterr().err)["error"]["message"]
+    assert "not both" in cli_error(capsys.readouterr().err)["message"]
 
 
 def test_a_file_that_kills_its_worker_is_one_error_row_and_the_rest_complete(library: Library,
                                                                               tmp_path: Path) -> None:
     from batchlib import crashing_task
+
     from inertia.batch import runner
     from inertia.batch.pool import run_pool
     from inertia.batch.sources import list_sources
