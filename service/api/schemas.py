@@ -19,6 +19,7 @@ from ..pipeline import METHODS, AnalysisOptions
 __all__ = [
     "MeshQuery", "PointIn", "PointsRequest", "PrecessionRequest",
     "AnalysisOut", "PrecessionOut", "PrecessionResponse", "ErrorOut", "HealthOut", "FormatsOut",
+    "UnavailableFormatOut",
     "ERROR_RESPONSES",
 ]
 
@@ -83,6 +84,9 @@ def _densities(text: str | None) -> dict[str, float] | None:
         value = json.loads(text, parse_constant=_reject_constant)
     except ValueError as exc:
         raise InvalidParameterError(f"densities must be a JSON object of finite numbers: {exc}",
+                                    parameter="densities") from None
+    except RecursionError:
+        raise InvalidParameterError('densities nests too deeply; send a flat JSON object {"part name": density}',
                                     parameter="densities") from None
     if not isinstance(value, dict) or not all(
             isinstance(v, (int, float)) and not isinstance(v, bool) for v in value.values()):
@@ -364,12 +368,19 @@ class FormatOut(BaseModel):
     parts: bool = Field(description="whether a file can hold several bodies (scene or assembly)")
 
 
+class UnavailableFormatOut(BaseModel):
+    format: str
+    needs: str = Field(description="what to install to read it (an extra of this package, or a package)")
+
+
 class FormatsOut(BaseModel):
     formats: list[FormatOut]
     surface: list[str] = Field(description="formats of surface meshes")
     volume: list[str] = Field(description="formats of volume meshes (tetrahedra, hexahedra, ...)")
     scene: list[str] = Field(description="formats that can hold several parts")
     points: list[str] = Field(description="formats of point-mass tables")
+    unavailable: list[UnavailableFormatOut] = Field(
+        default_factory=list, description="formats known to the service that this installation cannot read")
 
 
 def _error(description: str) -> dict[str, Any]:
