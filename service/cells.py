@@ -319,7 +319,7 @@ def shape_functions(name: str, xi: NDArray[np.float64]) -> tuple[NDArray[np.floa
 # ----------------------------------------------------------------------------------------------
 # Integration
 
-_BLOCK_POINTS = 1 << 18  # quadrature points per vectorised block: (cells, q) temporaries of ~2 MB
+_BLOCK_POINTS = 1 << 16  # quadrature points per vectorised block: its ~40 (cells, q) temporaries take ~20 MB
 
 
 def _jacobians(xyz: list[NDArray[np.float64]], cells: NDArray[np.int64], rule: CellRule

@@ -405,3 +405,19 @@ def test_a_server_with_an_api_key_is_used_with_the_key(browser: Any, tmp_path: P
         assert all("401" in e for e in console.http_errors)  # the first look, before the key was given
     finally:
         server.stop()
+
+
+def test_an_export_the_api_refuses_disables_its_button_with_the_reason(console_page: tuple[Any, Console], server: Server) -> None:
+    page, console = console_page
+    console.expect_http_errors = True
+    open_page(page, server)
+    page.click("#paste-box summary")
+    page.fill("#paste", "1,0,0,0\n1,1,0,0\n")  # two points: a linear rotator, which simulators reject
+    assert analyze(page) == "ready"
+    if not page.locator("button[data-export=urdf]").is_visible():
+        pytest.skip("this service offers no export")
+    page.click("button[data-export=urdf]")
+    page.wait_for_selector("#export-error:not([hidden])")
+    assert "invalid_inertia" in page.inner_text("#export-error")
+    assert page.is_disabled("button[data-export=urdf]")
+    assert page.is_enabled("#dl-json")
