@@ -51,6 +51,10 @@ def add_analysis_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("--tolerance", type=float, default=1e-6, help="relative tolerance for equal moments")
     p.add_argument("--reference", type=_triple, help="x,y,z point (file units): also report the tensor about it")
     p.add_argument("--densities", help="JSON file: part name -> density (kg/m^3) for files of several parts")
+    p.add_argument("--geometry", choices=("brep", "mesh"), default="brep",
+                   help="CAD files: integrate the exact B-rep (default) or a tessellation of it")
+    p.add_argument("--deflection", type=float,
+                   help="with --geometry mesh: chordal deflection relative to the bounding-box diagonal (default 1e-3)")
 
 
 def options_from_args(args: argparse.Namespace) -> Any:
@@ -79,6 +83,8 @@ def options_from_args(args: argparse.Namespace) -> Any:
         samples=getattr(args, "samples", None),
         method=getattr(args, "method", "exact"),
         densities=densities,
+        geometry=getattr(args, "geometry", "brep"),
+        deflection=getattr(args, "deflection", None),
     )
 
 

@@ -7,7 +7,7 @@ from typing import Annotated, Any
 from fastapi import APIRouter, Depends, File, Query, Request, UploadFile
 from fastapi.responses import StreamingResponse
 
-from ..load.sniff import POINT_FORMATS, SCENE_FORMATS, SURFACE_FORMATS, VOLUME_FORMATS
+from ..load.sniff import CAD_FORMATS, POINT_FORMATS, SCENE_FORMATS, SURFACE_FORMATS, VOLUME_FORMATS
 from .compute import ComputePool
 from .jobs import MeshJob, PointsJob, PrecessionJob
 from .ndjson import batch_lines
@@ -60,11 +60,11 @@ async def healthz() -> dict[str, str]:
 async def formats() -> FormatsOut:
     """The readable formats, and which hold surfaces, volume cells, or scenes of several parts."""
     kinds = [(f, "surface") for f in SURFACE_FORMATS] + [(f, "volume") for f in VOLUME_FORMATS]
-    kinds += [(f, "points") for f in POINT_FORMATS]
+    kinds += [(f, "points") for f in POINT_FORMATS] + [(f, "cad") for f in CAD_FORMATS]
     table = [FormatOut(format=f, kind=k, parts=f in SCENE_FORMATS)  # type: ignore[arg-type]
              for f, k in kinds]
     return FormatsOut(formats=table, surface=list(SURFACE_FORMATS), volume=list(VOLUME_FORMATS), scene=list(SCENE_FORMATS),
-                      points=list(POINT_FORMATS))
+                      points=list(POINT_FORMATS), cad=list(CAD_FORMATS))
 
 
 @v1.post("/analyze/mesh", response_model=AnalysisOut, response_model_exclude_none=True,

@@ -5,10 +5,10 @@ from __future__ import annotations
 import os
 from dataclasses import dataclass
 
-from ..body import Body, MeshBody, Part, PointBody, VolumeBody
+from ..body import Body, BrepBody, MeshBody, Part, PointBody, VolumeBody
 from ..conventions import length_scale
 from ..errors import EmptyGeometryError, UnreadableFileError
-from .sniff import FORMATS, POINT_FORMATS, SCENE_FORMATS, SURFACE_FORMATS, VOLUME_FORMATS, sniff_format
+from .sniff import CAD_FORMATS, FORMATS, POINT_FORMATS, SCENE_FORMATS, SURFACE_FORMATS, VOLUME_FORMATS, sniff_format
 
 __all__ = ["Loaded", "load_body", "load_points", "FORMATS", "SURFACE_FORMATS", "VOLUME_FORMATS", "SCENE_FORMATS"]
 
@@ -17,8 +17,9 @@ __all__ = ["Loaded", "load_body", "load_points", "FORMATS", "SURFACE_FORMATS", "
 class Loaded:
     """What was read: one or more parts and where they came from.
 
-    kind : "mesh" (surface), "volume" (volume cells) or "points".
+    kind : "mesh" (surface), "volume" (volume cells), "points" or "cad" (B-rep solids).
     units : the length unit used; units_from : "request", "file" or "default".
+    warnings : what the loader assumed (besides each body's own).
     """
 
     parts: tuple[Part, ...]
@@ -27,9 +28,10 @@ class Loaded:
     kind: str
     units: str
     units_from: str
+    warnings: tuple[str, ...] = ()
 
     @property
-    def body(self) -> Body:
+    def body(self) -> Body | BrepBody:
         """The single body (first part)."""
         return self.parts[0].body
 
@@ -80,6 +82,11 @@ def _load_bytes(data: bytes, filename: str | None, format: str | None, units: st
     if not len(data):
         raise EmptyGeometryError("the file is empty; send a mesh with geometry", filename=filename)
     fmt = sniff_format(filename, format, bytes(data[:512]))
+    if fmt in CAD_FORMATS:
+        from ..cad import read_cad_parts
+
+        cad_parts, unit, units_from, warnings = read_cad_parts(data, fmt, units)
+        return Loaded(tuple(cad_parts), filename, fmt, "cad", unit, units_from, warnings)
     requested = None if units is None else (units, length_scale(units))
     scale = requested[1] if requested else 1.0
 
