@@ -47,7 +47,7 @@ __all__ = [
 ]
 
 # mesh formats (points files are JSON/CSV, too generic to pick up from a folder)
-KNOWN_EXTENSIONS = frozenset(FORMATS) | {"stla", "stlb"}
+KNOWN_EXTENSIONS = frozenset(FORMATS) | {"stla", "stlb", "stp", "igs"}
 ZIP_EXTENSION = "zip"
 
 
