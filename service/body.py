@@ -134,8 +134,9 @@ class BrepBody:
     """A solid of a CAD file, kept as its exact boundary representation.
 
     solid : the CAD binding's solid (``inertia.cad.occ.Solid``; opaque here),
-        coordinates in metres as the file's own unit gives them.
-    length_scale : multiplies those coordinates: 1, or (requested unit) /
+        coordinates in the binding's model unit (millimetres), converted from
+        the file's own unit.
+    length_scale : metres per model unit: 1e-3, times (requested unit) /
         (file unit) when the request overrides the file's unit.
     """
 

@@ -62,14 +62,14 @@ def read_cad_parts(data: bytes, fmt: str, units: str | None) -> tuple[list[Part]
         if file_scale is None:
             raise InvalidParameterError(
                 f"the file's length unit ({declared or 'several units'}) cannot be overridden; omit units", parameter="units")
-        scale, unit, units_from = LENGTH_UNITS[units] / file_scale, units, "request"
+        scale, unit, units_from = occ.MODEL_UNIT * LENGTH_UNITS[units] / file_scale, units, "request"
     elif file_scale is None:
-        scale, unit, units_from = 1.0, "m", "file"
+        scale, unit, units_from = occ.MODEL_UNIT, "m", "file"
         warnings.append(f"the file's length unit ({declared or 'several units'}) was converted to metres; "
                         "reference points are read in metres")
     else:
         assert declared is not None
-        scale, unit, units_from = 1.0, declared, "file"
+        scale, unit, units_from = occ.MODEL_UNIT, declared, "file"
     parts = [Part(s.name, BrepBody(s, scale, s.name)) for s in solids]
     return parts, unit, units_from, tuple(warnings)
 
@@ -148,7 +148,7 @@ def tessellated(loaded: Loaded, deflection: float) -> Loaded:
         body = part.body
         assert isinstance(body, BrepBody)
         vertices, faces = occ.tessellate(body.solid, deflection)
-        # coordinates stay in metres as read; length_scale applies a requested unit, as for the B-rep
+        # coordinates stay in the model unit as read; length_scale turns them into metres, as for the B-rep
         parts.append(Part(part.name, MeshBody(vertices, faces, body.length_scale, part.name), part.extras))
     return replace(loaded, parts=tuple(parts))
 

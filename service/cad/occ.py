@@ -6,9 +6,12 @@ Everything the binding can throw is caught here and translated into a
 Reading.  STEP and IGES go through OpenCASCADE's XDE readers
 (``STEPCAFControl_Reader``, ``IGESCAFControl_Reader``), which keep product
 names and the assembly tree.  The document's length unit is set to the
-metre, so the reader converts the file's own unit (STEP ``SI_UNIT`` /
-``CONVERSION_BASED_UNIT``, IGES global section parameters 14-15) into metres;
-the unit the file declared is read back from the reader for ``source.units``.
+millimetre, so the reader converts the file's own unit (STEP ``SI_UNIT`` /
+``CONVERSION_BASED_UNIT``, IGES global section parameters 14-15) into
+millimetres: OpenCASCADE's tolerances (``Precision::Confusion`` = 1e-7 model
+units, the mesher's minimum size) assume parts of millimetres to metres in
+model units, and a part read in metres meshes slowly and badly at fine
+deflections.  The unit the file declared is read back for ``source.units``.
 
 Integration.  ``BRepGProp.VolumeProperties_s(shape, props, eps)`` runs
 OpenCASCADE's adaptive Gauss integration over the exact faces; its returned
@@ -39,10 +42,13 @@ from ..errors import (
     UnreadableFileError,
     ZeroVolumeError,
 )
+from ..tolerances import DEFAULT_TOLERANCES
 
 __all__ = ["CAD_EXTRA_HINT", "Solid", "BrepIntegral", "read_solids", "integrate", "tessellate", "available"]
 
 CAD_EXTRA_HINT = "pip install 'inertia-service[cad]'"
+VOLUME_REL = DEFAULT_TOLERANCES.volume_rel  # |V| below this x the bounding box's volume: no solid
+MODEL_UNIT = 1e-3  # metres per model unit: OpenCASCADE works in millimetres
 
 COARSE_EPS = 1e-12  # below ~1e-12 the moments, not only the volume, settle (API.md, accuracy of brep)
 FINE_EPS = 1e-14  # a hundredfold tighter: its difference to COARSE_EPS is the error estimate
@@ -76,7 +82,7 @@ def available() -> bool:
 
 @dataclass(frozen=True, slots=True)
 class Solid:
-    """One solid of the file, placed in the file's frame, coordinates in metres.
+    """One solid of the file, placed in the file's frame, coordinates in millimetres.
 
     shape : the located ``TopoDS_Shape`` (a solid).  name : its product or shape name.
     """
@@ -87,9 +93,9 @@ class Solid:
 
 @dataclass(frozen=True, slots=True)
 class BrepIntegral:
-    """Volume integrals of one solid, coordinates in metres, unit density.
+    """Volume integrals of one solid, coordinates in millimetres, unit density.
 
-    volume [m^3]; center [m]; tensor [m^5], about the centre, input axes
+    volume [mm^3]; center [mm]; tensor [mm^5], about the centre, input axes
     (Landau & Lifshitz sign convention, as OpenCASCADE's MatrixOfInertia);
     estimate : relative error bound of volume, centre (in units of the radius
     of gyration) and each principal moment.
@@ -126,7 +132,7 @@ def _read(data: bytes, fmt: str) -> tuple[list[Solid], str | None]:
 
     _quiet()
     doc = TDocStd_Document(TCollection_ExtendedString("XmlXCAF"))
-    XCAFDoc_DocumentTool.SetLengthUnit_s(doc, 1.0)  # document unit: 1 m, so the reader converts to metres
+    XCAFDoc_DocumentTool.SetLengthUnit_s(doc, MODEL_UNIT)  # the reader converts the file's unit to this
     reader = _reader(fmt)
     with tempfile.TemporaryDirectory(prefix="inertia-cad-") as tmp:
         path = os.path.join(tmp, "input." + ("stp" if fmt == "step" else "igs"))
@@ -326,7 +332,7 @@ def _integrate(solid: Solid) -> BrepIntegral:
     centre = gp_Pnt(*((lo + hi) / 2).tolist())
     v1, c1, t1 = _properties(solid.shape, centre, COARSE_EPS)
     v2, c2, t2 = _properties(solid.shape, centre, FINE_EPS)
-    if not all(math.isfinite(x) for x in (v1, v2)) or abs(v2) <= 1e-12 * float(np.prod(np.maximum(hi - lo, 0.0))):
+    if not all(math.isfinite(x) for x in (v1, v2)) or abs(v2) <= VOLUME_REL * float(np.prod(np.maximum(hi - lo, 0.0))):
         raise ZeroVolumeError(f"the solid {solid.name!r} encloses no volume; export it again as a closed solid")
     if v2 < 0:  # an inside-out solid: every integral changes sign
         v1, t1, v2, t2 = -v1, -t1, -v2, -t2
@@ -368,7 +374,7 @@ def _count_faces(shape: Any) -> int:
 
 
 def bounding_box(shape: Any) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """Lower and upper corners [m] of the shape's exact bounding box."""
+    """Lower and upper corners [mm] of the shape's exact bounding box."""
     from OCP.Bnd import Bnd_Box
     from OCP.BRepBndLib import BRepBndLib
 
@@ -403,11 +409,40 @@ def _tessellate(solid: Solid, deflection: float) -> tuple[NDArray[np.float64], N
     lo, hi = bounding_box(solid.shape)
     diagonal = float(np.linalg.norm(hi - lo))
     shape = solid.shape
-    BRepTools.Clean_s(shape)  # drop any triangulation the file carried
-    mesher = BRepMesh_IncrementalMesh(shape, deflection * diagonal, False, ANGULAR_DEFLECTION, False)
-    if not mesher.IsDone():
-        raise UnreadableFileError(f"OpenCASCADE could not tessellate the solid {solid.name!r}", part=solid.name)
-    return _triangles(shape, solid.name)
+    for attempt in range(2):
+        BRepTools.Clean_s(shape)  # drop any triangulation the file (or the last attempt) carried
+        mesher = BRepMesh_IncrementalMesh(shape, deflection * diagonal, False, ANGULAR_DEFLECTION, False)
+        if mesher.IsDone() and _all_faces_meshed(shape):
+            return _triangles(shape, solid.name)
+        if attempt == 0:
+            # Blend faces read back from STEP can carry p-curves the mesher rejects; ShapeFix
+            # rebuilds p-curves and tolerances (the surfaces stay the same) and the mesher succeeds.
+            shape = _fixed(shape)
+    raise UnreadableFileError(f"OpenCASCADE could not tessellate every face of the solid {solid.name!r}; "
+                              "use geometry=brep", part=solid.name)
+
+
+def _all_faces_meshed(shape: Any) -> bool:
+    from OCP.BRep import BRep_Tool
+    from OCP.TopAbs import TopAbs_FACE
+    from OCP.TopExp import TopExp_Explorer
+    from OCP.TopLoc import TopLoc_Location
+    from OCP.TopoDS import TopoDS
+
+    explorer = TopExp_Explorer(shape, TopAbs_FACE)
+    while explorer.More():
+        if BRep_Tool.Triangulation_s(TopoDS.Face(explorer.Current()), TopLoc_Location()) is None:
+            return False
+        explorer.Next()
+    return True
+
+
+def _fixed(shape: Any) -> Any:
+    from OCP.ShapeFix import ShapeFix_Shape
+
+    fixer = ShapeFix_Shape(shape)
+    fixer.Perform()
+    return fixer.Shape()
 
 
 def _triangles(shape: Any, name: str) -> tuple[NDArray[np.float64], NDArray[np.int64]]:

@@ -31,10 +31,9 @@ import pytest
 
 pytest.importorskip("OCP")
 
-from cadlib import box, cylinder, nurbs, open_shell, write_iges, write_step  # noqa: E402
-
-from inertia.errors import NotWatertightError, UnsupportedFormatError  # noqa: E402
-from inertia.pipeline import AnalysisOptions, analyze  # noqa: E402
+from cadlib import box, cylinder, nurbs, open_shell, write_iges, write_step
+from inertia.errors import NotWatertightError, UnsupportedFormatError
+from inertia.pipeline import AnalysisOptions, analyze
 
 RHO = 1000.0  # the default density, kg/m^3
 REL = 1e-9
