@@ -1,5 +1,6 @@
 # The HTTP service: python slim, runtime dependencies only, non-root, serves on port 8000.
-# Build steps are the README's install steps (pip install .).
+# Dependencies are installed in their own layer from pyproject.toml alone, so a change to the
+# sources rebuilds only the last, small layer.
 FROM python:3.11-slim
 
 ENV PYTHONDONTWRITEBYTECODE=1 \
@@ -10,13 +11,21 @@ ENV PYTHONDONTWRITEBYTECODE=1 \
 RUN useradd --create-home --uid 10001 inertia
 WORKDIR /app
 
-COPY pyproject.toml README.md ./
+# 1. dependencies, read from pyproject.toml alone (this layer is cached while it is unchanged)
+COPY pyproject.toml ./
+RUN python -c "import tomllib; print('\n'.join(tomllib.load(open('pyproject.toml', 'rb'))['project']['dependencies']))" \
+        > /tmp/requirements.txt \
+    && pip install -r /tmp/requirements.txt && rm /tmp/requirements.txt
+
+# 2. the package itself
+COPY README.md LICENSE ./
 COPY service ./service
-# the package lands in site-packages; the sources are not needed at run time
-RUN pip install . && rm -rf /app/service /app/pyproject.toml /app/README.md /app/build
+RUN pip install --no-deps . && rm -rf /app/service /app/build /app/README.md /app/LICENSE /app/pyproject.toml
 
 USER inertia
 EXPOSE 8000
+# Compute processes default to the CPUs the container may use (its cgroup quota, e.g. --cpus 2),
+# not the host's core count; INERTIA_COMPUTE_PROCESSES overrides.
 HEALTHCHECK --interval=30s --timeout=3s --start-period=20s \
     CMD python -c "import urllib.request; urllib.request.urlopen('http://127.0.0.1:8000/healthz', timeout=2)"
 CMD ["inertia", "serve", "--host", "0.0.0.0", "--port", "8000"]

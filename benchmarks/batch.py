@@ -1,4 +1,4 @@
-"""Batch throughput: ``inertia batch`` on local Dask workers against a plain serial trimesh loop.
+"""Batch throughput at 2 workers: ``inertia batch`` (the local process pool) against a plain serial trimesh loop.
 
     python -m benchmarks.batch            # full run, writes docs/batch.md
     python -m benchmarks.batch --quick    # smaller sizes, a few minutes

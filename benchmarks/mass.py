@@ -1,7 +1,11 @@
 """Load + mass properties of binary STL files: ours against trimesh and numpy-stl.
 
-    python -m benchmarks.mass            # 1e4, 1e5, 1e6, 4e6 triangles -> docs/performance.md
+    python -m benchmarks.mass            # 1e4, 1e5, 1e6, 5e6, 2e7 triangles -> docs/performance.md
     python -m benchmarks.mass --quick    # 1e4, 1e5 only (a smoke run)
+
+2e7 triangles (a 1 GB file) runs a tool only where the machine has the
+memory it needs free (trimesh needs ~12x the file size); otherwise the cell
+says it was skipped and why.
 
 Test bodies are closed tori (R = 3, r = 1, a u-by-v grid, two triangles per
 quad) written as binary STL into a temporary directory.  Three measurements
@@ -12,7 +16,9 @@ in the same run:
     against a script that imports trimesh, loads the file and reads
     ``mass_properties`` and ``is_watertight``, and one that calls numpy-stl's
     ``Mesh.from_file`` + ``get_mass_properties``.  Wall time and peak RSS
-    (GNU time's %M for the tool's own process, else ``os.wait4``) are the median of ``--repeat`` runs.
+    (GNU time's %M for the tool's own process, else ``os.wait4``) and CPU time are
+    the best of ``--repeat`` interleaved rounds (the tools' order alternates),
+    with the spread of the wall times shown: the machine may be shared.
 (b) our stages in process (read + weld of the STL, edge topology, outward
     orientation, each integration pass), timed by
     wrapping the stage functions around one ``pipeline.analyze`` call.
@@ -27,7 +33,6 @@ import importlib.metadata
 import json
 import os
 import platform
-import statistics
 import subprocess
 import sys
 import tempfile
@@ -39,9 +44,13 @@ from typing import Any
 
 import numpy as np
 
-SIZES = {"1e4": (100, 50), "1e5": (250, 200), "1e6": (1000, 500), "4e6": (2000, 1000)}
+SIZES = {"1e4": (100, 50), "1e5": (250, 200), "1e6": (1000, 500), "5e6": (2500, 1000), "2e7": (5000, 2000)}
 QUICK = ("1e4", "1e5")
-SLOW_NUMPY_STL = 1_000_000  # numpy-stl's exact mass path takes ~36 s at 1e6: one run from here up
+SLOW_NUMPY_STL = 1_000_000  # numpy-stl's exact mass path takes ~36 s at 1e6: one run there
+NO_NUMPY_STL = 5_000_000  # ... and minutes from 5e6 up: not run
+# peak memory of each tool as a multiple of the file size (measured at 1e6-5e6), to decide whether a run fits
+MEMORY_FACTOR = {"inertia": 3.5, "trimesh": 13.0, "numpy-stl": 36.0}
+MEMORY_MARGIN = 2 << 30  # left free for everyone else on the machine
 
 TRIMESH_SCRIPT = """
 import json, sys, trimesh
@@ -81,8 +90,19 @@ def torus_stl(path: Path, nu: int, nv: int, major: float = 3.0, minor: float = 1
 GNU_TIME = "/usr/bin/time"
 
 
-def run_process(cmd: list[str]) -> tuple[float, int, str]:
-    """Wall time [s], peak RSS [bytes] and stdout of one child process.
+def available_memory() -> int:
+    """MemAvailable of /proc/meminfo in bytes (0 where unknown)."""
+    try:
+        for line in Path("/proc/meminfo").read_text().splitlines():
+            if line.startswith("MemAvailable:"):
+                return int(line.split()[1]) * 1024
+    except (OSError, ValueError, IndexError):
+        pass
+    return 0
+
+
+def run_process(cmd: list[str]) -> tuple[float, int, str, float]:
+    """Wall time [s], peak RSS [bytes], stdout and CPU time [s] of one child process.
 
     Linux carries a process's high-water RSS across fork and exec into the
     child's ``ru_maxrss``, so a child of this (large) benchmark process would
@@ -91,7 +111,7 @@ def run_process(cmd: list[str]) -> tuple[float, int, str]:
     """
     wrapped = os.path.exists(GNU_TIME)
     with tempfile.TemporaryFile() as out, tempfile.NamedTemporaryFile("r") as rss_file:
-        full = [GNU_TIME, "-f", "%M", "-o", rss_file.name, *cmd] if wrapped else cmd
+        full = [GNU_TIME, "-f", "%M %U %S", "-o", rss_file.name, *cmd] if wrapped else cmd
         start = time.perf_counter()
         proc = subprocess.Popen(full, stdout=out, stderr=subprocess.PIPE)
         _, status, usage = os.wait4(proc.pid, 0)
@@ -100,9 +120,13 @@ def run_process(cmd: list[str]) -> tuple[float, int, str]:
         err = proc.stderr.read().decode() if proc.stderr else ""
         if proc.returncode != 0:
             raise RuntimeError(f"{cmd[:3]} failed ({proc.returncode}): {err[-2000:]}")
-        peak_kb = int(rss_file.read().split()[-1]) if wrapped else usage.ru_maxrss
+        if wrapped:
+            fields = rss_file.read().split()[-3:]
+            peak_kb, cpu = int(fields[0]), float(fields[1]) + float(fields[2])
+        else:
+            peak_kb, cpu = usage.ru_maxrss, usage.ru_utime + usage.ru_stime
         out.seek(0)
-        return wall, peak_kb * 1024, out.read().decode()
+        return wall, peak_kb * 1024, out.read().decode(), cpu
 
 
 def tool_commands(path: Path) -> dict[str, list[str]]:
@@ -110,7 +134,7 @@ def tool_commands(path: Path) -> dict[str, list[str]]:
     inertia = Path(py).with_name("inertia")
     ours = [str(inertia)] if inertia.exists() else [py, "-m", "inertia"]
     return {
-        "inertia": ours + ["analyze", str(path), "--json"],
+        "inertia": [*ours, "analyze", str(path), "--json"],
         "trimesh": [py, "-c", TRIMESH_SCRIPT, str(path)],
         "numpy-stl": [py, "-c", NUMPY_STL_SCRIPT, str(path)],
     }
@@ -126,22 +150,41 @@ def principal_per_density(tool: str, stdout: str) -> tuple[np.ndarray, float | N
 
 
 def measure_processes(path: Path, triangles: int, repeat: int) -> dict[str, dict[str, Any]]:
+    """Every tool on ``path``, ``repeat`` interleaved rounds (the order alternates); the best of each."""
     out: dict[str, dict[str, Any]] = {}
-    for tool, cmd in tool_commands(path).items():
-        runs = 1 if tool == "numpy-stl" and triangles >= SLOW_NUMPY_STL else repeat
-        walls, rss = [], []
-        for _ in range(runs):
-            wall, peak, stdout = run_process(cmd)
-            walls.append(wall)
-            rss.append(peak)
-        moments, estimate = principal_per_density(tool, stdout)
-        out[tool] = {"wall": statistics.median(walls), "rss": statistics.median(rss), "runs": runs,
-                     "moments": moments, "estimate": estimate}
+    commands = tool_commands(path)
+    size = path.stat().st_size
+    for tool in commands:
+        need = MEMORY_FACTOR[tool] * size
+        if tool == "numpy-stl" and triangles >= NO_NUMPY_STL:
+            out[tool] = {"skipped": "not run (its exact mass path takes minutes from 5e6 triangles)"}
+        elif available_memory() < need + MEMORY_MARGIN:
+            out[tool] = {"skipped": f"not run: needs ~{need / 2**30:.1f} GiB, "
+                                    f"{available_memory() / 2**30:.1f} GiB available"}
+        else:
+            out[tool] = {"walls": [], "rss": [], "cpu": []}
+    for r in range(repeat):
+        order = [t for t in commands if "skipped" not in out[t]]
+        for tool in order if r % 2 == 0 else order[::-1]:
+            if tool == "numpy-stl" and triangles >= SLOW_NUMPY_STL and out[tool]["walls"]:
+                continue
+            wall, peak, stdout, cpu = run_process(commands[tool])
+            out[tool]["walls"].append(wall)
+            out[tool]["rss"].append(peak)
+            out[tool]["cpu"].append(cpu)
+            out[tool]["stdout"] = stdout
+    for r in out.values():
+        if "skipped" in r:
+            continue
+        r["wall"], r["rss"], r["cpu_s"], r["runs"] = min(r["walls"]), min(r["rss"]), min(r["cpu"]), len(r["walls"])
+    for tool, r in out.items():
+        if "skipped" not in r:
+            r["moments"], r["estimate"] = principal_per_density(tool, r.pop("stdout"))
     return out
 
 
-def stage_breakdown(path: Path) -> dict[str, float]:
-    """Seconds per stage of one in-process ``pipeline.analyze`` (after a warm-up run)."""
+def stage_breakdown(path: Path, warmup: Path) -> dict[str, float]:
+    """Seconds per stage of one in-process ``pipeline.analyze`` (after a warm-up run on a small file)."""
     import inertia.load.stl as stl
     import inertia.mass as mass
     import inertia.solid as solid
@@ -170,7 +213,7 @@ def stage_breakdown(path: Path) -> dict[str, float]:
     try:
         for obj, attr, name in patches:
             setattr(obj, attr, timed(name, getattr(obj, attr)))
-        pipeline.analyze(str(path))  # warm-up: lazy imports
+        pipeline.analyze(str(warmup))  # warm-up: lazy imports
         times.clear()
         passes[0] = 0
         start = time.perf_counter()
@@ -212,31 +255,52 @@ def _rel(a: np.ndarray, b: np.ndarray) -> float:
     return float(np.max(np.abs(a - b) / np.abs(b)))
 
 
+def _cell(r: dict[str, Any], key: str, fmt: str, scale: float = 1.0) -> str:
+    return "skipped" if "skipped" in r else format(r[key] / scale, fmt)
+
+
 def report(results: dict[str, dict[str, Any]], stages: dict[str, dict[str, float]], command: str) -> str:
     mb = 1e6
+    tools = ("inertia", "trimesh", "numpy-stl")
     lines = ["# Performance: load + mass properties of binary STL", "",
              f"Regenerate with `{command}` from the repository root (written by `benchmarks/mass.py`).", "",
              "Bodies: closed tori (R = 3, r = 1) as binary STL, two triangles per grid quad.  Whole processes:",
              "`inertia analyze FILE --json` (load, float32 weld, watertight and winding checks, exact",
              "multi-pass integration, JSON) against a script that imports trimesh, loads the file and reads",
              "`mass_properties` and `is_watertight`, and one that runs numpy-stl's `Mesh.from_file` +",
-             "`get_mass_properties`.  Times and peak RSS (GNU time's maximum resident set of the tool's own process) are medians of the",
-             "runs shown; numpy-stl runs once from 1e6 triangles up (its exact mass path takes minutes).", "",
+             "`get_mass_properties`.  Rounds are interleaved (the tools' order alternates); wall time, CPU time",
+             "(user + system) and peak RSS (GNU time's maximum resident set of the tool's own process) are the",
+             "best of the runs shown, and *spread* is the slowest run over the fastest, a measure of how much",
+             "the shared machine disturbed the run. numpy-stl runs once at 1e6 triangles and not above",
+             "(its exact mass path takes minutes).", "",
              "## Whole process", "",
-             "| triangles | file MB | inertia s | trimesh s | numpy-stl s | trimesh / inertia | numpy-stl / inertia "
-             "| inertia peak MB | x file | trimesh peak MB | x file | numpy-stl peak MB | runs (ours, trimesh, numpy-stl) |",
-             "|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
-    for label, r in results.items():
+             "| triangles | file MB | inertia s | inertia CPU s | trimesh s | trimesh CPU s | numpy-stl s "
+             "| trimesh / inertia (wall) | trimesh / inertia (CPU) | numpy-stl / inertia "
+             "| inertia peak MB | x file | trimesh peak MB | x file | numpy-stl peak MB | runs (ours, trimesh, numpy-stl) "
+             "| spread (ours, trimesh) |",
+             "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
+    skipped: list[str] = []
+    for r in results.values():
         size = r["file_bytes"]
-        t = {k: r[k]["wall"] for k in ("inertia", "trimesh", "numpy-stl")}
-        m = {k: r[k]["rss"] for k in ("inertia", "trimesh", "numpy-stl")}
-        runs = ", ".join(str(r[k]["runs"]) for k in ("inertia", "trimesh", "numpy-stl"))
+        ours, tm, ns = (r[k] for k in tools)
+        runs = ", ".join(str(r[k].get("runs", 0)) for k in tools)
+        ratio = f"{tm['wall'] / ours['wall']:.2f}x" if "skipped" not in tm and "skipped" not in ours else "skipped"
+        cpu_ratio = (f"{tm['cpu_s'] / ours['cpu_s']:.2f}x" if "skipped" not in tm and "skipped" not in ours
+                     else "skipped")
+        ns_ratio = f"{ns['wall'] / ours['wall']:.1f}x" if "skipped" not in ns and "skipped" not in ours else "skipped"
+        spread = ", ".join(f"{max(x['walls']) / min(x['walls']):.2f}" if "skipped" not in x else "-" for x in (ours, tm))
         lines.append(
-            f"| {r['triangles']:,} | {size / mb:.1f} | {t['inertia']:.3f} | {t['trimesh']:.3f} | {t['numpy-stl']:.2f} "
-            f"| {t['trimesh'] / t['inertia']:.2f}x | {t['numpy-stl'] / t['inertia']:.1f}x "
-            f"| {m['inertia'] / mb:.0f} | {m['inertia'] / size:.2f} | {m['trimesh'] / mb:.0f} | {m['trimesh'] / size:.2f} "
-            f"| {m['numpy-stl'] / mb:.0f} | {runs} |")
-    lines += ["", "Targets at 1e6 triangles: at least 3x faster than trimesh, peak memory at most 4x the file size.", ""]
+            f"| {r['triangles']:,} | {size / mb:.1f} | {_cell(ours, 'wall', '.3f')} | {_cell(ours, 'cpu_s', '.2f')} "
+            f"| {_cell(tm, 'wall', '.3f')} | {_cell(tm, 'cpu_s', '.2f')} | {_cell(ns, 'wall', '.2f')} "
+            f"| {ratio} | {cpu_ratio} | {ns_ratio} "
+            f"| {_cell(ours, 'rss', '.0f', mb)} | {_cell(ours, 'rss', '.2f', size)} | {_cell(tm, 'rss', '.0f', mb)} "
+            f"| {_cell(tm, 'rss', '.2f', size)} | {_cell(ns, 'rss', '.0f', mb)} | {runs} | {spread} |")
+        skipped += [f"- {r['triangles']:,} triangles, {k}: {r[k]['skipped']}" for k in tools if "skipped" in r[k]]
+    lines += [""]
+    if skipped:
+        lines += ["Not run:", "", *skipped, ""]
+    lines += ["Targets: at least 5x faster than trimesh at 1e6 triangles and 4x at 5e6, whole processes; peak memory "
+              "at most 3x the file size.", ""]
     lines += ["## Where our time goes (in process, one `pipeline.analyze`, seconds)", ""]
     names: list[str] = []
     for st in stages.values():
@@ -251,13 +315,17 @@ def report(results: dict[str, dict[str, Any]], stages: dict[str, dict[str, float
               "| triangles | inertia moments | max rel. diff trimesh | max rel. diff numpy-stl | inertia error estimate |",
               "|---|---|---|---|---|"]
     for r in results.values():
+        if "skipped" in r["inertia"]:
+            continue
         ours = r["inertia"]["moments"]
+        diffs = [f"{_rel(r[k]['moments'], ours):.1e}" if "skipped" not in r[k] else "not run"
+                 for k in ("trimesh", "numpy-stl")]
         lines.append(f"| {r['triangles']:,} | {', '.join(f'{x:.12g}' for x in ours)} "
-                     f"| {_rel(r['trimesh']['moments'], ours):.1e} | {_rel(r['numpy-stl']['moments'], ours):.1e} "
-                     f"| {r['inertia']['estimate']:.1e} |")
+                     f"| {diffs[0]} | {diffs[1]} | {r['inertia']['estimate']:.1e} |")
     lines += ["", "## Machine", "",
               "Wall times are only comparable within one run: a load average above the core count means",
-              "other work shared the CPUs, which slows every tool (peak memory is unaffected).", ""] + [f"- {k}: {v}" for k, v in machine_info().items()] + [""]
+              "other work shared the CPUs, which slows every tool (peak memory is unaffected).", "",
+              *[f"- {k}: {v}" for k, v in machine_info().items()], ""]
     return "\n".join(lines)
 
 
@@ -272,6 +340,8 @@ def main(argv: list[str] | None = None) -> int:
     results: dict[str, dict[str, Any]] = {}
     stages: dict[str, dict[str, float]] = {}
     with tempfile.TemporaryDirectory(prefix="inertia-bench-") as tmp:
+        warmup = Path(tmp) / "warmup.stl"
+        torus_stl(warmup, *SIZES["1e4"])
         for label in sizes:
             path = Path(tmp) / f"torus_{label}.stl"
             triangles = torus_stl(path, *SIZES[label])
@@ -279,9 +349,11 @@ def main(argv: list[str] | None = None) -> int:
             r = measure_processes(path, triangles, args.repeat)
             r["triangles"], r["file_bytes"] = triangles, path.stat().st_size
             results[label] = r
-            stages[label] = stage_breakdown(path)
-            print("  " + ", ".join(f"{k} {r[k]['wall']:.3f} s {r[k]['rss'] / 1e6:.0f} MB"
-                                   for k in ("inertia", "trimesh", "numpy-stl")), file=sys.stderr, flush=True)
+            if "skipped" not in r["inertia"]:
+                stages[label] = stage_breakdown(path, warmup)
+            print("  " + ", ".join(f"{k} {r[k]['wall']:.3f} s {r[k]['rss'] / 1e6:.0f} MB" if "skipped" not in r[k]
+                                   else f"{k} skipped" for k in ("inertia", "trimesh", "numpy-stl")),
+                  file=sys.stderr, flush=True)
             path.unlink()
     command = "python -m benchmarks.mass" + (" --quick" if args.quick and not args.sizes else "") \
         + (f" --sizes {' '.join(args.sizes)}" if args.sizes else "") \

@@ -10,7 +10,7 @@ import importlib
 from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
-    from .classify import Classification, RotorClass, classify
+    from .classification import Classification, RotorClass, classify
     from .errors import ServiceError
     from .load import Loaded, load_body
     from .mass import InertiaTensor, MassProperties, mass_properties
@@ -21,7 +21,7 @@ if TYPE_CHECKING:
 # Names are imported on first use (PEP 562), so ``import inertia`` and the CLI
 # start without numpy: ``inertia batch`` starts its workers' forkserver first.
 _HOME = {
-    "Classification": "classify", "RotorClass": "classify", "classify": "classify",
+    "Classification": "classification", "RotorClass": "classification", "classify": "classification",
     "ServiceError": "errors",
     "Loaded": "load", "load_body": "load",
     "InertiaTensor": "mass", "MassProperties": "mass", "mass_properties": "mass",
@@ -33,6 +33,13 @@ _HOME = {
 
 
 def __getattr__(name: str) -> Any:
+    if name == "__version__":  # one source: the distribution's metadata, from pyproject.toml
+        from importlib.metadata import PackageNotFoundError, version
+
+        try:
+            return version("inertia-service")
+        except PackageNotFoundError:  # a checkout that was never installed
+            return "0+unknown"
     home = _HOME.get(name)
     if home is None:
         raise AttributeError(f"module 'inertia' has no attribute {name!r}")

@@ -15,7 +15,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from .errors import EmptyGeometryError, InvalidParameterError
 
-__all__ = ["MeshBody", "VolumeBody", "PointBody", "BrepBody", "Part", "Body"]
+__all__ = ["MeshBody", "VolumeBody", "CellBlock", "PointBody", "BrepBody", "Part", "Body"]
 
 
 def _frozen(arr: ArrayLike, dtype: type[np.generic]) -> NDArray[Any]:
@@ -39,6 +39,10 @@ class MeshBody:
     vertices : (n, 3) float64, file units.  faces : (m, 3) int64 indices.
     welded : the reader already merged vertices with bit-identical coordinates
         (as ``topology.weld`` does), so the solid path need not weld again.
+    coordinate_eps : unit roundoff of the file's coordinate storage: 2**-24 for
+        float32 (binary STL), 2**-53 by default; each stored coordinate x may be
+        |x| x this from the value the exporter had (``mass`` refuses a body whose
+        volume or moments are within what that resolution can change).
     """
 
     vertices: NDArray[np.float64]
@@ -47,6 +51,7 @@ class MeshBody:
     name: str | None = None
     warnings: tuple[str, ...] = ()
     welded: bool = False
+    coordinate_eps: float = 2.0**-53
 
     def __post_init__(self) -> None:
         v = _frozen(self.vertices, np.float64)
@@ -63,11 +68,46 @@ class MeshBody:
 
 
 @dataclass(frozen=True, slots=True)
-class VolumeBody:
-    """Tetrahedra (other cells already split into tetrahedra).
+class CellBlock:
+    """Cells of one type other than the linear tetrahedron, integrated by ``cells``.
 
-    points : (n, 3) float64, file units.  tets : (k, 4) int64.
+    type : a key of ``cells.CELL_NODES`` (meshio's name; VTK node order).
+    nodes : (k, n) int64 point indices.  density : (k,) kg/m^3, or None (uniform).
+    """
+
+    type: str
+    nodes: NDArray[np.int64]
+    density: NDArray[np.float64] | None = None
+
+    def __post_init__(self) -> None:
+        from .cells import CELL_NODES
+
+        nodes = _frozen(self.nodes, np.int64)
+        if self.type not in CELL_NODES or nodes.ndim != 2 or nodes.shape[1] != CELL_NODES[self.type]:
+            raise ValueError(f"a {self.type} block needs (k, {CELL_NODES.get(self.type, '?')}) node indices")
+        object.__setattr__(self, "nodes", nodes)
+        if self.density is not None:
+            object.__setattr__(self, "density", _densities(self.density, len(nodes)))
+
+
+def _densities(values: ArrayLike, count: int) -> NDArray[np.float64]:
+    rho = _frozen(values, np.float64)
+    if rho.shape != (count,):
+        raise ValueError("cell densities need one value per cell")
+    _check_finite("cell densities", rho)
+    if np.any(rho <= 0):
+        raise InvalidParameterError("cell densities must be positive (kg/m^3)", field="density")
+    return rho
+
+
+@dataclass(frozen=True, slots=True)
+class VolumeBody:
+    """Volume cells: linear tetrahedra, and blocks of other cells.
+
+    points : (n, 3) float64, file units.  tets : (k, 4) int64 linear tetrahedra.
     cell_density : (k,) float64 kg/m^3 per tetrahedron, or None (uniform).
+    cells : blocks of hexahedra, wedges, pyramids and quadratic cells, each
+        integrated as the element it is (``cells``), with its own densities.
     """
 
     points: NDArray[np.float64]
@@ -76,27 +116,35 @@ class VolumeBody:
     length_scale: float = 1.0
     name: str | None = None
     warnings: tuple[str, ...] = ()
+    cells: tuple[CellBlock, ...] = ()
 
     def __post_init__(self) -> None:
         p = _frozen(self.points, np.float64)
-        t = _frozen(self.tets, np.int64)
+        t = _frozen(self.tets, np.int64).reshape(-1, 4) if np.size(self.tets) == 0 else _frozen(self.tets, np.int64)
         if p.ndim != 2 or p.shape[1] != 3 or t.ndim != 2 or t.shape[1] != 4:
             raise ValueError("points must be (n, 3) and tets (k, 4)")
-        if len(t) == 0:
+        if len(t) == 0 and not any(len(b.nodes) for b in self.cells):
             raise EmptyGeometryError("the volume mesh has no 3-D cells; send tetrahedra, hexahedra, wedges or pyramids")
         _check_finite("point coordinates", p)
-        if t.min() < 0 or t.max() >= len(p):
-            raise InvalidParameterError("a cell refers to a point that does not exist; the file is corrupt")
+        for nodes in [t, *(b.nodes for b in self.cells)]:
+            if len(nodes) and (nodes.min() < 0 or nodes.max() >= len(p)):
+                raise InvalidParameterError("a cell refers to a point that does not exist; the file is corrupt")
         object.__setattr__(self, "points", p)
         object.__setattr__(self, "tets", t)
         if self.cell_density is not None:
-            rho = _frozen(self.cell_density, np.float64)
-            if rho.shape != (len(t),):
-                raise ValueError("cell_density needs one value per tetrahedron")
-            _check_finite("cell densities", rho)
-            if np.any(rho <= 0):
-                raise InvalidParameterError("cell densities must be positive (kg/m^3)", field="density")
-            object.__setattr__(self, "cell_density", rho)
+            object.__setattr__(self, "cell_density", _densities(self.cell_density, len(t)))
+        weighted = {self.cell_density is not None for _ in t[:1]} | {b.density is not None for b in self.cells if len(b.nodes)}
+        if len(weighted) > 1:
+            raise ValueError("either every cell carries a density or none does")
+
+    @property
+    def weighted(self) -> bool:
+        """The cells carry their own densities."""
+        return self.cell_density is not None or any(b.density is not None for b in self.cells)
+
+    @property
+    def cell_count(self) -> int:
+        return len(self.tets) + sum(len(b.nodes) for b in self.cells)
 
 
 @dataclass(frozen=True, slots=True)

@@ -1,7 +1,16 @@
 """Command line: ``inertia analyze | batch | serve``, a thin front end over the pipeline.
 
-Errors are printed to stderr in the API's envelope and the exit status comes
-from ``EXIT_CODES``.
+Errors are printed to stderr as a sentence (``error: ... (code)``), or in the API's
+envelope with ``--json``; the exit status comes from ``EXIT_CODES``:
+
+    0  success
+    1  an unexpected internal error (a bug: please report it)
+    2  a bad option or parameter
+    3  a file that cannot be read: unsupported format, unreadable, no geometry
+    4  a body that is not a solid: open mesh, zero volume
+    5  a time limit was reached
+    6  the environment refused: a port in use, an output that cannot be written
+  130  interrupted (Ctrl-C)
 """
 
 from __future__ import annotations
@@ -9,6 +18,7 @@ from __future__ import annotations
 import argparse
 import gc
 import json
+import re
 import sys
 from collections.abc import Sequence
 from typing import Any
@@ -24,9 +34,24 @@ EXIT_CODES = {
     "empty_geometry": 3,
     "not_watertight": 4,
     "zero_volume": 4,
+    "insufficient_precision": 4,
+    "invalid_inertia": 4,
     "timeout": 5,
 }
 EXIT_INTERNAL = 1
+EXIT_ENVIRONMENT = 6
+EXIT_INTERRUPTED = 130
+
+# Lengths in the table: (label, metres per unit); masses: (label, kilograms per unit).
+OUTPUT_UNITS = {
+    "si": (("m", 1.0), ("kg", 1.0)),
+    "kg-mm": (("mm", 1e-3), ("kg", 1.0)),
+    "g-mm": (("mm", 1e-3), ("g", 1e-3)),
+    "g-cm": (("cm", 1e-2), ("g", 1e-3)),
+}
+
+# A value that starts like a negative number ("-0.1,2,0", "-1e-3"): argparse would take it for an option.
+_NEGATIVE_VALUE = re.compile(r"^-(\d|\.\d)")
 
 
 def _triple(text: str) -> tuple[float, float, float]:
@@ -39,22 +64,40 @@ def _triple(text: str) -> tuple[float, float, float]:
         raise argparse.ArgumentTypeError(f"expected three numbers x,y,z but got {text!r}") from None
 
 
+def _quaternion(text: str) -> tuple[float, float, float, float]:
+    parts = text.replace(" ", "").split(",")
+    try:
+        values = [float(v) for v in parts]
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected four numbers w,x,y,z but got {text!r}") from None
+    if len(values) != 4:
+        raise argparse.ArgumentTypeError(f"expected a quaternion w,x,y,z but got {text!r}")
+    return (values[0], values[1], values[2], values[3])
+
+
 def add_analysis_options(p: argparse.ArgumentParser) -> None:
     """Options shared by ``analyze`` and ``batch`` (the API's query parameters)."""
     p.add_argument("--format", help="file format; inferred from the name when absent")
-    p.add_argument("--units", help="length unit of the file: m, cm, mm, um, in, ft (default: the file's, else m)")
+    p.add_argument("--units", help="length unit of the file: m, cm, mm, um, in, ft, angstrom "
+                   "(default: the file's; angstrom for .xyz; else m)")
     group = p.add_mutually_exclusive_group()
     group.add_argument("--density", type=float, help="density in kg/m^3 (default 1000)")
     group.add_argument("--mass", type=float, help="total mass in kg (density is derived)")
     p.add_argument("--model", choices=("solid", "shell"), default="solid", help="closed solid or thin shell")
     p.add_argument("--thickness", type=float, help="shell wall thickness, in the file's units")
     p.add_argument("--tolerance", type=float, default=1e-6, help="relative tolerance for equal moments")
-    p.add_argument("--reference", type=_triple, help="x,y,z point (file units): also report the tensor about it")
+    p.add_argument("--reference", type=_triple, metavar="X,Y,Z",
+                   help="point (file units): also report the tensor about it; negative values as written: -1,0,0")
     p.add_argument("--densities", help="JSON file: part name -> density (kg/m^3) for files of several parts")
     p.add_argument("--geometry", choices=("brep", "mesh"), default="brep",
                    help="CAD files: integrate the exact B-rep (default) or a tessellation of it")
     p.add_argument("--deflection", type=float,
                    help="with --geometry mesh: chordal deflection relative to the bounding-box diagonal (default 1e-3)")
+    p.add_argument("--frame", type=_quaternion, metavar="W,X,Y,Z",
+                   help="unit quaternion carrying a named frame's axes into the file's: also report the centre of "
+                   "mass and tensors along that frame's axes")
+    p.add_argument("--isotopes", choices=("standard", "abundant"), default="standard",
+                   help="atoms named by element (.xyz): standard atomic weights or the most abundant isotope")
 
 
 def options_from_args(args: argparse.Namespace) -> Any:
@@ -85,24 +128,35 @@ def options_from_args(args: argparse.Namespace) -> Any:
         densities=densities,
         geometry=getattr(args, "geometry", "brep"),
         deflection=getattr(args, "deflection", None),
+        export=getattr(args, "export", None),
+        frame=getattr(args, "frame", None),
+        isotopes=getattr(args, "isotopes", "standard"),
     )
 
 
 def _parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="inertia", description="Mass properties and free rotation of rigid bodies.")
+    parser.add_argument("--version", action="version", version=f"%(prog)s {_package_version()}")
     sub = parser.add_subparsers(dest="command", required=True)
 
-    a = sub.add_parser("analyze", help="analyse one mesh or points file (.json/.csv)")
-    a.add_argument("file")
+    a = sub.add_parser("analyze", help="analyse one mesh or points file (.json/.csv/.xyz)")
+    a.add_argument("file", help="mesh, volume mesh or points file (.json/.csv/.xyz); the format from its name or --format")
     add_analysis_options(a)
-    a.add_argument("--omega", type=_triple, help="wx,wy,wz initial angular velocity, rad/s, input frame")
+    a.add_argument("--omega", type=_triple, metavar="WX,WY,WZ",
+                   help="initial angular velocity, rad/s, input frame (adds the precession section)")
     a.add_argument("--duration", type=float, help="seconds of motion to predict (with --omega and --samples)")
     a.add_argument("--samples", type=int, help="number of time samples of the trajectory")
-    a.add_argument("--method", default="exact", choices=("exact", "dop853", "rk45", "splitting"))
-    a.add_argument("--json", action="store_true", help="print the API's JSON instead of a table")
+    a.add_argument("--method", default="exact", choices=("exact", "dop853", "rk45", "splitting"),
+                   help="motion method: exact (closed form / elliptic), dop853, rk45 or splitting (default exact)")
+    a.add_argument("--json", action="store_true", help="print the API's JSON instead of a table (errors as JSON too)")
+    a.add_argument("--output-units", choices=tuple(OUTPUT_UNITS), default="si",
+                   help="units of the table: si (kg, m, kg m^2; default), kg-mm (kg mm^2), g-mm (g mm^2) or g-cm "
+                        "(g cm^2); --json stays SI")
+    a.add_argument("--export", choices=("urdf", "sdf", "mjcf"),
+                   help="print only the inertial element of a robot description format (SI units)")
 
     b = sub.add_parser("batch", help="analyse many files, folders or .zip archives into JSONL/CSV/Parquet")
-    b.add_argument("paths", nargs="+")
+    b.add_argument("paths", nargs="+", help="files, folders (read recursively) or .zip archives")
     b.add_argument("--out", required=True, help="results file: .jsonl, .csv or .parquet")
     b.add_argument("--resume", action="store_true", help="skip files that already have a line in --out")
     b.add_argument("--workers", type=int, help="local worker processes (default: the number of cores)")
@@ -111,10 +165,11 @@ def _parser() -> argparse.ArgumentParser:
     add_analysis_options(b)
 
     s = sub.add_parser("serve", help="serve the HTTP API under uvicorn")
-    s.add_argument("--host", default="127.0.0.1")
-    s.add_argument("--port", type=int, default=8000)
-    s.add_argument("--workers", type=int, default=1)
-    s.add_argument("--log-level", default="info")
+    s.add_argument("--host", default="127.0.0.1", help="address to listen on (default 127.0.0.1; 0.0.0.0 for all)")
+    s.add_argument("--port", type=int, default=8000, help="port to listen on (default 8000)")
+    s.add_argument("--workers", type=int, default=1, help="uvicorn worker processes (default 1)")
+    s.add_argument("--log-level", default="info", choices=("critical", "error", "warning", "info", "debug", "trace"),
+                   help="uvicorn's log level (default info)")
     return parser
 
 
@@ -129,8 +184,26 @@ def console_main() -> int:
     return code
 
 
+def _package_version() -> str:
+    from . import __version__
+
+    return str(__version__)
+
+
+def joined_negative_values(argv: Sequence[str]) -> list[str]:
+    """``--omega -0.1,2,0`` as ``--omega=-0.1,2,0``, so argparse does not read the value as an option."""
+    out: list[str] = []
+    for token in argv:
+        if out and _NEGATIVE_VALUE.match(token) and out[-1].startswith("--") and "=" not in out[-1]:
+            out[-1] = f"{out[-1]}={token}"
+        else:
+            out.append(token)
+    return out
+
+
 def main(argv: Sequence[str] | None = None) -> int:
-    args = _parser().parse_args(argv)
+    args = _parser().parse_args(joined_negative_values(sys.argv[1:] if argv is None else argv))
+    as_json = bool(getattr(args, "json", False))
     try:
         if args.command == "analyze":
             return _analyze(args)
@@ -140,11 +213,17 @@ def main(argv: Sequence[str] | None = None) -> int:
             return run_batch_cli(args)
         return _serve(args)
     except ServiceError as exc:
-        print(json.dumps(exc.as_dict()), file=sys.stderr)
+        if as_json:
+            print(json.dumps(exc.as_dict()), file=sys.stderr)
+        else:
+            print(f"error: {exc.message} ({exc.code})", file=sys.stderr)
         return EXIT_CODES.get(exc.code, EXIT_INTERNAL)
     except BrokenPipeError:  # output piped into head & co.: not an error of ours
         sys.stderr.close()
         return 0
+    except KeyboardInterrupt:
+        print("interrupted", file=sys.stderr)
+        return EXIT_INTERRUPTED
 
 
 def _analyze(args: argparse.Namespace) -> int:
@@ -152,16 +231,47 @@ def _analyze(args: argparse.Namespace) -> int:
 
     result = analyze(args.file, options=options_from_args(args))
     doc = result.as_dict()
+    if getattr(args, "export", None) and not args.json:
+        print(export_text(doc))
+        for w in doc.get("warnings", []):
+            print(f"warning: {w}", file=sys.stderr)
+        return 0
     if args.json:
-        print(json.dumps(doc, indent=2))
+        try:
+            text = json.dumps(doc, indent=2, allow_nan=False)
+        except ValueError as exc:  # a non-finite number is a bug: say so, never print Infinity or NaN
+            raise InvalidParameterError("the result holds a number that is not finite, which JSON cannot carry; "
+                                        "please report the input") from exc
+        print(text)
     else:
-        print(render_table(doc))
+        print(render_table(doc, args.output_units))
     return 0
+
+
+def _port_free(host: str, port: int) -> bool:
+    import socket
+
+    try:
+        infos = socket.getaddrinfo(host, port, type=socket.SOCK_STREAM, flags=socket.AI_PASSIVE)
+    except socket.gaierror:
+        return True  # uvicorn reports an unknown host itself
+    family, kind, proto, _, address = infos[0]
+    with socket.socket(family, kind, proto) as probe:
+        probe.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)  # as uvicorn binds
+        try:
+            probe.bind(address)
+        except OSError:
+            return False
+    return True
 
 
 def _serve(args: argparse.Namespace) -> int:
     import uvicorn
 
+    if not _port_free(args.host, args.port):
+        print(f"error: port {args.port} on {args.host} is in use or not available; stop the other server "
+              f"or choose another port with --port", file=sys.stderr)
+        return EXIT_ENVIRONMENT
     # the service writes its own structured access line (inertia.api.access)
     uvicorn.run(f"{__package__}.app:app", host=args.host, port=args.port, workers=args.workers,
                 log_level=args.log_level, access_log=False)
@@ -176,43 +286,80 @@ def _vec(v: Sequence[float]) -> str:
     return "[" + ", ".join(_fmt(x) for x in v) + "]"
 
 
-def render_table(doc: dict[str, Any]) -> str:
-    """A readable summary of an analysis result (SI units)."""
+def export_text(doc: dict[str, Any]) -> str:
+    """The export snippet alone; for several parts, each part's after the whole body's, named in a comment."""
+    export = doc["export"]
+    blocks = [export["text"]]
+    for part in export.get("parts", []):
+        blocks.append(f"<!-- part {part['name'].replace('--', '- -')} -->\n{part['text']}")
+    return "\n".join(blocks)
+
+
+def _v11_rows(doc: dict[str, Any], length: Any, tensor_rows: Any) -> list[tuple[str, str]]:
+    """Rows of the API 1.1 sections: rotational constants and the named frame (in the table's units)."""
+    rows: list[tuple[str, str]] = []
+    rc = doc.get("rotational_constants")
+    if rc is not None:
+        names = "B" if len(rc["MHz"]) == 1 else "A, B, C"
+        rows.append((f"rotational {names}", ", ".join(f"{v:.9g}" for v in rc["MHz"]) + " MHz"))
+        rows.append(("", ", ".join(f"{v:.9g}" for v in rc["cm-1"]) + " cm^-1"))
+    fr = doc.get("frame")
+    if fr is not None:
+        rows.append(("frame (w,x,y,z)", _vec(fr["quaternion"])))
+        rows.append(("  centre of mass", length(fr["center_of_mass"])))
+        rows += tensor_rows("  inertia tensor", fr["inertia_tensor"])
+        if "reference_inertia" in fr:
+            rows += tensor_rows("  about reference", fr["reference_inertia"])
+    return rows
+
+
+def render_table(doc: dict[str, Any], output_units: str = "si") -> str:
+    """A readable summary of an analysis result, in ``OUTPUT_UNITS[output_units]`` (SI by default)."""
+    (ln, lu), (mn, mu) = OUTPUT_UNITS[output_units]
+    inertia_unit = f"{mn} {ln}^2"
+
+    def length(v: Sequence[float]) -> str:
+        return f"{_vec([x / lu for x in v])} {ln}"
+
+    def tensor_rows(label: str, tensor: Sequence[Sequence[float]]) -> list[tuple[str, str]]:
+        scale = mu * lu * lu
+        return [(label if i == 0 else "", f"{_vec([x / scale for x in row])} {inertia_unit}")
+                for i, row in enumerate(tensor)]
+
     src = doc["source"]
     lines = [f"{src.get('filename', 'points')}  ({src['format']}, {src['kind']}, units {src['units']})"]
-    rows: list[tuple[str, str]] = [("mass", f"{_fmt(doc['mass'])} kg")]
+    rows: list[tuple[str, str]] = [("mass", f"{_fmt(doc['mass'] / mu)} {mn}")]
     if "volume" in doc:
-        rows.append(("volume", f"{_fmt(doc['volume'])} m^3"))
+        rows.append(("volume", f"{_fmt(doc['volume'] / lu**3)} {ln}^3"))
     if "density" in doc:
-        rows.append(("density", f"{_fmt(doc['density'])} kg/m^3"))
-    rows.append(("centre of mass", f"{_vec(doc['center_of_mass'])} m"))
-    for i, row in enumerate(doc["inertia_tensor"]):
-        rows.append(("inertia tensor" if i == 0 else "", f"{_vec(row)} kg m^2"))
+        rows.append(("density", f"{_fmt(doc['density'] / mu * lu**3)} {mn}/{ln}^3"))
+    if "surface_area" in doc:
+        rows.append(("surface area", f"{_fmt(doc['surface_area'] / lu**2)} {ln}^2"))
+    rows.append(("centre of mass", length(doc["center_of_mass"])))
+    rows += tensor_rows("inertia tensor", doc["inertia_tensor"])
     pr = doc["principal"]
-    rows.append(("principal moments", f"{_vec(pr['moments'])} kg m^2"))
+    rows.append(("principal moments", f"{_vec([x / (mu * lu * lu) for x in pr['moments']])} {inertia_unit}"))
     for i, axis in enumerate(pr["axes"]):
         rows.append((f"axis {i + 1}", _vec(axis)))
+    if "radii_of_gyration" in pr:
+        rows.append(("radii of gyration", length(pr["radii_of_gyration"])))
     cls = doc["classification"]
     kind = cls["kind"] + (f" ({cls['shape']})" if "shape" in cls else "")
     rows.append(("class", kind))
     if "asymmetry" in cls:
         rows.append(("asymmetry kappa", _fmt(cls["asymmetry"])))
     rows.append(("planar", str(cls["planar"]).lower()))
+    rows += _v11_rows(doc, length, tensor_rows)
     if "reference_inertia" in doc:
         ref = doc["reference_inertia"]
-        for i, row in enumerate(ref["tensor"]):
-            rows.append((f"tensor about {_vec(ref['point'])}" if i == 0 else "", f"{_vec(row)} kg m^2"))
+        rows += tensor_rows(f"tensor about {length(ref['point'])}", ref["tensor"])
     if "precession" in doc:
-        pc = doc["precession"]
-        rows.append(("precession", pc.get("regime", "")))
-        for key in ("angular_momentum_magnitude", "kinetic_energy", "body_precession_rate",
-                    "space_precession_rate", "spin_rate", "nutation_angle", "period", "flip_interval"):
-            if key in pc:
-                rows.append((key.replace("_", " "), _fmt(pc[key])))
+        rows += _motion_rows(doc["precession"], inertia_unit, mu * lu * lu)
     if "parts" in doc:
         for part in doc["parts"]:
-            rows.append((f"part {part['name']}", f"mass {_fmt(part['mass'])} kg, "
-                         f"moments {_vec(part['principal']['moments'])}"))
+            moments = [x / (mu * lu * lu) for x in part["principal"]["moments"]]
+            rows.append((f"part {part['name']}", f"mass {_fmt(part['mass'] / mu)} {mn}, "
+                         f"moments {_vec(moments)} {inertia_unit}"))
     diag = doc["diagnostics"]
     rows.append(("relative error", f"{diag['relative_error_estimate']:.2g}"))
     rows.append(("elapsed", f"{diag['elapsed_s'] * 1e3:.2f} ms"))
@@ -220,3 +367,22 @@ def render_table(doc: dict[str, Any]) -> str:
     lines += [f"  {k:<{width}}  {v}" for k, v in rows]
     lines += [f"  warning: {w}" for w in doc.get("warnings", [])]
     return "\n".join(lines)
+
+
+# Motion quantities of the table with their units; momentum and energy scale with the inertia unit.
+_MOTION_UNITS = {
+    "angular_momentum_magnitude": "momentum", "kinetic_energy": "energy",
+    "body_precession_rate": "rad/s", "space_precession_rate": "rad/s", "spin_rate": "rad/s",
+    "nutation_angle": "rad", "period": "s", "flip_interval": "s",
+}
+
+
+def _motion_rows(pc: dict[str, Any], inertia_unit: str, inertia_scale: float) -> list[tuple[str, str]]:
+    """|M| in (inertia unit)/s and E in (inertia unit)/s^2 (J in SI); rates, angles and times in SI."""
+    scaled = {"momentum": f"{inertia_unit}/s", "energy": "J" if inertia_unit == "kg m^2" else f"{inertia_unit}/s^2"}
+    rows = [("precession", pc.get("regime", ""))]
+    for key, unit in _MOTION_UNITS.items():
+        if key in pc:
+            value = pc[key] / inertia_scale if unit in scaled else pc[key]
+            rows.append((key.replace("_", " "), f"{_fmt(value)} {scaled.get(unit, unit)}"))
+    return rows

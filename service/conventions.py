@@ -36,6 +36,7 @@ LENGTH_UNITS: dict[str, float] = {
     "um": 1e-6,
     "in": 0.0254,  # exact by the 1959 international yard and pound agreement
     "ft": 0.3048,
+    "angstrom": 1e-10,  # molecules (XYZ files, points); exact by definition
 }
 
 

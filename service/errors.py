@@ -14,16 +14,20 @@ __all__ = [
     "LoadError",
     "UnsupportedFormatError",
     "UnreadableFileError",
+    "ExternalReferenceError",
     "EmptyGeometryError",
     "InvalidMeshError",
     "NotWatertightError",
     "DegenerateBodyError",
     "ZeroVolumeError",
+    "InsufficientPrecisionError",
     "InvalidParameterError",
     "MotionError",
     "PayloadTooLargeError",
     "ComputeTimeoutError",
     "UnauthorizedError",
+    "InvalidInertiaError",
+    "ServerBusyError",
 ]
 
 
@@ -60,6 +64,12 @@ class UnreadableFileError(LoadError):
     code = "unreadable_file"
 
 
+class ExternalReferenceError(UnreadableFileError):
+    """The file names another file (an include, an external buffer) that did not come with it."""
+
+    code = "external_reference"
+
+
 class EmptyGeometryError(LoadError):
     code = "empty_geometry"
 
@@ -82,6 +92,14 @@ class ZeroVolumeError(DegenerateBodyError):
     code = "zero_volume"
 
 
+class InsufficientPrecisionError(DegenerateBodyError):
+    """The stored coordinates cannot represent the body: its volume or a moment is within the
+    change their resolution allows (float32 far from the origin, degenerate shells), or the
+    polyhedron they make has a zero or negative principal moment."""
+
+    code = "insufficient_precision"
+
+
 class InvalidParameterError(ServiceError):
     code = "invalid_parameter"
 
@@ -102,3 +120,15 @@ class ComputeTimeoutError(ServiceError):
 
 class UnauthorizedError(ServiceError):
     code = "unauthorized"
+
+
+class InvalidInertiaError(ServiceError):
+    """The body's inertia is one a simulator would refuse to load (robotics export)."""
+
+    code = "invalid_inertia"
+
+
+class ServerBusyError(ServiceError):
+    """Every compute process is busy and the queue of waiting jobs is full; retry later."""
+
+    code = "server_busy"

@@ -29,9 +29,9 @@ from .arrays import freeze_fields
 from .body import Body, PointBody, VolumeBody
 from .conventions import DEFAULT_DENSITY
 from .ddouble import rotated
-from .errors import InvalidParameterError, ZeroVolumeError
+from .eigen import jacobi_eigh
+from .errors import InsufficientPrecisionError, InvalidParameterError, ZeroVolumeError
 from .integrals import Sums, local_origin, point_sums, simplex_sums
-from .principal import jacobi_eigh
 from .solid import closed_surface
 from .tolerances import DEFAULT_TOLERANCES, EPS, Tolerances
 
@@ -126,8 +126,11 @@ class _Geometry:
     """Points + cells of one body in a form the passes can re-integrate."""
 
     def __init__(self, points: NDArray[np.float64], cells: NDArray[np.int64], kind: str,
-                 weight: NDArray[np.float64] | None) -> None:
+                 weight: NDArray[np.float64] | None, coordinate_eps: float = 2.0**-53,
+                 blocks: tuple[QuadBlock, ...] = ()) -> None:
         self.points, self.cells, self.kind, self.weight = points, cells, kind, weight
+        self.coordinate_eps = coordinate_eps  # unit roundoff of the stored coordinates (float32: 2**-24)
+        self.blocks = blocks  # volume cells other than linear tetrahedra: (type, nodes, weight), by quadrature
 
     @property
     def referenced_points(self) -> int:
@@ -141,12 +144,30 @@ class _Geometry:
                 if self.kind == "points":
                     assert self.weight is not None
                     return point_sums(self.weight, x)
-                return simplex_sums(x, self.cells, self.kind, self.weight)
+                if not self.blocks:
+                    return simplex_sums(x, self.cells, self.kind, self.weight)
+                return _volume_sums(x, self.cells, self.weight, self.blocks)
         except FloatingPointError as exc:
             raise InvalidParameterError(
                 "the coordinates or masses are so large that the inertia integrals overflow floating point; "
                 "express the input in other units"
             ) from exc
+
+
+QuadBlock = tuple[str, NDArray[np.int64], NDArray[np.float64] | None]
+
+
+def _volume_sums(x: NDArray[np.float64], tets: NDArray[np.int64], weight: NDArray[np.float64] | None,
+                 blocks: tuple[QuadBlock, ...]) -> Sums:
+    """Linear tetrahedra in closed form plus every other cell by its exact quadrature (``cells``)."""
+    from .cells import cell_sums, combined
+
+    total = simplex_sums(x, tets, "tet", weight) if len(tets) else None
+    for name, nodes, w in blocks:
+        part = cell_sums(x, name, nodes, w)
+        total = part if total is None else combined(total, part)
+    assert total is not None
+    return total
 
 
 @dataclass(frozen=True, slots=True)
@@ -165,6 +186,7 @@ class _Refined:
     moments: NDArray[np.float64]
     axes: NDArray[np.float64]
     estimate: float
+    warnings: tuple[str, ...] = ()
 
 
 def _refine(geometry: _Geometry, tolerances: Tolerances) -> _Refined:
@@ -191,12 +213,101 @@ def _refine(geometry: _Geometry, tolerances: Tolerances) -> _Refined:
         if settled:
             break
     _check_volume(s, geometry.kind)
-    estimate = _error_estimate(s, values)
+    estimate, errors = _error_estimate(s, values)
     if not settled:
         estimate = max(estimate, step)
+    values, warnings = _physical_moments(geometry, values, errors)
+    if geometry.kind == "apex":
+        warnings += _check_resolution(geometry, s, com, rotation, values)
     tensor = rotation @ np.diag(values) @ rotation.T
     tensor = 0.5 * (tensor + tensor.T)
-    return _Refined(s, com, tensor, values, rotation.T.copy(), estimate)
+    return _Refined(s, com, tensor, values, rotation.T.copy(), estimate, warnings)
+
+
+def _physical_moments(geometry: _Geometry, values: NDArray[np.float64],
+                      errors: NDArray[np.float64]) -> tuple[NDArray[np.float64], tuple[str, ...]]:
+    """No zero or negative moment of a solid, and no negative moment at all, comes back.
+
+    Points on one line have a smallest moment that is zero up to rounding: it is
+    reported as 0 (a linear rotator), with a warning.  A solid or a surface
+    always has three positive moments (I1 + I2 >= I3 too); a stored polyhedron
+    whose integration gives a moment within its rounding of zero, or below,
+    is not a body (its faces cross or its shells are degenerate) and is refused.
+    """
+    low = values <= errors
+    if geometry.kind == "points":
+        # the second pass's rotation leaves a line's points off it by ~eps of their spread: a smallest
+        # moment below 64 eps of the largest (the motion's rounding level) is that, not a size
+        low |= values <= 64 * EPS * float(np.max(values))
+        if not np.any(low):
+            return values, ()
+        if bool(np.all(low)):  # a single point, or all the mass at one place: every moment is zero
+            return np.zeros(3), () if not np.any(values) else (
+                "all principal moments are zero within rounding (the mass is at one point) and are reported as 0",)
+        return np.where(low, 0.0, values), (
+            "the smallest principal moment is zero within rounding (the points lie on a line) and is reported as 0",)
+    order = np.sort(values)
+    slack = float(errors.sum())
+    if np.any(low) or order[0] + order[1] < order[2] - slack:
+        raise InsufficientPrecisionError(
+            "the stored polyhedron integrates to principal moments no body has (zero, negative, or "
+            f"I1 + I2 < I3: {', '.join(f'{x:.6g}' for x in order)} in the file's units): its faces cross "
+            "or its shells are degenerate; repair the mesh or export it nearer the origin in float64",
+            moments=[float(x) for x in order])
+    return values, ()
+
+
+_RESOLUTION_REFUSE = 1.0
+"""Refuse a surface whose volume or a moment could change by this fraction of itself when every
+stored coordinate moves by its resolution: the file does not determine the body."""
+_RESOLUTION_WARN = 1e-3
+"""Warn (naming the resolution) above this fraction: the stored polyhedron is computed exactly,
+but it may differ that much from the part it was exported from."""
+
+
+def _check_resolution(geometry: _Geometry, s: Sums, com: NDArray[np.float64], rotation: NDArray[np.float64],
+                      values: NDArray[np.float64]) -> tuple[str, ...]:
+    """Refuse a closed surface its stored coordinates cannot represent; warn when they barely do.
+
+    Each stored coordinate x is the exporter's value to within delta = u |x|max
+    (u: the storage's unit roundoff, 2**-24 for float32).  Moving every surface
+    point by up to sqrt(3) delta changes the volume by at most sqrt(3) delta A
+    (A the surface area) and moment k by at most that volume times the largest
+    squared distance of the surface from axis k.  When either change reaches
+    the quantity itself, the numbers describe the rounding, not a part.
+    """
+    x = geometry.points
+    delta = geometry.coordinate_eps * float(np.abs(x).max())
+    y = x - com
+    area = 0.0
+    for start in range(0, len(geometry.cells), 1 << 16):
+        tri = y[geometry.cells[start : start + (1 << 16)]]
+        area += 0.5 * float(np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]), axis=1).sum())
+    weight = 1.0 if geometry.weight is None else float(np.max(geometry.weight))
+    moved = math.sqrt(3.0) * delta * area  # volume the resolution can move
+    volume = abs(s.measure)
+    along = y @ rotation  # principal-frame coordinates (columns of rotation are the axes)
+    sq = along * along
+    reach = np.array([float(np.max(sq.sum(axis=1) - sq[:, k])) for k in range(3)])
+    ratio_v = moved / volume if volume > 0 else math.inf
+    ratio_i = float(np.max(moved * weight * reach / values))
+    ratio = max(ratio_v, ratio_i)
+    if not ratio >= _RESOLUTION_WARN:
+        return ()
+    float32 = geometry.coordinate_eps >= 2.0**-24
+    cause = (f"the file's float32 coordinates, {float(np.abs(x).max()):.3g} units from the origin, are resolved "
+             f"only to {delta:.3g} units" if float32 else
+             f"its coordinates are resolved only to {delta:.3g} units (degenerate shells, or a body thinner "
+             "than the rounding of its coordinates)")
+    if ratio >= _RESOLUTION_REFUSE:
+        raise InsufficientPrecisionError(
+            f"the stored coordinates cannot represent this body: {cause}, which can change its volume or a "
+            f"principal moment by {ratio:.3g} times its own value; "
+            + ("export it in float64 (e.g. OBJ, or ASCII STL with 9 digits) or nearer the origin"
+               if float32 else "repair the degenerate shells or export the part nearer the origin"),
+            resolution=delta, ratio=min(ratio, 1e300))
+    return (f"{cause}: the stored polyhedron is integrated exactly, but it may differ from the exported part by up "
+            f"to {ratio:.2g} of its volume or a principal moment; export in float64 or nearer the origin to avoid it",)
 
 
 def _offdiagonal_ratio(t: NDArray[np.float64]) -> float:
@@ -208,8 +319,11 @@ def _offdiagonal_ratio(t: NDArray[np.float64]) -> float:
     return worst
 
 
-def _error_estimate(s: Sums, moments: NDArray[np.float64]) -> float:
-    """Relative rounding-error bound of each principal moment, the worst one.
+def _error_estimate(s: Sums, moments: NDArray[np.float64]) -> tuple[float, NDArray[np.float64]]:
+    """Relative rounding-error bound of each principal moment, the worst one, and each one's absolute bound.
+
+    A moment within its absolute bound of zero is left out of the relative
+    estimate (``_physical_moments`` reports it as 0, or refuses the body).
 
     In the final pass (principal frame, about the centre of mass) the
     coordinates are exact to their last bit, so the error comes from each
@@ -221,14 +335,10 @@ def _error_estimate(s: Sums, moments: NDArray[np.float64]) -> float:
     per_block = max(2, math.ceil(s.terms / max(s.blocks, 1)))
     gamma = (math.log2(per_block) + math.log2(max(s.blocks, 1)) + 4) * EPS
     diag_err = gamma * np.diag(s.abs_m2) + 8 * EPS * s.element_err
-    worst = 0.0
-    for k in range(3):
-        err = sum(diag_err[j] for j in range(3) if j != k)
-        if moments[k] > 0:
-            worst = max(worst, err / moments[k])
-        elif err > 0:
-            worst = math.inf
-    return max(worst, 4 * EPS)
+    errors = np.array([sum(diag_err[j] for j in range(3) if j != k) for k in range(3)], dtype=np.float64)
+    live = moments > errors
+    worst = float(np.max(errors[live] / moments[live])) if np.any(live) else 1.0
+    return max(worst, 4 * EPS), errors
 
 
 def _check_volume(s: Sums, kind: str) -> None:
@@ -247,11 +357,24 @@ def _geometry(body: Body, model: str, thickness: float | None, tolerances: Toler
     if isinstance(body, VolumeBody):
         if model == Model.SHELL:
             raise InvalidParameterError("model=shell needs a surface mesh; a volume mesh is always a solid", parameter="model")
-        return _Geometry(body.points, body.tets, "tet", body.cell_density), ()
+        blocks = tuple((b.type, b.nodes, b.density) for b in body.cells)
+        return _Geometry(body.points, body.tets, "tet", body.cell_density, blocks=blocks), _tangled_warning(body)
     if model == Model.SHELL:
         return _Geometry(body.vertices, body.faces, "tri", None), ()
     vertices, faces, warnings = closed_surface(body)
-    return _Geometry(vertices, faces, "apex", None), warnings
+    return _Geometry(vertices, faces, "apex", None, body.coordinate_eps), warnings
+
+
+def _tangled_warning(body: VolumeBody) -> tuple[str, ...]:
+    if not body.cells:
+        return ()
+    from .cells import tangled_cells
+
+    count = sum(tangled_cells(body.points, b.type, b.nodes) for b in body.cells)
+    if not count:
+        return ()
+    return (f"{count} of {body.cell_count} cells fold over themselves (their Jacobian changes sign); "
+            "each was integrated with its signed Jacobian, so a folded region counts negatively: check the mesh",)
 
 
 def mass_properties(
@@ -291,7 +414,7 @@ def mass_properties(
     else:
         area = None
         volume = s.m0 * L**3
-        weighted = isinstance(body, VolumeBody) and body.cell_density is not None
+        weighted = isinstance(body, VolumeBody) and body.weighted
         if weighted:
             volume = s.measure * L**3
             measure_to_mass = 1.0 if mass is None else mass / (s.m0 * L**3)
@@ -317,7 +440,7 @@ def mass_properties(
         volume=None if volume is None else float(volume),
         density=None if uniform_density is None else float(uniform_density),
         area=None if area is None else float(area),
-        warnings=body.warnings + warnings,
+        warnings=body.warnings + warnings + refined.warnings,
         mesh_vertices=geometry.referenced_points if geometry.kind == "apex" else None,
     )
 
@@ -350,7 +473,10 @@ def assembly_properties(
     warnings: list[str] = []
     for body, density in parts:
         geometry, more = _geometry(body, model, thickness, tolerances)
-        geoms.append((geometry, _element_weights(geometry, density, model, thickness, L) * factor))
+        weights = _element_weights(geometry, density, model, thickness, L) * factor
+        geometry.blocks = tuple((name, nodes, _block_weights(w, len(nodes), density) * factor)
+                                for name, nodes, w in geometry.blocks)
+        geoms.append((geometry, weights))
         warnings.extend(more)
     kinds = {g.kind for g, _ in geoms}
     if len(kinds) != 1:
@@ -362,6 +488,8 @@ def assembly_properties(
         np.concatenate([g.cells + off for (g, _), off in zip(geoms, offsets)]) if kind != "points" else np.empty((0, 0), np.int64),
         kind,
         np.concatenate([w for _, w in geoms]),
+        max(g.coordinate_eps for g, _ in geoms),
+        tuple((name, nodes + off, w) for (g, _), off in zip(geoms, offsets) for name, nodes, w in g.blocks),
     )
     refined = _refine(whole, tolerances)
     s, com, tensor, moments, axes, estimate = (refined.sums, refined.com, refined.tensor, refined.moments,
@@ -377,7 +505,7 @@ def assembly_properties(
         principal_moments=moments * inertia_scale,
         principal_axes=axes,
         relative_error_estimate=float(estimate + 8 * EPS),
-        warnings=tuple(warnings),
+        warnings=tuple(warnings) + refined.warnings,
     )
 
 
@@ -392,6 +520,13 @@ def _element_weights(geometry: _Geometry, density: float | None, model: str, thi
         assert thickness is not None
         rho = rho * thickness * L
     return np.full(n, rho)
+
+
+def _block_weights(weight: NDArray[np.float64] | None, count: int, density: float | None) -> NDArray[np.float64]:
+    """Density of each cell of a block: its own, or the part's uniform density."""
+    if weight is not None:
+        return np.asarray(weight, dtype=np.float64)
+    return np.full(count, DEFAULT_DENSITY if density is None else density)
 
 
 def _check_finite_results(mass: float, com: NDArray[np.float64], tensor: NDArray[np.float64]) -> None:

@@ -21,16 +21,19 @@ import numpy as np
 from numpy.typing import NDArray
 
 from .body import BrepBody
-from .classify import Classification, classify
+from .classification import Classification, classify
 from .conventions import length_scale
 from .errors import InvalidParameterError
 from .load import Loaded, load_body, load_points
 from .mass import InertiaTensor, MassProperties, Model, assembly_properties, mass_properties
-from .principal import PrincipalFrame, principal_frame
+from .principal import PrincipalFrame, principal_frame, tensor_frame
 from .tolerances import DEFAULT_TOLERANCES, EPS
 
 if TYPE_CHECKING:
+    from .export import Snippet
+    from .frames import NamedFrame
     from .motion import FreeMotion
+    from .rotational import RotationalConstants
 
 __all__ = ["AnalysisOptions", "AnalysisResult", "PartResult", "analyze", "analyze_points",
            "analyze_loaded", "PrecessionResult", "precession"]
@@ -80,6 +83,10 @@ class AnalysisOptions:
     densities: Mapping[str, float] | None = None
     geometry: str = "brep"
     deflection: float | None = None
+    export: str | None = None
+    frame: tuple[float, float, float, float] | None = None
+    isotopes: str = "standard"
+    mass_unit: str = "kg"
 
     def __post_init__(self) -> None:
         if self.units is not None:
@@ -105,7 +112,26 @@ class AnalysisOptions:
         if self.densities is not None:
             for name, rho in self.densities.items():
                 _positive(f"densities[{name!r}]", rho)
+        _check_v11(self)
         _check_geometry(self.geometry, self.deflection)
+
+
+def _check_v11(options: AnalysisOptions) -> None:
+    """The options of API 1.1: export, frame, isotopes, mass_unit."""
+    from .export import EXPORT_FORMATS
+    from .frames import frame_rotation
+
+    if options.export is not None and options.export not in EXPORT_FORMATS:
+        raise InvalidParameterError(f"export must be one of {', '.join(EXPORT_FORMATS)}, got {options.export!r}",
+                                    parameter="export")
+    if options.frame is not None:
+        q, _ = frame_rotation(options.frame)
+        object.__setattr__(options, "frame", tuple(float(v) for v in q))
+    if options.isotopes not in ("standard", "abundant"):
+        raise InvalidParameterError(f"isotopes must be 'standard' or 'abundant', got {options.isotopes!r}",
+                                    parameter="isotopes")
+    if options.mass_unit not in ("kg", "u"):
+        raise InvalidParameterError(f"mass_unit must be 'kg' or 'u', got {options.mass_unit!r}", parameter="mass_unit")
 
 
 def _check_geometry(geometry: str, deflection: float | None) -> None:
@@ -128,6 +154,8 @@ class PartResult:
     props: MassProperties
     frame: PrincipalFrame
     classification: Classification
+    surface_area: float | None = None
+    export: Snippet | None = None
 
 
 @dataclass(frozen=True, slots=True)
@@ -144,6 +172,10 @@ class AnalysisResult:
     warnings: tuple[str, ...] = ()
     elapsed_s: float = 0.0
     tessellation_error: float | None = None
+    surface_area: float | None = None
+    rotational_constants: RotationalConstants | None = None
+    named_frame: NamedFrame | None = None
+    export: Snippet | None = None
 
     def as_dict(self) -> dict[str, Any]:
         from .report import analysis_dict
@@ -152,21 +184,59 @@ class AnalysisResult:
 
 
 def analyze(
-    source: bytes | str | os.PathLike[str],
+    source: bytes | str | os.PathLike[str] | Any,
     *,
     filename: str | None = None,
     options: AnalysisOptions = AnalysisOptions(),
 ) -> AnalysisResult:
-    """Analyse a mesh or points file (bytes, or a path)."""
+    """Analyse a mesh or points file (bytes, or a path), a ``trimesh.Trimesh``, or ``(vertices, faces)`` arrays.
+
+    Arrays and mesh objects are in ``options.units`` (default metres): vertices (n, 3), faces (m, 3) of
+    vertex indices, a closed surface wound either way.
+    """
     start = time.perf_counter()
-    loaded = load_body(source, filename=filename, format=options.format, units=options.units)
+    if isinstance(source, (bytearray, memoryview)):
+        source = bytes(source)
+    if isinstance(source, (bytes, str, os.PathLike)):
+        loaded = load_body(source, filename=filename, format=options.format, units=options.units,
+                           isotopes=options.isotopes)
+    else:
+        loaded = _loaded_from_arrays(source, filename, options.units)
     return analyze_loaded(loaded, options, start)
 
 
+def _loaded_from_arrays(source: Any, filename: str | None, units: str | None) -> Loaded:
+    """A surface given in memory: an object with ``vertices`` and ``faces`` (trimesh's Trimesh) or a pair."""
+    from .body import MeshBody, Part
+
+    if hasattr(source, "vertices") and hasattr(source, "faces"):
+        vertices, faces, fmt = source.vertices, source.faces, type(source).__name__.lower()
+    elif isinstance(source, (tuple, list)) and len(source) == 2:
+        (vertices, faces), fmt = source, "arrays"
+    else:
+        raise InvalidParameterError(
+            f"cannot analyse a {type(source).__name__}: give a file path, the file's bytes, a trimesh.Trimesh "
+            "or a (vertices, faces) pair of arrays", parameter="source")
+    try:
+        v = np.array(vertices, dtype=np.float64)
+        f = np.array(faces)
+    except (TypeError, ValueError) as exc:
+        raise InvalidParameterError(f"vertices and faces must be numeric arrays: {exc}", parameter="source") from exc
+    if f.dtype.kind not in "iu" and not (f.dtype.kind == "f" and np.array_equal(f, np.round(f))):
+        raise InvalidParameterError("faces must hold whole vertex indices", parameter="source")
+    try:
+        body = MeshBody(v, f.astype(np.int64), length_scale(units or "m"), filename or "body")
+    except ValueError as exc:  # shapes
+        raise InvalidParameterError(f"{exc}; got vertices {v.shape} and faces {f.shape}", parameter="source") from exc
+    name = filename or "body"
+    return Loaded((Part(name, body),), filename, fmt, "mesh", units or "m", "request" if units else "default")
+
+
 def analyze_points(records: list[dict[str, Any]], options: AnalysisOptions = AnalysisOptions()) -> AnalysisResult:
-    """Analyse point masses ``[{"mass": m, "position": [x, y, z]}, ...]``."""
+    """Analyse point masses ``[{"mass": m, "position": [x, y, z]}, ...]`` (or ``"element"`` for ``mass``)."""
     start = time.perf_counter()
-    return analyze_loaded(load_points(records, options.units), options, start)
+    loaded = load_points(records, options.units, isotopes=options.isotopes, mass_unit=options.mass_unit)
+    return analyze_loaded(loaded, options, start)
 
 
 def analyze_loaded(loaded: Loaded, options: AnalysisOptions, start: float | None = None) -> AnalysisResult:
@@ -176,6 +246,14 @@ def analyze_loaded(loaded: Loaded, options: AnalysisOptions, start: float | None
         return _tessellated_cad(loaded, options, start)
     if loaded.kind == "points" and options.model == Model.SHELL:
         raise InvalidParameterError("model=shell applies to surface meshes, not point masses", parameter="model")
+    _check_part_names(loaded, options)
+    if loaded.kind == "mesh" and len(loaded.parts) > 1 and options.model == Model.SOLID and not options.densities:
+        # open parts that close together become one body (with per-part densities they stay apart, and
+        # an open part is refused by name: one body cannot hold two materials)
+        from .seams import join_open_parts
+
+        parts_joined, _ = join_open_parts(list(loaded.parts))
+        loaded = replace(loaded, parts=tuple(parts_joined))
     single = len(loaded.parts) == 1
     part_results = tuple(_part(p.name, p.body, options, single) for p in loaded.parts)
     factor = 1.0
@@ -194,6 +272,9 @@ def analyze_loaded(loaded: Loaded, options: AnalysisOptions, start: float | None
     warnings = list(loaded.warnings) + list(props.warnings)
     if loaded.units_from == "file":
         warnings.append(f"length unit {loaded.units!r} taken from the file")
+    warnings.extend(_unit_warning(loaded))
+    if options.model == Model.SHELL:
+        warnings.extend(_shell_thickness_warning(loaded, options))
     reference = None
     if options.reference is not None:
         reference = props.about(np.asarray(options.reference) * length_scale(loaded.units))
@@ -201,6 +282,9 @@ def analyze_loaded(loaded: Loaded, options: AnalysisOptions, start: float | None
     if options.omega is not None:
         motion = _motion(frame, cls, options)
         warnings.extend(motion.warnings)
+    extra = _v11_sections(loaded, props, frame, cls, reference, parts, options, warnings)
+    if parts is not None:
+        parts = extra.pop("parts")
     return AnalysisResult(
         source=_source(loaded, part_results),
         props=props,
@@ -211,6 +295,7 @@ def analyze_loaded(loaded: Loaded, options: AnalysisOptions, start: float | None
         parts=parts,
         warnings=tuple(dict.fromkeys(warnings)),
         elapsed_s=time.perf_counter() - start,
+        **extra,
     )
 
 
@@ -225,6 +310,116 @@ def _tessellated_cad(loaded: Loaded, options: AnalysisOptions, start: float) -> 
     source = {**result.source, "geometry": "mesh", "deflection": deflection}
     return replace(result, source=source, tessellation_error=tessellation_error(exact.props, result.props),
                    elapsed_s=time.perf_counter() - start)
+
+
+def _v11_sections(loaded: Loaded, props: MassProperties, frame: PrincipalFrame, cls: Classification,
+                  reference: InertiaTensor | None, parts: tuple[PartResult, ...] | None,
+                  options: AnalysisOptions, warnings: list[str]) -> dict[str, Any]:
+    """surface_area, rotational_constants, frame and export (API.md 1.1), each only when it applies."""
+    from .surface import part_surface_area
+
+    areas = [part_surface_area(p) for p in loaded.parts]
+    out: dict[str, Any] = {}
+    if all(a is not None for a in areas):
+        out["surface_area"] = math.fsum(a for a in areas if a is not None)
+    if any(p.extras.get("molecule") for p in loaded.parts):
+        from .classification import RotorClass
+        from .rotational import rotational_constants
+
+        out["rotational_constants"] = rotational_constants(frame.moments, cls.rotor == RotorClass.LINEAR)
+        if out["rotational_constants"] is None:
+            warnings.append("rotational constants need positive principal moments; a single atom has none")
+    if options.frame is not None:
+        from .frames import named_frame
+
+        out["named_frame"] = named_frame(
+            options.frame, props.center_of_mass, props.inertia.matrix,
+            None if reference is None else reference.point, None if reference is None else reference.matrix)
+    if options.export is not None:
+        out["export"] = _export(options.export, props, frame, cls, "")
+        warnings.extend(out["export"].warnings)
+    if parts is not None:
+        new_parts = []
+        for part, area in zip(parts, areas):
+            snippet = None if options.export is None else _export(options.export, part.props, part.frame,
+                                                                  part.classification, part.name)
+            if snippet is not None:
+                warnings.extend(snippet.warnings)
+            new_parts.append(replace(part, surface_area=area, export=snippet))
+        out["parts"] = tuple(new_parts)
+    return out
+
+
+def _export(fmt: str, props: MassProperties, frame: PrincipalFrame, cls: Classification, name: str) -> Snippet:
+    from .classification import RotorClass
+    from .export import Inertial, inertial_snippet
+
+    body = Inertial(props.mass, props.center_of_mass, props.inertia.matrix, frame.moments, frame.axes,
+                    frame.quaternion, linear=cls.rotor == RotorClass.LINEAR,
+                    relative_error=props.relative_error_estimate)
+    return inertial_snippet(fmt, body, name)
+
+
+def _check_part_names(loaded: Loaded, options: AnalysisOptions) -> None:
+    """Every name in ``densities`` must be a part of the file: a typo never falls back to the default."""
+    if not options.densities:
+        return
+    names = [p.name for p in loaded.parts]
+    unknown = sorted(set(options.densities) - set(names))
+    if unknown:
+        listed = ", ".join(repr(n) for n in names[:20]) + (" ..." if len(names) > 20 else "")
+        raise InvalidParameterError(
+            f"densities names {', '.join(repr(n) for n in unknown)}, which is not a part of this file; "
+            f"its parts are: {listed}", parameter="densities", unknown=unknown, parts=names[:100])
+
+
+def _extent(body: Any) -> NDArray[np.float64] | None:
+    """Bounding-box side lengths of a mesh or volume body [m]; None for point sets."""
+    coords = getattr(body, "vertices", None)
+    if coords is None:
+        coords = getattr(body, "points", None)
+    if coords is None or not len(coords):
+        return None
+    extent: NDArray[np.float64] = (coords.max(axis=0) - coords.min(axis=0)) * body.length_scale
+    return extent
+
+
+def _unit_warning(loaded: Loaded) -> list[str]:
+    """A file with no length unit, read as metres, that is implausibly large for a part: say so."""
+    if loaded.units_from != "default" or loaded.kind == "points":
+        return []
+    sizes = [e for e in (_extent(p.body) for p in loaded.parts) if e is not None]
+    if not sizes:
+        return []
+    diagonal = float(np.linalg.norm(np.max(sizes, axis=0)))
+    if diagonal <= DEFAULT_TOLERANCES.metres_plausible:
+        return []
+    return [f"the file declares no length unit and none was given, so it was read in metres: the part is "
+            f"{diagonal:.4g} m across; if it was drawn in millimetres, pass units=mm (CLI: --units mm), "
+            f"which divides the mass by 1e9"]
+
+
+def _shell_thickness_warning(loaded: Loaded, options: AnalysisOptions) -> list[str]:
+    """The thin-shell model needs a wall much thinner than the part: refuse a thicker one, warn near it."""
+    assert options.thickness is not None  # AnalysisOptions requires it for shells
+    thickness = options.thickness * length_scale(loaded.units)
+    out: list[str] = []
+    for part in loaded.parts:
+        extent = _extent(part.body)
+        if extent is None:
+            continue
+        size = float(np.linalg.norm(extent))
+        ratio = thickness / size
+        where = f" ({part.name})" if len(loaded.parts) > 1 else ""
+        if ratio >= DEFAULT_TOLERANCES.shell_thickness_max:
+            raise InvalidParameterError(
+                f"thickness {thickness:.4g} m is {ratio:.3g} times the part's size{where} ({size:.4g} m across): "
+                f"a thin shell needs a wall much thinner than the part; check thickness and units, or analyse "
+                f"it as a solid", parameter="thickness", thickness_m=thickness, size_m=size)
+        if ratio >= DEFAULT_TOLERANCES.shell_thickness_warn:
+            out.append(f"thickness {thickness:.4g} m is {100 * ratio:.2g}% of the part's size{where}: the thin-shell "
+                       f"model (mass = area x thickness x density) is only approximate for so thick a wall")
+    return out
 
 
 def _part_density(name: str, options: AnalysisOptions) -> float | None:
@@ -315,7 +510,8 @@ def _source(loaded: Loaded, parts: Sequence[PartResult]) -> dict[str, Any]:
     elif loaded.kind == "volume":
         vols = [b for b in bodies if isinstance(b, VolumeBody)]
         out["points"] = len(vols[0].points)
-        out["tetrahedra"] = int(sum(len(b.tets) for b in vols))
+        out["tetrahedra"] = int(sum(len(b.tets) for b in vols))  # linear tetrahedra
+        out["cells"] = int(sum(b.cell_count for b in vols))  # every 3-D cell, each integrated as its element
     else:
         out["points"] = int(sum(len(b.masses) for b in bodies if isinstance(b, PointBody)))
     if loaded.is_assembly:
@@ -377,7 +573,9 @@ def precession(
             matrix = np.asarray(inertia_tensor, dtype=np.float64)
         except (TypeError, ValueError) as exc:
             raise InvalidParameterError("inertia_tensor must be a 3x3 array of numbers", parameter="inertia_tensor") from exc
-        frame = PrincipalFrame.from_tensor(matrix, tolerance)
+        # the estimate comes from the eigenproblem's conditioning: ~17 eps I3 / Ii for moment i
+        solved = tensor_frame(matrix, tolerance)
+        frame, estimate, notes = solved.frame, solved.relative_error_estimate, solved.warnings
     else:
         try:
             moments = np.asarray(principal_moments, dtype=np.float64)
@@ -386,6 +584,8 @@ def precession(
         if moments.shape != (3,) or not np.all(np.isfinite(moments)):
             raise InvalidParameterError("principal_moments must be three finite numbers", parameter="principal_moments")
         frame = PrincipalFrame.from_tensor(np.diag(moments), tolerance)
+        estimate, notes = 8 * EPS, ()  # the moments as given: only the motion's own arithmetic
     cls = classify(frame)
     motion = _motion(frame, cls, options)
-    return PrecessionResult(frame, cls, motion, 8 * EPS, time.perf_counter() - start, tuple(motion.warnings))
+    warnings = tuple(dict.fromkeys((*notes, *motion.warnings)))
+    return PrecessionResult(frame, cls, motion, max(estimate, 8 * EPS), time.perf_counter() - start, warnings)

@@ -1,12 +1,7 @@
 """Principal frame: ascending principal moments, right-handed principal axes.
 
-The eigen-decomposition is a cyclic Jacobi method on the 3x3 tensor.  Jacobi
-rotations compute every eigenvalue of a positive (semi-)definite matrix to
-high *relative* accuracy (Demmel & Veselic, SIAM J. Matrix Anal. Appl. 13,
-1992), unlike a tridiagonal QR whose error is relative to the largest moment:
-that matters for the smallest moment of a needle, which can be 1e-12 of the
-largest.  It is also a fixed sequence of float operations, so results are
-bit-identical on every run.
+The eigen-decomposition is ``eigen.jacobi_eigh``, a cyclic Jacobi method with
+high relative accuracy for every moment, the smallest of a needle included.
 """
 
 from __future__ import annotations
@@ -19,61 +14,28 @@ from numpy.typing import NDArray
 
 from .arrays import freeze_fields
 from .conventions import orient_axes, quaternion_from_matrix
+from .eigen import jacobi_eigh
 from .errors import InvalidParameterError
-from .tolerances import DEFAULT_TOLERANCES, Tolerances
+from .tolerances import DEFAULT_TOLERANCES, EPS
 
 if TYPE_CHECKING:
     from .mass import MassProperties
 
-__all__ = ["PrincipalFrame", "principal_frame", "jacobi_eigh", "equal_moment_pairs"]
+__all__ = ["PrincipalFrame", "principal_frame", "equal_moment_pairs", "TensorFrame", "tensor_frame",
+           "TENSOR_ERROR_FACTOR"]
 
-_PAIRS = ((0, 1), (0, 2), (1, 2))
+TENSOR_ERROR_FACTOR = 17 * EPS
+"""Absolute error of every eigenvalue of a given 3x3 tensor, times its Frobenius norm.
 
-
-def jacobi_eigh(
-    matrix: NDArray[np.float64], tolerances: Tolerances = DEFAULT_TOLERANCES
-) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """Eigenvalues (unsorted) and eigenvectors (as rows) of a symmetric 3x3 matrix.
-
-    Cyclic Jacobi with the rotation formulas of Rutishauser (Numer. Math. 9,
-    1966): t = sgn(theta) / (|theta| + sqrt(theta^2 + 1)), which keeps |angle|
-    <= pi/4 so that nearly diagonal input is barely rotated.
-    """
-    a = np.array(matrix, dtype=np.float64)
-    a = 0.5 * (a + a.T)
-    v = np.eye(3)
-    for _ in range(tolerances.jacobi_max_sweeps):
-        if _off_diagonal_negligible(a, tolerances.jacobi_rel):
-            break
-        for p, q in _PAIRS:
-            _rotate(a, v, p, q)
-    return np.diag(a).copy(), v.T.copy()
-
-
-def _off_diagonal_negligible(a: NDArray[np.float64], rel: float) -> bool:
-    for p, q in _PAIRS:
-        scale = np.sqrt(abs(a[p, p] * a[q, q]))
-        if abs(a[p, q]) > rel * scale and a[p, q] != 0.0:
-            return False
-    return True
-
-
-def _rotate(a: NDArray[np.float64], v: NDArray[np.float64], p: int, q: int) -> None:
-    apq = a[p, q]
-    if apq == 0.0:
-        return
-    theta = (a[q, q] - a[p, p]) / (2.0 * apq)
-    t = np.copysign(1.0, theta) / (abs(theta) + np.sqrt(theta * theta + 1.0))
-    c = 1.0 / np.sqrt(t * t + 1.0)
-    s = t * c
-    rot = np.eye(3)
-    rot[p, p] = c
-    rot[q, q] = c
-    rot[p, q] = s
-    rot[q, p] = -s
-    a[:] = rot.T @ a @ rot
-    a[p, q] = a[q, p] = 0.0
-    v[:] = v @ rot
+Jacobi's rotations are orthogonal to rounding, so the computed eigenvalues are
+exact for a tensor within a few eps x ||T||_F of the one given (backward
+error; Golub & Van Loan, Matrix Computations, §8.5), and Weyl's inequality
+moves each eigenvalue by at most that perturbation's norm.  16 eps covers the
+rotations of the sweeps; one more eps/2 x ||T||_F covers the rounding of the
+input's own entries (each float64 entry is within half an ulp of the tensor
+the user meant).  The Frobenius norm is at least the largest moment, so the
+bound is ~17 eps I3 whatever the orientation: relative to moment i it is
+~17 eps I3 / Ii, large for the smallest moment of a needle-like tensor."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -114,16 +76,20 @@ class PrincipalFrame:
 
     @classmethod
     def from_tensor(
-        cls, tensor: NDArray[np.float64], tolerance: float = DEFAULT_TOLERANCES.moment_rel
+        cls, tensor: NDArray[np.float64], tolerance: float = DEFAULT_TOLERANCES.moment_rel, rounding: float = 0.0
     ) -> PrincipalFrame:
-        """Principal frame of an inertia tensor about the centre of mass."""
+        """Principal frame of an inertia tensor about the centre of mass.
+
+        rounding : [kg m^2] absolute error of the computed moments; a moment
+            below ``-rounding`` is refused as negative (default: any negative one).
+        """
         matrix = np.asarray(tensor, dtype=np.float64)
         if matrix.shape != (3, 3) or not np.all(np.isfinite(matrix)):
             raise InvalidParameterError("the inertia tensor must be a finite 3x3 matrix")
         if not np.allclose(matrix, matrix.T, rtol=1e-9, atol=1e-12 * np.abs(matrix).max()):
             raise InvalidParameterError("the inertia tensor must be symmetric")
         values, vectors = jacobi_eigh(matrix)
-        _check_physical(np.sort(values), tolerance)
+        _check_physical(np.sort(values), tolerance, rounding)
         return cls.from_eigen(values, vectors, tolerance)
 
     def as_rotation_matrix(self) -> NDArray[np.float64]:
@@ -131,11 +97,11 @@ class PrincipalFrame:
         return np.array(self.axes.T)
 
 
-def _check_physical(moments: NDArray[np.float64], tolerance: float) -> None:
+def _check_physical(moments: NDArray[np.float64], tolerance: float, rounding: float = 0.0) -> None:
     scale = moments[2]
     if not scale > 0:
         raise InvalidParameterError("principal moments must be positive; got a zero or negative tensor")
-    if moments[0] < -tolerance * scale:
+    if moments[0] < -rounding:
         raise InvalidParameterError(
             f"the tensor has a negative principal moment ({moments[0]:.6g} kg m^2); it is not an inertia tensor"
         )
@@ -143,6 +109,64 @@ def _check_physical(moments: NDArray[np.float64], tolerance: float) -> None:
         raise InvalidParameterError(
             "principal moments break the triangle inequality I1 + I2 >= I3; no body has this tensor"
         )
+
+
+@dataclass(frozen=True, slots=True)
+class TensorFrame:
+    """The principal frame of a given tensor, with error bounds from the eigenproblem's conditioning.
+
+    moment_errors : (3,) [kg m^2] absolute error bound of each moment (ascending order).
+    relative_error_estimate : the largest moment error over its moment, among the
+        moments larger than their own bound (those within it are reported as 0).
+    axes_error : [rad] bound on the angle error of the unique axes, moment error
+        over the smallest gap to another moment (Davis-Kahan); inf where two
+        moments are equal within their errors (the axes are then any in their plane).
+    warnings : what was assumed (a moment zero within rounding).
+    """
+
+    frame: PrincipalFrame
+    moment_errors: NDArray[np.float64]
+    relative_error_estimate: float
+    axes_error: float
+    warnings: tuple[str, ...]
+
+
+def tensor_frame(tensor: NDArray[np.float64], tolerance: float = DEFAULT_TOLERANCES.moment_rel) -> TensorFrame:
+    """Principal frame of a tensor given by a client, with an estimate from its conditioning.
+
+    The absolute error of every eigenvalue is ``TENSOR_ERROR_FACTOR`` x ||T||_F,
+    so moment i carries a relative error ~ 17 eps I3 / Ii.  A moment within its
+    bound of zero is zero to rounding (a linear rotator's I1): it is reported as
+    0 with a warning, never as a tiny negative number.  A moment below minus its
+    bound is refused (no body has a negative moment).
+    """
+    matrix = np.asarray(tensor, dtype=np.float64)
+    if matrix.shape != (3, 3) or not np.all(np.isfinite(matrix)):
+        raise InvalidParameterError("the inertia tensor must be a finite 3x3 matrix")
+    scale = float(np.sqrt(np.sum((matrix / max(float(np.abs(matrix).max()), 1e-300)) ** 2))) * float(np.abs(matrix).max())
+    if not np.isfinite(scale):
+        raise InvalidParameterError("the inertia tensor's entries are too large to compute with in float64; "
+                                    "express it in other units")
+    bound = TENSOR_ERROR_FACTOR * scale
+    frame = PrincipalFrame.from_tensor(matrix, tolerance, rounding=bound)
+    moments = frame.moments
+    warnings: list[str] = []
+    zero = moments <= bound
+    if np.any(zero):
+        warnings.append(
+            f"{int(zero.sum())} principal moment(s) are zero within the rounding of the tensor "
+            f"(|I| <= {bound:.3g} kg m^2) and are reported as 0"
+        )
+        clamped = np.where(zero, 0.0, moments)
+        frame = PrincipalFrame(clamped, frame.axes, frame.quaternion,
+                               not equal_moment_pairs(clamped, tolerance), tolerance)
+    errors = np.full(3, bound)
+    live = ~zero
+    relative = float(np.max(bound / frame.moments[live])) if np.any(live) else 1.0
+    gaps = [min(abs(float(frame.moments[i] - frame.moments[j])) for j in range(3) if j != i) for i in range(3)]
+    smallest_gap = min(gaps)
+    axes_error = float(2 * bound / smallest_gap) if smallest_gap > 2 * bound else float("inf")
+    return TensorFrame(frame, errors, relative, axes_error, tuple(warnings))
 
 
 def equal_moment_pairs(moments: NDArray[np.float64], tolerance: float) -> tuple[tuple[int, int], ...]:

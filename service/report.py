@@ -2,12 +2,13 @@
 
 from __future__ import annotations
 
+import math
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 if TYPE_CHECKING:
-    from .classify import Classification
+    from .classification import Classification
     from .mass import MassProperties
     from .pipeline import AnalysisResult, PartResult, PrecessionResult
     from .principal import PrincipalFrame
@@ -19,13 +20,21 @@ def _list(arr: Any) -> Any:
     return np.asarray(arr, dtype=np.float64).tolist()
 
 
-def principal_dict(frame: PrincipalFrame) -> dict[str, Any]:
-    return {
+def principal_dict(frame: PrincipalFrame, mass: float | None = None) -> dict[str, Any]:
+    out: dict[str, Any] = {
         "moments": _list(frame.moments),
         "axes": _list(frame.axes),
         "quaternion": _list(frame.quaternion),
         "unique_axes": bool(frame.unique_axes),
     }
+    if mass is not None and mass > 0:
+        out["radii_of_gyration"] = radii_of_gyration(frame.moments, mass)
+    return out
+
+
+def radii_of_gyration(moments: Any, mass: float) -> list[float]:
+    """k_i = sqrt(I_i / m) [m] (a zero moment within rounding, e.g. of a rotator, gives 0)."""
+    return [math.sqrt(max(float(i), 0.0) / mass) for i in moments]
 
 
 def classification_dict(cls: Classification) -> dict[str, Any]:
@@ -59,7 +68,9 @@ def _part_dict(part: PartResult) -> dict[str, Any]:
     p = part.props
     out: dict[str, Any] = {"name": part.name, **_body_dict(p)}
     out["inertia_tensor"] = _list(p.inertia.matrix)
-    out["principal"] = principal_dict(part.frame)
+    if part.surface_area is not None:
+        out["surface_area"] = float(part.surface_area)
+    out["principal"] = principal_dict(part.frame, p.mass)
     out["classification"] = classification_dict(part.classification)
     if p.warnings:
         out["warnings"] = list(p.warnings)
@@ -72,12 +83,18 @@ def analysis_dict(result: AnalysisResult) -> dict[str, Any]:
     out: dict[str, Any] = {"source": dict(result.source), **_body_dict(p)}
     if result.reference is not None:
         out["reference_inertia"] = {"point": _list(result.reference.point), "tensor": _list(result.reference.matrix)}
-    out["principal"] = principal_dict(result.frame)
+    if result.surface_area is not None:
+        out["surface_area"] = float(result.surface_area)
+    out["principal"] = principal_dict(result.frame, p.mass)
     out["classification"] = classification_dict(result.classification)
+    out.update(_v11_dict(result))
     if result.motion is not None:
         out["precession"] = result.motion.as_dict()
     if result.parts is not None:
         out["parts"] = [_part_dict(part) for part in result.parts]
+        if result.export is not None:
+            out["export"]["parts"] = [{"name": part.name, "text": part.export.text}
+                                      for part in result.parts if part.export is not None]
     out["warnings"] = list(result.warnings)
     out["diagnostics"] = {
         "elapsed_s": float(result.elapsed_s),
@@ -85,6 +102,23 @@ def analysis_dict(result: AnalysisResult) -> dict[str, Any]:
     }
     if result.tessellation_error is not None:
         out["diagnostics"]["tessellation_error"] = float(result.tessellation_error)
+    return out
+
+
+def _v11_dict(result: AnalysisResult) -> dict[str, Any]:
+    """rotational_constants, frame and export (API.md, "Additions, version 1.1")."""
+    out: dict[str, Any] = {}
+    rc = result.rotational_constants
+    if rc is not None:
+        out["rotational_constants"] = {"MHz": list(rc.mhz), "cm-1": list(rc.wavenumber)}
+    nf = result.named_frame
+    if nf is not None:
+        out["frame"] = {"quaternion": _list(nf.quaternion), "center_of_mass": _list(nf.center_of_mass),
+                        "inertia_tensor": _list(nf.inertia_tensor)}
+        if nf.reference_inertia is not None:
+            out["frame"]["reference_inertia"] = _list(nf.reference_inertia)
+    if result.export is not None:
+        out["export"] = {"format": result.export.format, "text": result.export.text}
     return out
 
 

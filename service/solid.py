@@ -1,9 +1,20 @@
 """A triangle surface made ready to integrate as a solid: welded, closed, wound outward.
 
-Never a silently wrong tensor: an open surface is refused (``not_watertight``
-with the count of open edges), inconsistent winding is repaired where the
-surface is orientable, and inverted shells are turned outward, each with a
-warning.  Cavities (a negative shell inside a positive one) are kept.
+Never a silently wrong tensor: seams (one point written twice with different
+rounding) are merged first (``seams.merge_seams``), an open surface is refused
+(``not_watertight`` with the count of open edges and the part's name),
+inconsistent winding is repaired where the surface is orientable, and shells
+are oriented by nesting, each with a warning.
+
+Orientation by nesting.  A shell inside an odd number of other shells bounds
+a cavity and must wind inward; one inside an even number (zero included)
+bounds material and must wind outward.  Whether a shell is inside another is
+decided by the generalised winding number of the other shell at a point of
+the first (the solid angle it subtends, van Oosterom & Strackee, IEEE Trans.
+Biomed. Eng. 30(2), 1983), which is exact for closed shells and does not
+depend on bounding boxes.  A shell of zero volume is never flipped, and
+shells that touch or coincide (a test point on the other shell) keep the
+file's orientation: flipping shells must not manufacture volume.
 """
 
 from __future__ import annotations
@@ -14,6 +25,8 @@ from numpy.typing import NDArray
 from .body import MeshBody
 from .errors import NotWatertightError, ZeroVolumeError
 from .integrals import CHUNK, local_origin
+from .seams import merge_seams
+from .tolerances import EPS
 from .topology import SurfaceTopology, face_components, orient_consistently, surface_topology, weld
 
 __all__ = ["closed_surface"]
@@ -26,14 +39,23 @@ def closed_surface(body: MeshBody) -> tuple[NDArray[np.float64], NDArray[np.int6
     if np.any(degenerate):
         faces = faces[~degenerate]  # zero-area faces contribute nothing to any integral
     if len(faces) == 0:
-        raise ZeroVolumeError("every triangle of the mesh is degenerate; the file holds no solid")
+        cause = ("; its float32 coordinates are too coarse at that distance from the origin: export it in float64 "
+                 "or nearer the origin") if body.coordinate_eps >= 2.0**-24 else ""
+        raise ZeroVolumeError(f"every triangle of the mesh is degenerate; the file holds no solid{cause}")
     topo = surface_topology(faces, len(vertices))
     warnings: list[str] = []
     if topo.open_edges:
+        seams = merge_seams(vertices, faces)
+        if seams.merged:
+            faces = seams.faces
+            topo = surface_topology(faces, len(vertices))
+            warnings.append(seams.warning())
+    if topo.open_edges:
+        named = f"part {body.name!r} " if body.name else "mesh "
         raise NotWatertightError(
-            f"mesh is not watertight ({topo.open_edges} open edges), so it does not bound a solid; "
+            f"{named}is not watertight ({topo.open_edges} open edges), so it does not bound a solid; "
             "repair it, or analyse it as a thin surface with model=shell and a thickness",
-            open_edges=topo.open_edges,
+            open_edges=topo.open_edges, **({"part": body.name} if body.name else {}),
         )
     if not topo.closed:
         faces, flipped = orient_consistently(faces, topo)
@@ -69,19 +91,79 @@ def _signed_volumes(x: NDArray[np.float64], faces: NDArray[np.int64]) -> NDArray
 def _orient_outward(
     vertices: NDArray[np.float64], faces: NDArray[np.int64], topo: SurfaceTopology
 ) -> tuple[NDArray[np.int64], list[str]]:
-    """Make every shell bound positive volume, except cavities inside another shell."""
+    """Orient every shell by its nesting depth: material outward, cavities inward."""
     x = vertices - local_origin(vertices)
     det = _signed_volumes(x, faces)
     if np.all(det >= 0):  # every face sees the local origin from outside: outward already
         return faces, []
+    total = float(det.sum())
     count, label = face_components(faces, topo)
     vol = np.bincount(label, weights=det, minlength=count)
-    if count == 1 or np.all(vol < 0):
-        if vol.sum() < 0:
+    noise = np.bincount(label, weights=np.abs(det), minlength=count)
+    flat = np.abs(vol) <= 64 * EPS * noise  # a shell of zero volume: no orientation makes it a body
+    if count == 1:
+        if total < 0:
             return faces[:, [0, 2, 1]], ["inverted winding corrected (all faces pointed inward)"]
         return faces, []
-    if np.all(vol > 0):
+    depth = _nesting_depth(x, faces, label, count)
+    if isinstance(depth, str):  # nesting undecidable: keep the file's orientation
+        if total < 0 and np.all(vol <= 0):
+            return faces[:, [0, 2, 1]], ["inverted winding corrected (all faces pointed inward)"]
+        return faces, [f"the {count} shells are kept as the file winds them ({depth}, so nesting was not tested); "
+                       f"{int(np.count_nonzero(vol < 0))} of them enclose negative volume (cavities)"]
+    want_positive = depth % 2 == 0
+    flip_shell = ((vol > 0) != want_positive) & ~flat
+    if not np.any(flip_shell):
         return faces, []
+    out = faces.copy()
+    sel = flip_shell[label]
+    out[sel] = out[sel][:, [0, 2, 1]]
+    if np.all(flip_shell | flat):
+        return out, ["inverted winding corrected (all faces pointed inward)"]
+    return out, [f"winding corrected on {int(flip_shell.sum())} of {count} shells by their nesting "
+                 "(a shell inside an odd number of others is a cavity)"]
+
+
+def winding_numbers(x: NDArray[np.float64], faces: NDArray[np.int64], points: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Generalised winding number of the triangles ``faces`` at each of ``points``.
+
+    The sum of the signed solid angles of the triangles seen from the point
+    over 4 pi (van Oosterom & Strackee 1983: tan(Omega/2) = a.(b x c) /
+    (|a||b||c| + (a.b)|c| + (a.c)|b| + (b.c)|a|)); an integer for a closed
+    surface and a point off it; NaN for a point on (or within 1e-12 of the
+    size of) one of the triangles, where it is undefined.  Evaluated in blocks of points x faces of at
+    most ``_WINDING_BLOCK`` pairs.
+    """
+    points = np.asarray(points, dtype=np.float64).reshape(-1, 3)
+    out = np.zeros(len(points))
+    tri = [x[faces[:, k]] for k in range(3)]
+    step = max(1, _WINDING_BLOCK // max(1, len(points)))
+    for start in range(0, len(faces), step):
+        a, b, c = (t[None, start : start + step, :] - points[:, None, :] for t in tri)
+        la, lb, lc = (np.sqrt(np.einsum("pfi,pfi->pf", v, v)) for v in (a, b, c))
+        num = np.einsum("pfi,pfi->pf", a, np.cross(b, c))
+        den = (la * lb * lc + np.einsum("pfi,pfi->pf", a, b) * lc + np.einsum("pfi,pfi->pf", a, c) * lb
+               + np.einsum("pfi,pfi->pf", b, c) * la)
+        out += np.arctan2(num, den).sum(axis=1)
+        scale = la * lb * lc
+        on = (np.abs(num) <= 1e-12 * scale) & (den <= 1e-12 * scale)  # in a triangle's plane and inside it
+        out[np.any(on, axis=1)] = np.nan
+    return out / (2 * np.pi)
+
+
+_WINDING_BLOCK = 1 << 18  # point-face pairs per block: ~50 MB of temporaries
+NESTING_WORK_LIMIT = 400_000_000
+"""Most point-triangle pairs the nesting test evaluates (a few seconds); past it, shells keep their stored orientation
+with a warning rather than the request stalling (a part with many thousands of cavities inside a fine outer skin)."""
+
+
+def _nesting_depth(x: NDArray[np.float64], faces: NDArray[np.int64], label: NDArray[np.int64],
+                   count: int) -> NDArray[np.int64] | str:
+    """How many other shells contain each shell, or why that cannot be decided.
+
+    A shell's test point is the centroid of its largest triangle; only shells
+    whose bounding box holds that point are evaluated.
+    """
     lo = np.full((count, 3), np.inf)
     hi = np.full((count, 3), -np.inf)
     for k in range(3):
@@ -89,13 +171,39 @@ def _orient_outward(
             coord = x[faces[:, corner], k]
             np.minimum.at(lo[:, k], label, coord)
             np.maximum.at(hi[:, k], label, coord)
-    flip_shell = np.zeros(count, dtype=bool)
-    for shell in np.flatnonzero(vol < 0):
-        inside = (vol > 0) & np.all(lo <= lo[shell], axis=1) & np.all(hi >= hi[shell], axis=1)
-        flip_shell[shell] = not np.any(inside)
-    if not np.any(flip_shell):
-        return faces, []
-    out = faces.copy()
-    sel = flip_shell[label]
-    out[sel] = out[sel][:, [0, 2, 1]]
-    return out, [f"inverted winding corrected on {int(flip_shell.sum())} of {count} shells"]
+    tri = x[faces]
+    area = np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]), axis=1)
+    by_shell = np.lexsort((-area, label))  # per shell, its faces from the largest down
+    order = np.argsort(label, kind="stable")
+    bounds = np.searchsorted(label[order], np.arange(count + 1))
+    sizes = np.diff(bounds)
+    depth = np.zeros(count, dtype=np.int64)
+    todo = np.arange(count)
+    spent = 0
+    for attempt in range(_NESTING_ATTEMPTS):  # a test point on another shell: try the shell's next largest face
+        todo = todo[sizes[todo] > attempt]
+        if len(todo) == 0:
+            return depth
+        points = tri[by_shell[bounds[todo] + attempt]].mean(axis=1)
+        inside = [np.flatnonzero(np.all(lo[t] <= points, axis=1) & np.all(hi[t] >= points, axis=1)) for t in range(count)]
+        inside = [i[todo[i] != t] for t, i in enumerate(inside)]
+        spent += sum(len(i) * int(sizes[t]) for t, i in enumerate(inside))
+        if spent > NESTING_WORK_LIMIT:
+            return f"{spent:.2g} point-triangle tests would be needed"
+        found = np.zeros(len(todo), dtype=np.int64)
+        unclear = np.zeros(len(todo), dtype=bool)
+        for t, i in enumerate(inside):
+            if len(i) == 0:
+                continue
+            w = winding_numbers(x, faces[order[bounds[t] : bounds[t + 1]]], points[i])
+            bad = ~(np.abs(w - np.round(w)) <= 0.25)  # NaN (on the shell) or far from an integer
+            unclear[i[bad]] = True
+            found[i[~bad]] += np.round(w[~bad]) != 0
+        depth[todo[~unclear]] = found[~unclear]
+        todo = todo[unclear]
+        if len(todo) == 0:
+            return depth
+    return "shells touch or overlap"
+
+
+_NESTING_ATTEMPTS = 4

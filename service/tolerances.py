@@ -25,6 +25,14 @@ class Tolerances:
     """A solid has zero volume when |V| is at most this times the volume of its
     bounding box: flat or degenerate meshes land near 1e-16 (rounding only)."""
 
+    seam_rel: float = 1e-12
+    """Two vertices on open edges of a surface are one seam vertex when they are
+    at most this times the diagonal of the part's bounding box apart.  CAD
+    exporters write one point twice with different rounding (``0.0`` in one
+    triangle, ``-2.7e-16`` in the next): gaps of a few ulps of the coordinates,
+    ~1e-16 of the size; 1e-12 is far above that and far below any real
+    feature or gap a part can have (a 1 m part: 1 pm)."""
+
     jacobi_rel: float = 4 * EPS
     """Off-diagonal entries below this times the geometric mean of their
     diagonal pair are zero in the 3x3 Jacobi eigen-solver (relative accuracy,
@@ -58,6 +66,19 @@ class Tolerances:
     max_integration_steps: int = 2_000_000
     """Cap on steps of the numerical methods (a pure-Python loop for splitting):
     beyond it predict_motion refuses and points to method='exact'."""
+
+    metres_plausible: float = 10.0
+    """A part read in metres by default (the file declares no unit and none was
+    given) that is more than this many metres across is most likely drawn in
+    millimetres (a 10 m part is a building, a 10 mm part is common): warn."""
+
+    shell_thickness_warn: float = 0.05
+    """model=shell: a wall thicker than this fraction of the part's bounding-box
+    diagonal is warned about; the thin-shell model's error grows like t/R."""
+
+    shell_thickness_max: float = 0.5
+    """model=shell: a wall at least half the part's diagonal is no wall (a box
+    of side 1 with thickness 2 weighs 12 solids): refused as invalid_parameter."""
 
 
 DEFAULT_TOLERANCES = Tolerances()

@@ -40,43 +40,67 @@ def weld(vertices: NDArray[np.float64], faces: NDArray[np.int64]) -> tuple[NDArr
     already welded mesh comes back unchanged (the same arrays, no copy).
     """
     v = np.ascontiguousarray(vertices + 0.0)  # turns -0.0 into 0.0 so both weld together
-    bits = v.view(np.uint64).reshape(-1, 3)
-    ids, heads = row_ids([bits[:, 0], bits[:, 1], bits[:, 2]])
+    ids, heads = row_ids(v.view(np.uint64).reshape(-1, 3))
     if len(heads) == len(vertices):
         return vertices, faces  # every vertex distinct: ids is the identity
     return vertices[heads], ids[faces]
 
 
-def row_ids(columns: Sequence[NDArray[np.unsignedinteger]]) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
-    """Group equal rows of integer columns exactly.
+def row_ids(rows: NDArray[np.unsignedinteger] | Sequence[NDArray[np.unsignedinteger]]
+            ) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
+    """Group equal rows of integers exactly.
 
-    Returns ``ids`` (n,): the group of each row, numbered in order of first
-    occurrence, and ``heads`` (k,): the first row of each group, ascending.
-    Rows are hashed to uint64 and sorted once; rows are then compared
-    exactly, and a run of equal hash holding different rows (a collision)
-    is re-sorted by the columns themselves, so distinct rows never merge.
+    ``rows`` is an (n, k) array (preferred: each row is gathered as one
+    record) or a sequence of k columns of length n.  Returns ``ids`` (n,):
+    the group of each row, numbered in order of first occurrence, and
+    ``heads`` (k,): the first row of each group, ascending.  Rows are hashed
+    to uint64 and sorted once; rows are then compared exactly, and a run of
+    equal hash holding different rows (a collision) is re-sorted by the
+    columns themselves, so distinct rows never merge.
+
+    Cache.  In the hash order, neighbours are rows far apart in memory: the
+    exact comparison gathers each row once, as one record of its k integers
+    (one cache line), not each column separately (k misses per row), and the
+    groups are numbered through flags indexed by row, not a second sort.
     """
-    n = len(columns[0])
+    table = _row_table(rows)
+    columns = [table[:, j] for j in range(table.shape[1])]
+    n = len(table)
     order, same_hash = _hash_order(_row_hash(columns))
-    same = _equal_neighbours(columns, order)
+    same = _equal_neighbours(table, order)
     collided = same_hash & ~same
     if np.any(collided):
-        order = _resolve_collisions(columns, order, same_hash)
-        same = _equal_neighbours(columns, order)
+        order = _resolve_collisions(table, order, same_hash)
+        same = _equal_neighbours(table, order)
     new = np.empty(n, dtype=bool)
     new[0] = True
     np.logical_not(same, out=new[1:])
     del same, same_hash, collided
-    first = order[new]  # smallest row of each group: runs keep index order
-    heads = np.sort(first)
-    rank = np.empty(len(first), dtype=np.int64)
-    rank[np.argsort(first)] = np.arange(len(first))
-    group = np.cumsum(new, dtype=np.int32 if len(first) < 2**31 else np.int64) - 1
+    # runs keep index order, so the first row of each run is its group's smallest row
+    firsts = order[np.flatnonzero(new)]  # hash-order group -> its first row
+    is_head = np.zeros(n, dtype=bool)
+    is_head[firsts] = True
+    heads = np.flatnonzero(is_head)
+    index: type[np.signedinteger] = np.int32 if n < 2**31 else np.int64
+    group_rank: NDArray[np.signedinteger] = np.cumsum(is_head, dtype=index)[firsts]
+    group_rank -= 1  # hash-order group -> its number in order of first occurrence
+    del is_head, firsts
+    group: NDArray[np.signedinteger] = np.cumsum(new, dtype=index)
+    group -= 1  # hash-order group of each sorted row
+    del new
     ids = np.empty(n, dtype=np.int64)
     for start in range(0, n, SCATTER_CHUNK):
         stop = start + SCATTER_CHUNK
-        ids[order[start:stop]] = rank[group[start:stop]]
+        ids[order[start:stop]] = group_rank[group[start:stop]]
     return ids, heads
+
+
+def _row_table(rows: NDArray[np.unsignedinteger] | Sequence[NDArray[np.unsignedinteger]]
+               ) -> NDArray[np.unsignedinteger]:
+    """The rows as one C-contiguous (n, k) array (columns are stacked)."""
+    if isinstance(rows, np.ndarray) and rows.ndim == 2:
+        return np.ascontiguousarray(rows)
+    return np.stack(list(rows), axis=1)
 
 
 def _row_hash(columns: Sequence[NDArray[np.unsignedinteger]]) -> NDArray[np.uint64]:
@@ -125,25 +149,31 @@ def _packed_sort(key: NDArray[np.uint64], index_bits: int) -> tuple[NDArray[np.i
     return key.view(np.int64), same
 
 
-def _equal_neighbours(columns: Sequence[NDArray[np.unsignedinteger]], order: NDArray[np.int64]) -> NDArray[np.bool_]:
-    """Rows ``order[i]`` and ``order[i + 1]`` equal in every column."""
-    same = np.ones(len(order) - 1, dtype=bool)
-    for col in columns:
-        c = col[order]
-        same &= c[1:] == c[:-1]
+def _equal_neighbours(table: NDArray[np.unsignedinteger], order: NDArray[np.int64]) -> NDArray[np.bool_]:
+    """Rows ``order[i]`` and ``order[i + 1]`` of ``table`` (n, k) equal in every column.
+
+    Each row is gathered once, as one opaque record of k integers (one
+    memory access per row; the columns then compare in the gathered copy).
+    """
+    k = table.shape[1]
+    records = table.view(np.dtype((np.void, table.dtype.itemsize * k))).reshape(-1)
+    gathered = records.take(order).view(table.dtype).reshape(-1, k)
+    same: NDArray[np.bool_] = gathered[1:, 0] == gathered[:-1, 0]
+    for j in range(1, k):
+        same &= gathered[1:, j] == gathered[:-1, j]
     return same
 
 
-def _resolve_collisions(columns: Sequence[NDArray[np.unsignedinteger]], order: NDArray[np.int64],
+def _resolve_collisions(table: NDArray[np.unsignedinteger], order: NDArray[np.int64],
                         same_hash: NDArray[np.bool_]) -> NDArray[np.int64]:
     """Re-sort the hash runs that hold distinct rows by (run, columns, index)."""
     run = np.cumsum(np.r_[True, ~same_hash])
-    same = _equal_neighbours(columns, order)
+    same = _equal_neighbours(table, order)
     bad_runs = np.zeros(int(run[-1]) + 1, dtype=bool)
     bad_runs[run[1:][same_hash & ~same]] = True
     pos = np.flatnonzero(bad_runs[run])
     sub = order[pos]
-    keys = [col[sub] for col in reversed(columns)] + [run[pos]]
+    keys = [table[sub, j] for j in reversed(range(table.shape[1]))] + [run[pos]]
     out = order.copy()
     out[pos] = sub[np.lexsort(keys)]  # lexsort is stable: index order kept among equal rows
     return out

@@ -32,7 +32,7 @@ def test_analyze_json_matches_closed_form_box() -> None:
 
 
 def test_errors_go_to_stderr_in_the_envelope_with_exit_code() -> None:
-    out = run("analyze", str(SAMPLES / "open_box.stl"))
+    out = run("analyze", str(SAMPLES / "open_box.stl"), "--json")
     assert out.returncode == 4
     assert out.stdout == ""
     err = json.loads(out.stderr)
@@ -41,9 +41,12 @@ def test_errors_go_to_stderr_in_the_envelope_with_exit_code() -> None:
 
 
 def test_bad_parameter_exit_code() -> None:
-    out = run("analyze", str(SAMPLES / "box.stl"), "--density", "-3")
+    out = run("analyze", str(SAMPLES / "box.stl"), "--density", "-3", "--json")
     assert out.returncode == 2
     assert json.loads(out.stderr)["error"]["code"] == "invalid_parameter"
+    table = run("analyze", str(SAMPLES / "box.stl"), "--density", "-3")
+    assert table.returncode == 2
+    assert table.stderr.startswith("error: ") and table.stderr.rstrip().endswith("(invalid_parameter)")
 
 
 def test_inverted_box_warns_on_the_table() -> None:

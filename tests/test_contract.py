@@ -1662,7 +1662,9 @@ def test_needle_of_aspect_1e6_is_a_linear_rotator_within_the_default_tolerance(c
     strict = analyze(client, "rod.obj", data, tolerance="1e-14")
     check_classification(strict, "symmetric_top", "prolate", planar=False, tolerance=1e-14)
     spin = analyze(client, "rod.obj", data, omega=",".join(repr(float(x)) for x in R @ [0, 0, 1.0]))
-    assert spin["precession"]["regime"] == "rotator"
+    # labelled a rotator, it moves as the thin prolate top its moments make (issue 12): spun
+    # perpendicular to its axis, that is a permanent rotation
+    assert spin["precession"]["regime"] == "permanent_rotation"
 
 
 def test_collinear_points_along_a_diagonal_are_a_linear_rotator(client):
@@ -1742,10 +1744,11 @@ def test_nearly_symmetric_mesh_reports_momentum_and_energy_of_its_own_tensor(cli
     res = analyze(client, "hex_prism.stl", omega="0.3,0.2,1", duration=20, samples=5)
     I = np.asarray(res["inertia_tensor"], float)
     pre = res["precession"]
-    assert pre["regime"] == "regular_precession"
+    # labelled symmetric by the tolerance, it moves as the asymmetric top its moments make (issue 12)
+    assert res["classification"]["kind"] == "symmetric_top"
+    assert pre["regime"] == "asymmetric"
     check_invariants(pre, I, omega)
-    # the idealised symmetric motion stays within ~gap * |Ω| t of the real one
-    check_trajectory(pre, res["principal"]["moments"], res["principal"]["axes"], omega, 20.0, 5, I, tol=1e-5)
+    check_trajectory(pre, res["principal"]["moments"], res["principal"]["axes"], omega, 20.0, 5, I, tol=1e-9)
 
 
 def test_exact_motion_over_many_periods(client):
@@ -2073,3 +2076,30 @@ def test_moments_equal_only_within_tolerance_are_not_rounded_in_momentum_and_ene
     assert res["classification"]["kind"] == "symmetric_top"
     assert res["classification"]["asymmetry"] == pytest.approx(ray_kappa(moments), rel=1e-12)
     check_invariants(res["precession"], np.diag(moments), omega)
+
+
+# ---- API 1.1: the added sections appear only when asked for --------------------------------------------
+
+
+def test_v11_sections_absent_unless_asked(client):
+    """A plain request carries none of export, frame, rotational_constants; a surface mesh carries surface_area."""
+    res = client.post("/v1/analyze/mesh", files={"file": ("box.stl", (SAMPLES / "box.stl").read_bytes())})
+    assert res.status_code == 200
+    doc = res.json()
+    assert not {"export", "frame", "rotational_constants"} & set(doc)
+    assert doc["surface_area"] == pytest.approx(2 * (1 * 2 + 2 * 3 + 3 * 1), rel=1e-12)  # the 1 x 2 x 3 m box
+    m, moments = doc["mass"], doc["principal"]["moments"]
+    assert doc["principal"]["radii_of_gyration"] == pytest.approx([math.sqrt(i / m) for i in moments], rel=1e-12)
+
+
+def test_cli_batch_reads_xyz_files_from_a_folder(tmp_path):
+    folder = tmp_path / "molecules"
+    folder.mkdir()
+    (folder / "co2.xyz").write_text("3\ncarbon dioxide\nO 0 0 -1.162\nC 0 0 0\nO 0 0 1.162\n")
+    out = tmp_path / "out.jsonl"
+    run = subprocess.run([sys.executable, "-m", "inertia", "batch", str(folder), "--out", str(out), "--workers", "1",
+                          "--no-progress"], capture_output=True, text=True, cwd=ROOT, check=False)
+    assert run.returncode == 0, run.stderr
+    (line,) = [json.loads(x) for x in out.read_text().splitlines()]
+    assert line["classification"]["kind"] == "linear_rotator"
+    assert len(line["rotational_constants"]["MHz"]) == 1

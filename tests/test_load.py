@@ -189,7 +189,28 @@ def test_gltf_with_external_buffers_is_refused_with_advice() -> None:
     data = trimesh.Scene(box_mesh()).export(file_type="gltf")["model.gltf"]
     with pytest.raises(UnreadableFileError) as err:
         analyze(data, filename="part.gltf")
-    assert ".glb" in err.value.message and "external buffer" in err.value.message
+    assert "same upload" in err.value.message and "gltf_buffer_0.bin" in err.value.message
+
+
+def test_gltf_with_its_bin_in_one_upload_is_read() -> None:
+    files = trimesh.Scene(box_mesh()).export(file_type="gltf")
+    pairs = [(name, data if isinstance(data, bytes) else data.encode()) for name, data in files.items()]
+    from inertia.load import load_body
+    from inertia.pipeline import analyze_loaded
+
+    loaded = load_body(pairs)
+    assert loaded.format == "gltf" and loaded.filename == "model.gltf"
+    doc = analyze_loaded(loaded, AnalysisOptions()).as_dict()
+    assert doc["mass"] == pytest.approx(6000, rel=1e-14)
+    import io
+    import zipfile
+
+    buf = io.BytesIO()
+    with zipfile.ZipFile(buf, "w") as zf:
+        for name, data in pairs:
+            zf.writestr(f"export/{name}", data)
+    zipped = load_body(buf.getvalue(), filename="part.zip")
+    assert analyze_loaded(zipped, AnalysisOptions()).as_dict()["mass"] == pytest.approx(6000, rel=1e-14)
 
 
 def test_assembly_far_from_the_origin_keeps_every_moment() -> None:

@@ -237,7 +237,7 @@ def test_volume_mesh_density_ratio_of_a_million() -> None:
 
 
 def test_diatomic_molecule_is_a_linear_rotator() -> None:
-    from inertia.classify import RotorClass, classify
+    from inertia.classification import RotorClass, classify
     from inertia.principal import principal_frame
 
     m1, m2, l = 1.0, 16.0, 1.2e-10

@@ -8,10 +8,11 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy.spatial.transform import Rotation
 
-from inertia.classify import RotorClass, classify, ray_asymmetry
+from inertia.classification import RotorClass, classify, ray_asymmetry
 from inertia.conventions import matrix_from_quaternion
+from inertia.eigen import jacobi_eigh
 from inertia.errors import InvalidParameterError
-from inertia.principal import PrincipalFrame, jacobi_eigh
+from inertia.principal import PrincipalFrame
 
 
 def frame_of(moments: list[float], rotation: np.ndarray | None = None, tol: float = 1e-6) -> PrincipalFrame:

@@ -26,7 +26,7 @@ from benchmarks.stability import (BOUND_EXACT, BOUND_INVARIANT, BOUND_THIN, BOX_
                                   sphere_with_triangles, two_material_case, box, DIRECTION)
 from exact import exact_eigenvalues, exact_solid  # noqa: E402
 from inertia.body import MeshBody  # noqa: E402
-from inertia.classify import RotorClass, classify  # noqa: E402
+from inertia.classification import RotorClass, classify  # noqa: E402
 from inertia.mass import mass_properties  # noqa: E402
 from inertia.principal import PrincipalFrame, principal_frame  # noqa: E402
 from inertia.tolerances import EPS  # noqa: E402

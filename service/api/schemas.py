@@ -11,7 +11,7 @@ import json
 import math
 from typing import Annotated, Any, Literal
 
-from pydantic import BaseModel, ConfigDict, Field
+from pydantic import BaseModel, ConfigDict, Field, model_validator
 
 from ..errors import InvalidParameterError
 from ..pipeline import METHODS, AnalysisOptions
@@ -19,6 +19,7 @@ from ..pipeline import METHODS, AnalysisOptions
 __all__ = [
     "MeshQuery", "PointIn", "PointsRequest", "PrecessionRequest",
     "AnalysisOut", "PrecessionOut", "PrecessionResponse", "ErrorOut", "HealthOut", "FormatsOut",
+    "UnavailableFormatOut",
     "ERROR_RESPONSES",
 ]
 
@@ -39,6 +40,8 @@ RealVector = Annotated[list[Real], Field(min_length=3, max_length=3)]
 RealTensor = Annotated[list[RealVector], Field(min_length=3, max_length=3)]
 Tensor = Annotated[list[Vector], Field(min_length=3, max_length=3)]
 Quaternion = Annotated[list[float], Field(min_length=4, max_length=4)]
+ExportFormat = Literal["urdf", "sdf", "mjcf"]
+Isotopes = Literal["standard", "abundant"]
 
 
 class _Request(BaseModel):
@@ -58,6 +61,18 @@ def _triple(name: str, text: str | None) -> tuple[float, float, float] | None:
     return (values[0], values[1], values[2])
 
 
+def _quaternion(text: str | None) -> tuple[float, float, float, float] | None:
+    if text is None:
+        return None
+    try:
+        values = tuple(float(p) for p in text.replace(" ", "").split(","))
+    except ValueError:
+        raise InvalidParameterError(f"frame must be four numbers 'w,x,y,z', got {text!r}", parameter="frame") from None
+    if len(values) != 4 or not all(math.isfinite(v) for v in values):
+        raise InvalidParameterError(f"frame must be four finite numbers 'w,x,y,z', got {text!r}", parameter="frame")
+    return (values[0], values[1], values[2], values[3])
+
+
 def _reject_constant(name: str) -> float:
     raise ValueError(f"{name} is not a finite number")
 
@@ -69,6 +84,9 @@ def _densities(text: str | None) -> dict[str, float] | None:
         value = json.loads(text, parse_constant=_reject_constant)
     except ValueError as exc:
         raise InvalidParameterError(f"densities must be a JSON object of finite numbers: {exc}",
+                                    parameter="densities") from None
+    except RecursionError:
+        raise InvalidParameterError('densities nests too deeply; send a flat JSON object {"part name": density}',
                                     parameter="densities") from None
     if not isinstance(value, dict) or not all(
             isinstance(v, (int, float)) and not isinstance(v, bool) for v in value.values()):
@@ -82,7 +100,8 @@ class MeshQuery(_Request):
 
     format: str | None = Field(None, description="file format (stl, obj, ply, off, glb, gltf, 3mf, vtu, vtk, msh, "
                                "...); inferred from the file name when absent", examples=["stl"])
-    units: str | None = Field(None, description="length unit of the file: m, cm, mm, um, in, ft (default m)",
+    units: str | None = Field(None, description="length unit of the file: m, cm, mm, um, in, ft, angstrom "
+                              "(default m; angstrom for xyz)",
                               examples=["m"])
     density: float | None = Field(None, gt=0, le=MAX_MAGNITUDE,
                                   description="density [kg/m^3] (default 1000); exclusive with mass")
@@ -105,19 +124,34 @@ class MeshQuery(_Request):
                                               "B-rep (brep) or its tessellation (mesh)")
     deflection: float | None = Field(None, gt=0, lt=1, description="with geometry=mesh: chordal deflection "
                                      "relative to the bounding-box diagonal [1] (default 1e-3)")
+    export: ExportFormat | None = Field(None, description="urdf, sdf or mjcf: adds the format's inertial element")
+    frame: str | None = Field(None, description="'w,x,y,z' unit quaternion carrying a named frame's axes into the "
+                              "input frame: adds the frame section", examples=["1,0,0,0"])
+    isotopes: Isotopes = Field("standard", description="atoms of an XYZ file: standard atomic weights or the most "
+                               "abundant isotope")
 
     def as_options(self) -> AnalysisOptions:
         return AnalysisOptions(
             format=self.format, units=self.units, density=self.density, mass=self.mass, model=self.model,
             thickness=self.thickness, tolerance=self.tolerance, reference=_triple("reference", self.reference),
             omega=_triple("omega", self.omega), duration=self.duration, samples=self.samples,
-            method=self.method, densities=_densities(self.densities), geometry=self.geometry,
-            deflection=self.deflection)
+            method=self.method, densities=_densities(self.densities),
+            export=self.export, frame=_quaternion(self.frame), isotopes=self.isotopes,
+            geometry=self.geometry, deflection=self.deflection)
 
 
 class PointIn(_Request):
-    mass: float = Field(gt=0, le=MAX_MAGNITUDE, description="point mass [kg]")
+    mass: float | None = Field(None, gt=0, le=MAX_MAGNITUDE, description="point mass [kg, or u with mass_unit=u]; "
+                               "wins over element")
+    element: str | None = Field(None, max_length=8, description="element symbol instead of a mass: 'O', '13C', 'D'",
+                                examples=["O"])
     position: RealVector = Field(description="position [units of the request]")
+
+    @model_validator(mode="after")
+    def _mass_or_element(self) -> PointIn:
+        if self.mass is None and self.element is None:
+            raise ValueError("a point needs a mass or an element")
+        return self
 
 
 _POINTS_EXAMPLE: dict[str, Any] = {
@@ -133,7 +167,14 @@ class PointsRequest(_Request):
     model_config = ConfigDict(json_schema_extra={"examples": [_POINTS_EXAMPLE]})
 
     points: list[PointIn] = Field(min_length=1, description="point masses")
-    units: str | None = Field(None, description="length unit of the positions: m, cm, mm, um, in, ft (default m)")
+    units: str | None = Field(None, description="length unit of the positions: m, cm, mm, um, in, ft, angstrom "
+                              "(default m)")
+    mass_unit: Literal["kg", "u"] = Field("kg", description="unit of given masses: kg, or u (dalton)")
+    isotopes: Isotopes = Field("standard", description="masses of points given by element: standard atomic weights "
+                               "or the most abundant isotope")
+    export: ExportFormat | None = Field(None, description="urdf, sdf or mjcf: adds the format's inertial element")
+    frame: Quaternion | None = Field(None, description="[w, x, y, z] unit quaternion carrying a named frame's axes "
+                                     "into the input frame: adds the frame section")
     tolerance: float = Field(1e-6, gt=0, lt=1, description="relative tolerance for equal principal moments")
     reference: RealVector | None = Field(None, description="also report the tensor about this point [units]")
     omega: RealVector | None = Field(None, description="initial angular velocity [rad/s]: adds precession")
@@ -143,12 +184,13 @@ class PointsRequest(_Request):
     method: Method = Field("exact", description="with omega: exact, dop853, rk45 or splitting")
 
     def records(self) -> list[dict[str, Any]]:
-        return [p.model_dump() for p in self.points]
+        return [p.model_dump(exclude_none=True) for p in self.points]
 
     def as_options(self) -> AnalysisOptions:
         return AnalysisOptions(
             units=self.units, tolerance=self.tolerance, method=self.method, duration=self.duration,
-            samples=self.samples,
+            samples=self.samples, mass_unit=self.mass_unit, isotopes=self.isotopes, export=self.export,
+            frame=None if self.frame is None else tuple(self.frame),  # type: ignore[arg-type]
             reference=None if self.reference is None else tuple(self.reference),  # type: ignore[arg-type]
             omega=None if self.omega is None else tuple(self.omega))  # type: ignore[arg-type]
 
@@ -207,6 +249,7 @@ class PrincipalOut(_Out):
     axes: Tensor = Field(description="rows: unit principal axes in the input frame")
     quaternion: Quaternion = Field(description="[w, x, y, z]: principal frame -> input frame")
     unique_axes: bool
+    radii_of_gyration: Vector | None = Field(None, description="k_i = sqrt(I_i / m) [m]")
 
 
 class ClassificationOut(_Out):
@@ -247,8 +290,32 @@ class PartOut(_Out):
     mass: float
     center_of_mass: Vector
     inertia_tensor: Tensor
+    surface_area: float | None = Field(None, description="[m^2]")
     principal: PrincipalOut | None = None
     classification: ClassificationOut | None = None
+
+
+class RotationalConstantsOut(_Out):
+    MHz: list[float] = Field(description="A >= B >= C [MHz]; B alone for a linear molecule")
+    cm_1: list[float] = Field(alias="cm-1", description="A >= B >= C [cm^-1]; B alone for a linear molecule")
+
+
+class FrameOut(_Out):
+    quaternion: Quaternion = Field(description="[w, x, y, z]: the named frame's axes -> input frame")
+    center_of_mass: Vector = Field(description="[m], along the named axes, from the input origin or the reference")
+    inertia_tensor: Tensor = Field(description="about the centre of mass [kg m^2], named-frame axes")
+    reference_inertia: Tensor | None = Field(None, description="about the reference point [kg m^2], named-frame axes")
+
+
+class ExportPartOut(_Out):
+    name: str
+    text: str
+
+
+class ExportOut(_Out):
+    format: ExportFormat
+    text: str = Field(description="the format's inertial element, SI units, 17 significant digits")
+    parts: list[ExportPartOut] | None = None
 
 
 class DiagnosticsOut(_Out):
@@ -268,8 +335,12 @@ class AnalysisOut(_Out):
     center_of_mass: Vector = Field(description="[m], input frame")
     inertia_tensor: Tensor = Field(description="about the centre of mass [kg m^2], input frame")
     reference_inertia: ReferenceInertiaOut | None = None
+    surface_area: float | None = Field(None, description="[m^2], surface meshes and CAD solids")
     principal: PrincipalOut
     classification: ClassificationOut
+    rotational_constants: RotationalConstantsOut | None = None
+    frame: FrameOut | None = None
+    export: ExportOut | None = None
     precession: PrecessionOut | None = None
     parts: list[PartOut] | None = None
     warnings: list[str] = []
@@ -304,6 +375,11 @@ class FormatOut(BaseModel):
     parts: bool = Field(description="whether a file can hold several bodies (scene or assembly)")
 
 
+class UnavailableFormatOut(BaseModel):
+    format: str
+    needs: str = Field(description="what to install to read it (an extra of this package, or a package)")
+
+
 class FormatsOut(BaseModel):
     formats: list[FormatOut]
     surface: list[str] = Field(description="formats of surface meshes")
@@ -311,6 +387,8 @@ class FormatsOut(BaseModel):
     scene: list[str] = Field(description="formats that can hold several parts")
     points: list[str] = Field(description="formats of point-mass tables")
     cad: list[str] = Field(default_factory=list, description="CAD formats (B-rep solids; the 'cad' extra)")
+    unavailable: list[UnavailableFormatOut] = Field(
+        default_factory=list, description="formats known to the service that this installation cannot read")
 
 
 def _error(description: str) -> dict[str, Any]:
@@ -321,7 +399,8 @@ def _error(description: str) -> dict[str, Any]:
 ERROR_RESPONSES: dict[int | str, dict[str, Any]] = {
     401: _error("unauthorized: the API key is missing or wrong"),
     413: _error("payload_too_large"),
-    422: _error("invalid_parameter, or a file that cannot be analysed"),
+    422: _error("invalid_parameter, invalid_inertia (export of a body a simulator would refuse), "
+                "or a file that cannot be analysed"),
     500: _error("internal_error"),
     503: _error("timeout"),
 }

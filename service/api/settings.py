@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-import os
-
 from pydantic import Field
 from pydantic_settings import BaseSettings, SettingsConfigDict
 
@@ -13,8 +11,10 @@ MIB = 1024 * 1024
 
 
 def _default_processes() -> int:
-    # one compute process per core: the work is CPU-bound numpy
-    return max(1, os.cpu_count() or 1)
+    # one compute process per usable core (the container's CPU quota included): the work is CPU-bound numpy
+    from ..cpus import available_cpus
+
+    return available_cpus()
 
 
 class Settings(BaseSettings):
@@ -31,3 +31,7 @@ class Settings(BaseSettings):
     api_key: str | None = Field(None, description="when set, /v1/ needs the header X-API-Key with this value")
     compute_processes: int = Field(default_factory=_default_processes, gt=0,
                                    description="worker processes that run the analyses")
+    max_waiting: int = Field(64, ge=0, description="jobs that may wait for a busy compute pool before more get "
+                             "503 server_busy (each waits at most timeout_s; its upload is on disk meanwhile)")
+    max_job_memory_bytes: int = Field(8192 * MIB, gt=0, description="most memory one analysis may add to its "
+                                      "compute process, whatever the upload's size [bytes]")

@@ -11,11 +11,17 @@ Ctrl-C or an error).  On ``--resume`` the existing rows are copied first.  Only
 a hard kill loses the rows of the current run; the previous output stays whole.
 
 Rows come in completion order, not input order; each carries its input's name.
+
+Rows are rendered where they are computed (:func:`render`, on the worker):
+the JSON line or CSV line as text, the Parquet row as a tuple of values.  The
+client then only appends what comes back (``write_rendered``), so its work per
+file stays a few microseconds however many workers feed it.
 """
 
 from __future__ import annotations
 
 import csv
+import io
 import json
 import os
 from collections.abc import Iterator
@@ -25,7 +31,7 @@ from ..errors import InvalidParameterError
 from .extras import require
 from .rows import COLUMNS, FLOAT_COLUMNS, flat_row, row_name
 
-__all__ = ["OUTPUT_FORMATS", "Sink", "done_names", "open_sink"]
+__all__ = ["OUTPUT_FORMATS", "Sink", "done_names", "open_sink", "render"]
 
 OUTPUT_FORMATS = {".jsonl": "jsonl", ".ndjson": "jsonl", ".csv": "csv", ".parquet": "parquet"}
 PARQUET_ROW_GROUP = 4096  # rows per Parquet row group: ~1 MB of columns, few enough groups to read fast
@@ -33,6 +39,9 @@ PARQUET_ROW_GROUP = 4096  # rows per Parquet row group: ~1 MB of columns, few en
 
 class Sink(Protocol):
     def write(self, row: dict[str, Any]) -> None: ...
+    def write_rendered(self, rendered: Any) -> None:
+        """Append a row already rendered by :func:`render` for this sink's format."""
+
     def flush(self) -> None:
         """Make the rows written so far durable (called after each finished task)."""
 
@@ -127,6 +136,20 @@ def _csv_names(fh: IO[str], path: str) -> set[str]:
 # writers
 
 
+def render(row: dict[str, Any], fmt: str) -> Any:
+    """A JSON line as the sink of ``fmt`` writes it: a line of text (JSONL, CSV) or a Parquet row tuple."""
+    if fmt == "jsonl":
+        # allow_nan=False: the contract never sends NaN, so one here is a bug to see
+        return json.dumps(row, allow_nan=False) + "\n"
+    flat = flat_row(row)
+    if fmt == "csv":
+        buf = io.StringIO()
+        # csv writes floats with repr(): they read back bit for bit
+        csv.writer(buf).writerow([flat[c] for c in COLUMNS])
+        return buf.getvalue()
+    return tuple(flat[c] for c in COLUMNS)
+
+
 def open_sink(path: str, append: bool) -> Sink:
     """A writer for ``path``; ``append`` keeps the rows already there."""
     fmt = output_format(path)
@@ -143,8 +166,10 @@ class JsonlSink:
         self._fh = open(path, "a" if append else "w", encoding="utf-8")  # noqa: SIM115  closed by close()
 
     def write(self, row: dict[str, Any]) -> None:
-        # allow_nan=False: the contract never sends NaN, so one here is a bug to see
-        self._fh.write(json.dumps(row, allow_nan=False) + "\n")
+        self._fh.write(render(row, "jsonl"))
+
+    def write_rendered(self, rendered: Any) -> None:
+        self._fh.write(rendered)
 
     def flush(self) -> None:
         self._fh.flush()
@@ -161,8 +186,10 @@ class CsvSink:
             self._writer.writeheader()
 
     def write(self, row: dict[str, Any]) -> None:
-        # csv writes floats with repr(): they read back bit for bit
-        self._writer.writerow(flat_row(row))
+        self._fh.write(render(row, "csv"))
+
+    def write_rendered(self, rendered: Any) -> None:
+        self._fh.write(rendered)
 
     def flush(self) -> None:
         self._fh.flush()
@@ -184,14 +211,17 @@ class ParquetSink:
         self._partial = path + ".partial"
         self._schema = parquet_schema()
         self._writer = pa.parquet.ParquetWriter(self._partial, self._schema)
-        self._buffer: list[dict[str, Any]] = []
+        self._buffer: list[tuple[Any, ...]] = []
         if append:
             old = pa.parquet.ParquetFile(path)
             for i in range(old.num_row_groups):
                 self._writer.write_table(old.read_row_group(i).select(list(COLUMNS)).cast(self._schema))
 
     def write(self, row: dict[str, Any]) -> None:
-        self._buffer.append(flat_row(row))
+        self.write_rendered(render(row, "parquet"))
+
+    def write_rendered(self, rendered: Any) -> None:
+        self._buffer.append(rendered)
         if len(self._buffer) >= PARQUET_ROW_GROUP:
             self._flush()
 
@@ -200,7 +230,10 @@ class ParquetSink:
 
     def _flush(self) -> None:
         if self._buffer:
-            self._writer.write_table(self._pa.Table.from_pylist(self._buffer, schema=self._schema))
+            columns = list(zip(*self._buffer, strict=True))
+            self._writer.write_table(self._pa.Table.from_arrays(
+                [self._pa.array(col, type=f.type) for col, f in zip(columns, self._schema, strict=True)],
+                schema=self._schema))
             self._buffer = []
 
     def close(self) -> None:

@@ -5,7 +5,10 @@ or several small ones to amortise the per-task overhead).  The worker reads
 each file itself (path, URL or zip member), analyses it with exactly the
 ``AnalysisOptions`` of the run, and returns one JSON-ready row per file.  A
 file that fails gives an error row; nothing a file does stops the group.
-Only the rows travel back, so a worker holds at most one group's files.
+Only the rows travel back, so a worker holds at most one group's files;
+:func:`render_sources` sends them rendered for the output (a JSON or CSV line
+of text, or a Parquet row tuple), the most compact form the client can
+append without further work.
 """
 
 from __future__ import annotations
@@ -17,9 +20,10 @@ from typing import Any
 from ..errors import ServiceError, UnreadableFileError
 from ..pipeline import AnalysisOptions, analyze
 from .rows import error_row
+from .sinks import render
 from .sources import Source, ZipCache, read_source
 
-__all__ = ["InternalError", "analyze_source", "analyze_sources"]
+__all__ = ["InternalError", "analyze_source", "analyze_sources", "render_sources"]
 
 
 class InternalError(ServiceError):
@@ -49,6 +53,11 @@ def analyze_sources(sources: Sequence[Source], options: AnalysisOptions) -> list
         return [analyze_source(src, options, zips) for src in sources]
     finally:
         zips.close()
+
+
+def render_sources(sources: Sequence[Source], options: AnalysisOptions, fmt: str) -> list[tuple[Any, bool]]:
+    """(the row rendered for an output of format ``fmt``, whether it is an error row) for each input."""
+    return [(render(row, fmt), "error" in row) for row in analyze_sources(sources, options)]
 
 
 def _json_safe(row: dict[str, Any]) -> dict[str, Any]:

@@ -24,6 +24,7 @@ import numpy as np
 from ..body import BrepBody, MeshBody, Part
 from ..conventions import DEFAULT_DENSITY, LENGTH_UNITS
 from ..errors import InvalidParameterError, UnsupportedFormatError
+from ..surface import SURFACE_AREA_KEY
 from ..tolerances import EPS
 
 if TYPE_CHECKING:
@@ -70,15 +71,16 @@ def read_cad_parts(data: bytes, fmt: str, units: str | None) -> tuple[list[Part]
     else:
         assert declared is not None
         scale, unit, units_from = occ.MODEL_UNIT, declared, "file"
-    parts = [Part(s.name, BrepBody(s, scale, s.name)) for s in solids]
+    parts = [Part(s.name, BrepBody(s, scale, s.name), {SURFACE_AREA_KEY: occ.surface_area(s) * scale**2})
+             for s in solids]
     return parts, unit, units_from, tuple(warnings)
 
 
 def brep_mass_properties(body: BrepBody, *, density: float | None = None, mass: float | None = None,
                          model: str = "solid") -> MassProperties:
     """Mass properties of one B-rep solid, SI units; density kg/m^3 (default 1000) or a total ``mass`` kg."""
+    from ..eigen import jacobi_eigh
     from ..mass import InertiaTensor, MassProperties
-    from ..principal import jacobi_eigh
     from . import occ
 
     if model != "solid":
@@ -111,8 +113,8 @@ def combined_properties(parts: Sequence[MassProperties]) -> MassProperties:
     its trace; the sum's eigenvalues move by at most the sum of those
     (Weyl), taken relative to the smallest principal moment of the whole.
     """
+    from ..eigen import jacobi_eigh
     from ..mass import InertiaTensor, MassProperties, parallel_axis
-    from ..principal import jacobi_eigh
 
     total = sum(p.mass for p in parts)
     com = sum((p.mass * p.center_of_mass for p in parts), np.zeros(3)) / total
@@ -149,7 +151,8 @@ def tessellated(loaded: Loaded, deflection: float) -> Loaded:
         assert isinstance(body, BrepBody)
         vertices, faces = occ.tessellate(body.solid, deflection)
         # coordinates stay in the model unit as read; length_scale turns them into metres, as for the B-rep
-        parts.append(Part(part.name, MeshBody(vertices, faces, body.length_scale, part.name), part.extras))
+        extras = {k: v for k, v in part.extras.items() if k != SURFACE_AREA_KEY}  # the triangles' own area
+        parts.append(Part(part.name, MeshBody(vertices, faces, body.length_scale, part.name), extras))
     return replace(loaded, parts=tuple(parts))
 
 

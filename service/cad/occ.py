@@ -347,6 +347,19 @@ def _integrate(solid: Solid) -> BrepIntegral:
     return BrepIntegral(v2, c2, 0.5 * (t2 + t2.T), estimate, _count_faces(solid.shape))
 
 
+def surface_area(solid: Solid) -> float:
+    """Area of the solid's faces [mm^2] by the same adaptive rule (eps ``FINE_EPS``)."""
+    try:
+        from OCP.BRepGProp import BRepGProp
+        from OCP.GProp import GProp_GProps
+
+        props = GProp_GProps()
+        BRepGProp.SurfaceProperties_s(solid.shape, props, FINE_EPS)
+        return float(props.Mass())
+    except (Exception, SystemExit) as exc:
+        raise _translated(exc, f"measure the surface of the solid {solid.name!r}") from exc
+
+
 def _check_closed(solid: Solid) -> None:
     """Every shell of the solid must be closed; an open one bounds no volume."""
     from OCP.BRep import BRep_Tool

@@ -3,12 +3,20 @@
 from __future__ import annotations
 
 import os
-from dataclasses import dataclass
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, replace
+
+import numpy as np
+from numpy.typing import NDArray
 
 from ..body import Body, BrepBody, MeshBody, Part, PointBody, VolumeBody
 from ..conventions import length_scale
 from ..errors import EmptyGeometryError, UnreadableFileError
+from .guard import check_upload
 from .sniff import CAD_FORMATS, FORMATS, POINT_FORMATS, SCENE_FORMATS, SURFACE_FORMATS, VOLUME_FORMATS, sniff_format
+from .upload import pick_model_file, unpack_zip
+
+XYZ_UNIT = "angstrom"  # the XYZ format's length unit (coordinates in angstrom, as chemistry programs write them)
 
 __all__ = ["Loaded", "load_body", "load_points", "FORMATS", "SURFACE_FORMATS", "VOLUME_FORMATS", "SCENE_FORMATS"]
 
@@ -41,22 +49,55 @@ class Loaded:
 
 
 def load_body(
-    source: bytes | str | os.PathLike[str],
+    source: bytes | str | os.PathLike[str] | Sequence[tuple[str, bytes]],
     *,
     filename: str | None = None,
     format: str | None = None,
     units: str | None = None,
+    isotopes: str = "standard",
 ) -> Loaded:
-    """Read a mesh or points file (bytes or a path) into bodies in file units."""
+    """Read a mesh or points file into bodies in file units.
+
+    source : the file's bytes, a path, or several files of one upload as
+        ``[(name, bytes), ...]`` (a model and its companion files, e.g. a
+        ``.gltf`` and its ``.bin``).  Bytes or a path named ``*.zip`` are
+        unpacked into such a list.  The model file is the one whose format
+        is readable and that is not a companion kind (``.bin``, images,
+        ``.mtl``, ``.node``); the others are offered to its reader by name,
+        and nothing outside the upload is ever opened.
+    isotopes : masses of atoms named by element (XYZ, points files): "standard"
+        atomic weights or the most "abundant" isotope.
+    """
+    if not isinstance(source, (bytes, bytearray, memoryview, str, os.PathLike)):
+        return _load_files(list(source), format, units, isotopes)
+    zipped = (format or "").lower().lstrip(".") == "zip"
+    inner_format = None if zipped else format
     if isinstance(source, (str, os.PathLike)):
         path = os.fspath(source)
         filename = filename or os.path.basename(path)
-        return _load_path(path, filename, format, units)
-    data = source if isinstance(source, bytes) else bytes(source)
-    return _load_bytes(data, filename, format, units)
+        if filename.lower().endswith(".zip") or zipped:
+            try:
+                with open(path, "rb") as fh:
+                    raw = fh.read()
+            except OSError as exc:
+                raise UnreadableFileError(f"cannot open {path!r}: {exc.strerror}") from exc
+            return _load_files(unpack_zip(raw), inner_format, units, isotopes)
+        return _load_path(path, filename, format, units, isotopes)
+    data = source if isinstance(source, bytes) else bytes(source)  # bytearray, memoryview
+    if (filename or "").lower().endswith(".zip") or zipped:
+        return _load_files(unpack_zip(data), inner_format, units, isotopes)
+    return _load_bytes(data, filename, format, units, isotopes)
 
 
-def _load_path(path: str, filename: str, format: str | None, units: str | None) -> Loaded:
+def _load_files(files: list[tuple[str, bytes]], format: str | None, units: str | None,
+                isotopes: str = "standard") -> Loaded:
+    """The model file of a multi-file upload, read with the others as its companions."""
+    main, companions = pick_model_file(files, format)
+    data = dict(files)[main]
+    return _load_bytes(bytes(data), os.path.basename(main), format, units, isotopes, companions)
+
+
+def _load_path(path: str, filename: str, format: str | None, units: str | None, isotopes: str = "standard") -> Loaded:
     """A file on disk; a binary STL is read in blocks, never held whole beside its vertices."""
     try:
         fh = open(path, "rb")  # noqa: SIM115  (closed by the with below; only opening errors are caught here)
@@ -67,26 +108,32 @@ def _load_path(path: str, filename: str, format: str | None, units: str | None) 
         fmt = sniff_format(filename, format, head) if head else None
         if fmt != "stl":
             fh.seek(0)
-            return _load_bytes(fh.read(), filename, format, units)
+            return _load_bytes(fh.read(), filename, format, units, isotopes)
         from .stl import read_stl_file
 
         fh.seek(0)
         vertices, faces = read_stl_file(fh, os.fstat(fh.fileno()).st_size)
     scale = 1.0 if units is None else length_scale(units)
     name = _stem(filename)
-    parts = (Part(name, MeshBody(vertices, faces, scale, name, welded=True)),)
+    parts = (Part(name, MeshBody(vertices, faces, scale, name, welded=True, coordinate_eps=stl_eps(vertices))),)
     return Loaded(parts, filename, "stl", "mesh", units or "m", "request" if units else "default")
 
 
-def _load_bytes(data: bytes, filename: str | None, format: str | None, units: str | None) -> Loaded:
+def _load_bytes(data: bytes, filename: str | None, format: str | None, units: str | None,
+                isotopes: str = "standard", companions: Mapping[str, bytes] | None = None) -> Loaded:
     if not len(data):
         raise EmptyGeometryError("the file is empty; send a mesh with geometry", filename=filename)
     fmt = sniff_format(filename, format, bytes(data[:512]))
+    # includes, external references, inflation bounds: before any reader
+    check_upload(data, fmt, companions=tuple(companions or ()))
     if fmt in CAD_FORMATS:
         from ..cad import read_cad_parts
 
         cad_parts, unit, units_from, warnings = read_cad_parts(data, fmt, units)
         return Loaded(tuple(cad_parts), filename, fmt, "cad", unit, units_from, warnings)
+    xyz_default = fmt == "xyz" and units is None
+    if xyz_default:
+        units = XYZ_UNIT
     requested = None if units is None else (units, length_scale(units))
     scale = requested[1] if requested else 1.0
 
@@ -95,25 +142,33 @@ def _load_bytes(data: bytes, filename: str | None, format: str | None, units: st
         from .stl import read_stl
 
         vertices, faces = read_stl(data)
-        parts = [Part(_stem(filename), MeshBody(vertices, faces, scale, _stem(filename), welded=True))]
+        parts = [Part(_stem(filename), MeshBody(vertices, faces, scale, _stem(filename), welded=True,
+                                              coordinate_eps=stl_eps(vertices)))]
         kind = "mesh"
     elif fmt in POINT_FORMATS:
-        from .points import read_points_file
+        from .points import read_points
 
-        parts = [Part(_stem(filename), read_points_file(data, fmt, scale))]
+        body, molecule = read_points(data, fmt, scale, isotopes=isotopes)
+        parts = [Part(_stem(filename), body, {"molecule": True} if molecule else {})]
         kind = "points"
     elif fmt in VOLUME_FORMATS:
-        from .meshes import read_meshio_parts
+        from .volume import read_volume_parts
 
-        parts = read_meshio_parts(data, fmt, scale)
+        parts = read_volume_parts(data, fmt, scale, filename=filename, companions=companions)
         kind = "volume"
     else:
-        from .meshes import read_trimesh_parts
+        from .meshes import read_surface_parts
 
-        parts, declared = read_trimesh_parts(data, fmt, scale)
+        parts, declared, notes = read_surface_parts(data, fmt, scale, companions)
+        if notes:  # what the file holds but is not weighed (3MF support objects, ...) travels as warnings
+            first = parts[0]
+            assert isinstance(first.body, MeshBody)
+            parts[0] = Part(first.name, replace(first.body, warnings=(*first.body.warnings, *notes)), first.extras)
         kind = "mesh"
 
-    if requested:
+    if xyz_default:
+        unit, units_from = XYZ_UNIT, "default"
+    elif requested:
         unit, units_from = requested[0], "request"
     elif declared:
         unit, units_from = declared, "file"
@@ -123,25 +178,34 @@ def _load_bytes(data: bytes, filename: str | None, format: str | None, units: st
     return Loaded(tuple(parts), filename, fmt, kind, unit, units_from)
 
 
-def load_points(records: list[dict[str, object]], units: str | None = None) -> Loaded:
-    """Point masses given as records ``{"mass": m, "position": [x, y, z]}``."""
-    from .points import points_from_records
+def load_points(records: list[dict[str, object]], units: str | None = None, *,
+                isotopes: str = "standard", mass_unit: str = "kg") -> Loaded:
+    """Point masses given as records ``{"mass": m, "position": [x, y, z]}`` (or ``"element"``)."""
+    from .points import names_elements, points_from_records
 
     unit = units or "m"
-    body = points_from_records(records, length_scale(unit))
-    return Loaded((Part("points", body),), None, "points", "points", unit, "request" if units else "default")
+    body = points_from_records(records, length_scale(unit), isotopes=isotopes, mass_unit=mass_unit)
+    extras: dict[str, object] = {"molecule": True} if names_elements(records) else {}
+    return Loaded((Part("points", body, extras),), None, "points", "points", unit, "request" if units else "default")
 
 
 def _rescaled(part: Part, scale: float) -> Part:
     body = part.body
     if isinstance(body, MeshBody):
-        new: Body = MeshBody(body.vertices, body.faces, scale, body.name, body.warnings, body.welded)
+        new: Body = MeshBody(body.vertices, body.faces, scale, body.name, body.warnings, body.welded,
+                             body.coordinate_eps)
     elif isinstance(body, VolumeBody):
-        new = VolumeBody(body.points, body.tets, body.cell_density, scale, body.name, body.warnings)
+        new = VolumeBody(body.points, body.tets, body.cell_density, scale, body.name, body.warnings, body.cells)
     else:
         assert isinstance(body, PointBody)
         new = PointBody(body.masses, body.positions, scale, body.name, body.warnings)
     return Part(part.name, new, part.extras)
+
+
+def stl_eps(vertices: NDArray[np.float64]) -> float:
+    """Unit roundoff of an STL file's coordinates: float32 (binary STL, or ASCII written from
+    float32) when every coordinate is a float32 value, else float64 (decimal text)."""
+    return 2.0**-24 if bool(np.array_equal(vertices.astype(np.float32), vertices)) else 2.0**-53
 
 
 def _stem(filename: str | None) -> str:

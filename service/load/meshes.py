@@ -1,87 +1,187 @@
-"""Adapters to trimesh (surface meshes and scenes) and meshio (volume meshes).
+"""Surface meshes and scenes: OBJ and 3MF by our own readers, PLY/OFF/glTF through trimesh.
 
 Only geometry is read: materials, textures, normals and colours are skipped
 (``skip_materials``) and trimesh's processing is off (``process=False``) so
 the polyhedron is exactly the one in the file.  Third-party exceptions are
-translated here; nothing above ``load/`` sees them.
+translated at the call (``safe.guarded_read``); nothing above ``load/`` sees
+them.  A scene node whose transform mirrors (negative determinant) has its
+triangles' winding reversed, as the glTF 2.0 specification (section 3.7.4,
+"Transformations") prescribes, so an outward mesh stays outward.
 """
 
 from __future__ import annotations
 
 import io
-import os
-import tempfile
+import json
+from collections.abc import Mapping
+from dataclasses import replace
 from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 
-from ..body import MeshBody, Part, VolumeBody
-from ..errors import EmptyGeometryError, UnreadableFileError
-from .sniff import VOLUME_FORMATS
+from ..body import MeshBody, Part
+from ..errors import EmptyGeometryError, UnreadableFileError, UnsupportedFormatError
+from .safe import guarded_read
 
-__all__ = ["read_trimesh_parts", "read_meshio_parts", "TET_SPLITS"]
+__all__ = ["read_trimesh_parts", "read_surface_parts", "mesh_part"]
 
-# Each 3-D cell type split into tetrahedra by node index (VTK/meshio node order).
-# Hexahedron: six tetrahedra around the diagonal 0-6; wedge: three; pyramid: two.
-TET_SPLITS: dict[str, NDArray[np.int64]] = {
-    "tetra": np.array([[0, 1, 2, 3]]),
-    "hexahedron": np.array([[0, 1, 2, 6], [0, 2, 3, 6], [0, 3, 7, 6], [0, 7, 4, 6], [0, 4, 5, 6], [0, 5, 1, 6]]),
-    "wedge": np.array([[0, 1, 2, 3], [1, 2, 3, 4], [2, 3, 4, 5]]),
-    "pyramid": np.array([[0, 1, 2, 4], [0, 2, 3, 4]]),
-}
-_HIGHER_ORDER = {"tetra10": "tetra", "hexahedron20": "hexahedron", "hexahedron27": "hexahedron",
-                 "wedge15": "wedge", "wedge18": "wedge", "pyramid13": "pyramid", "pyramid14": "pyramid"}
+# glTF extensions that change nothing in the geometry we read (materials, textures, lights, metadata)
+_HARMLESS_GLTF_EXTENSIONS = ("KHR_materials_", "KHR_texture_", "KHR_lights_", "KHR_xmp", "KHR_animation_pointer",
+                             "EXT_texture_")
 
 
-def read_trimesh_parts(data: bytes, fmt: str, length_scale: float) -> tuple[list[Part], str | None]:
-    """Parts of a surface file (one per scene node) and the unit it declares."""
+def read_surface_parts(data: bytes, fmt: str, length_scale: float,
+                       companions: Mapping[str, bytes] | None = None) -> tuple[list[Part], str | None, list[str]]:
+    """Parts of a surface file, the unit it declares, and notes on what was left out (not weighed)."""
+    if fmt == "obj":
+        from .obj import read_obj
+
+        groups = guarded_read(lambda: read_obj(data), fmt)  # our reader; any slip still becomes a sentence
+        parts = [mesh_part(name or "body", v, f, length_scale, "obj") for name, v, f in groups]
+        if len(parts) == 1 and not groups[0][0]:
+            parts = [mesh_part("body", groups[0][1], groups[0][2], length_scale, "obj")]
+        return parts, None, []
+    if fmt == "3mf":
+        from .threemf import read_3mf
+
+        model = guarded_read(lambda: read_3mf(data), fmt)
+        parts = [mesh_part(name, v, f, length_scale, "3mf") for name, v, f in model.parts]
+        return parts, model.unit, model.notes
+    parts, unit = read_trimesh_parts(data, fmt, length_scale, companions)
+    return parts, unit, []
+
+
+def mesh_part(name: str, vertices: NDArray[Any], faces: NDArray[Any], length_scale: float, fmt: str) -> Part:
+    """A checked part: (n, 3) finite vertices, (m, 3) faces within range, or an ``UnreadableFileError``."""
+    v = np.asarray(vertices, dtype=np.float64)
+    f = np.asarray(faces)
+    if v.ndim != 2 or v.shape[1] != 3:
+        raise UnreadableFileError(f"the {fmt.upper()} file's vertices of {name!r} do not have three coordinates "
+                                  "each; check the file or re-export it", format=fmt, part=name)
+    if f.ndim != 2 or f.shape[1] != 3 or not np.issubdtype(f.dtype, np.integer):
+        raise UnreadableFileError(f"the {fmt.upper()} file's faces of {name!r} are not triangles of vertex "
+                                  "numbers; check the file or re-export it", format=fmt, part=name)
+    if len(f) == 0:
+        raise EmptyGeometryError(f"part {name!r} of the {fmt.upper()} file has no triangles", format=fmt, part=name)
+    if f.min() < 0 or f.max() >= len(v):
+        raise UnreadableFileError(f"a triangle of {name!r} in the {fmt.upper()} file refers to a vertex that does "
+                                  f"not exist (number {int(f.max())} of {len(v)}); the file is corrupt or truncated",
+                                  format=fmt, part=name)
+    # non-finite coordinates: MeshBody refuses them as invalid_parameter (API.md)
+    return Part(name, MeshBody(v, f.astype(np.int64), length_scale, name))
+
+
+def read_trimesh_parts(data: bytes, fmt: str, length_scale: float,
+                       companions: Mapping[str, bytes] | None = None) -> tuple[list[Part], str | None]:
+    """Parts of a PLY/OFF/GLB/glTF file (one per scene node) and the unit it declares."""
     import trimesh
 
-    if fmt == "gltf":
-        _check_gltf_self_contained(data)
-    extra: dict[str, Any] = {"split_objects": True, "split_groups": True, "group_material": False} if fmt == "obj" else {}
-    try:
-        scene = trimesh.load_scene(
-            io.BytesIO(data), file_type=fmt, process=False, skip_materials=True, merge_primitives=False, **extra
-        )
-    except Exception as exc:  # trimesh raises many types for bad input
-        raise UnreadableFileError(f"could not read the {fmt.upper()} file: {_short(exc)}", format=fmt) from exc
+    notes = _check_gltf_document(data, fmt) if fmt in ("gltf", "glb") else []
+    kwargs: dict[str, Any] = {}
+    if companions:
+        kwargs["resolver"] = trimesh.resolvers.ZipResolver(dict(companions))
+    scene = guarded_read(lambda: trimesh.load_scene(io.BytesIO(data), file_type=fmt, process=False,
+                                                    skip_materials=True, merge_primitives=False, **kwargs), fmt)
     parts: list[Part] = []
-    # sorted: the scene graph's node order is not stable across processes
-    for node in sorted(scene.graph.nodes_geometry, key=str):
+    skipped = 0
+    nodes = guarded_read(lambda: sorted(scene.graph.nodes_geometry, key=str), fmt)  # node order is not stable
+    for node in nodes:
         transform, geom_name = scene.graph[node]
         geom = scene.geometry.get(geom_name)
         if not isinstance(geom, trimesh.Trimesh) or len(geom.faces) == 0:
+            skipped += 1
             continue
         vertices = np.asarray(geom.vertices, dtype=np.float64)
+        faces = np.asarray(geom.faces)
         t = np.asarray(transform, dtype=np.float64)
         if not np.array_equal(t, np.eye(4)):
-            vertices = vertices @ t[:3, :3].T + t[:3, 3]
-        name = str(node) if node != geom_name or len(scene.graph.nodes_geometry) > 1 else str(geom_name)
-        parts.append(Part(name, MeshBody(vertices, np.asarray(geom.faces, dtype=np.int64), length_scale, name)))
+            if vertices.ndim == 2 and vertices.shape[1] == 3:
+                vertices = vertices @ t[:3, :3].T + t[:3, 3]
+            if np.linalg.det(t[:3, :3]) < 0 and faces.ndim == 2 and faces.shape[1] == 3:
+                faces = faces[:, [0, 2, 1]]
+        name = str(node) if node != geom_name or len(nodes) > 1 else str(geom_name)
+        parts.append(mesh_part(name, vertices, faces, length_scale, fmt))
     if not parts:
-        raise EmptyGeometryError(f"the {fmt.upper()} file holds no triangles")
+        what = " (only points or lines)" if skipped else ""
+        raise EmptyGeometryError(f"the {fmt.upper()} file holds no triangles{what}; a solid needs a triangle mesh",
+                                 format=fmt)
+    if notes:
+        first = parts[0]
+        assert isinstance(first.body, MeshBody)
+        parts[0] = Part(first.name, replace(first.body, warnings=(*first.body.warnings, *notes)))
     return parts, _declared_unit(scene, fmt)
 
 
-def _check_gltf_self_contained(data: bytes) -> None:
-    """A .gltf upload must carry its buffers; external files are never read."""
-    import json
-
+def _gltf_document(data: bytes, fmt: str) -> Any:
     try:
-        doc = json.loads(data)
-    except (UnicodeDecodeError, json.JSONDecodeError) as exc:
-        raise UnreadableFileError(f"the glTF file is not valid JSON ({exc})", format="gltf") from exc
-    buffers = doc.get("buffers", []) if isinstance(doc, dict) else []
-    external = [b.get("uri") for b in buffers if isinstance(b, dict) and b.get("uri")
-                and not str(b.get("uri")).startswith("data:")]
-    if external:
-        raise UnreadableFileError(
-            f"the glTF file refers to external buffer files ({', '.join(map(str, external))}); "
-            "upload a .glb, or a .gltf with embedded (data URI) buffers",
-            format="gltf",
-        )
+        if fmt == "glb":
+            size = int.from_bytes(data[12:16], "little")
+            return json.loads(data[20:20 + size])
+        return json.loads(data)
+    except (ValueError, UnicodeDecodeError):
+        return None  # the reader reports a malformed document in its own words
+
+
+def _check_gltf_document(data: bytes, fmt: str) -> list[str]:
+    """Refuse what trimesh's glTF reader would read as other geometry than the file's; notes on what is left out.
+
+    glTF 2.0 specification: required extensions that change the geometry
+    (Draco or meshopt compression, quantized positions), sparse accessors
+    (section 3.6.2.3; trimesh does not apply them), triangle fans (mode 6),
+    skinned meshes (posed by their joints, section 3.7.3: the node's own
+    transform is ignored) and morph targets with non-zero default weights
+    (section 3.7.2.2) are refused with a sentence; point and line primitives
+    (modes 0-3) hold no volume and are left out with a note.
+    """
+    doc = _gltf_document(data, fmt)
+    if not isinstance(doc, dict):
+        return []
+
+    def refuse(what: str, **details: Any) -> UnsupportedFormatError:
+        return UnsupportedFormatError(f"the {fmt.upper()} file {what}", format=fmt, **details)
+
+    required = doc.get("extensionsRequired", [])
+    unknown = [str(e) for e in required if isinstance(e, str) and not e.startswith(_HARMLESS_GLTF_EXTENSIONS)] \
+        if isinstance(required, list) else []
+    if unknown:
+        raise refuse(f"requires the extension(s) {', '.join(unknown)}, which this service does not decode "
+                     "(compressed or quantized geometry); export it without mesh compression", extensions=unknown)
+    accessors: list[Any] = doc["accessors"] if isinstance(doc.get("accessors"), list) else []
+    meshes: list[Any] = doc["meshes"] if isinstance(doc.get("meshes"), list) else []
+    nodes: list[Any] = doc["nodes"] if isinstance(doc.get("nodes"), list) else []
+    notes: list[str] = []
+    lines = 0
+    for mi, mesh in enumerate(meshes):
+        if not isinstance(mesh, dict):
+            continue
+        label = mesh.get("name") or f"mesh {mi}"
+        weights = mesh.get("weights")
+        if isinstance(weights, list) and any(isinstance(w, (int, float)) and w != 0 for w in weights):
+            raise refuse(f"gives mesh {label!r} morph-target weights, so its shape is not the stored positions; "
+                         "export it with the morph applied")
+        for prim in mesh.get("primitives", []) if isinstance(mesh.get("primitives"), list) else []:
+            if not isinstance(prim, dict):
+                continue
+            mode = prim.get("mode", 4)
+            if mode in (0, 1, 2, 3):
+                lines += 1
+                continue
+            if mode == 6:
+                raise refuse(f"stores mesh {label!r} as a triangle fan (mode 6), which this service does not "
+                             "read; export it as triangles")
+            attrs: dict[str, Any] = prim["attributes"] if isinstance(prim.get("attributes"), dict) else {}
+            for key in (attrs.get("POSITION"), prim.get("indices")):
+                if isinstance(key, int) and 0 <= key < len(accessors) and isinstance(accessors[key], dict) \
+                        and "sparse" in accessors[key]:
+                    raise refuse(f"stores mesh {label!r} with a sparse accessor, which this service does not "
+                                 "apply; export it without sparse storage")
+    if any(isinstance(n, dict) and "skin" in n and "mesh" in n for n in nodes):
+        raise refuse("holds a skinned mesh, whose shape is set by its joints (the node's own transform is "
+                     "ignored, glTF 2.0 section 3.7.3); export the mesh with the skin applied")
+    if lines:
+        notes.append(f"{lines} point or line primitive(s) of the glTF file hold no volume and were left out")
+    return notes
 
 
 def _declared_unit(scene: Any, fmt: str) -> str | None:
@@ -104,60 +204,3 @@ _UNIT_NAMES = {
     "inch": "in", "inches": "in", "in": "in",
     "foot": "ft", "feet": "ft", "ft": "ft",
 }
-
-
-def read_meshio_parts(data: bytes, fmt: str, length_scale: float) -> list[Part]:
-    """Parts of a volume mesh: one per block of 3-D cells, split into tetrahedra."""
-    import meshio
-
-    with tempfile.TemporaryDirectory() as tmp:
-        path = os.path.join(tmp, f"upload.{fmt}")
-        with open(path, "wb") as fh:
-            fh.write(data)
-        try:
-            mesh = meshio.read(path, file_format=VOLUME_FORMATS[fmt])
-        except Exception as exc:  # meshio raises ReadError, KeyError, ValueError, ...
-            raise UnreadableFileError(f"could not read the {fmt.upper()} file: {_short(exc)}", format=fmt) from exc
-    points = np.asarray(mesh.points, dtype=np.float64)
-    if points.ndim != 2 or points.shape[1] not in (2, 3):
-        raise UnreadableFileError("the volume mesh has no 3-D points")
-    if points.shape[1] == 2:
-        raise EmptyGeometryError("the mesh is two-dimensional; a volume needs 3-D cells")
-    densities = mesh.cell_data.get("density")
-    names = _block_names(mesh)
-    parts: list[Part] = []
-    for i, block in enumerate(mesh.cells):
-        ctype = _HIGHER_ORDER.get(block.type, block.type)
-        if ctype not in TET_SPLITS:
-            continue
-        split = TET_SPLITS[ctype]
-        nodes = np.asarray(block.data, dtype=np.int64)[:, : split.max() + 1]
-        tets = nodes[:, split].reshape(-1, 4)
-        rho = None
-        if densities is not None:
-            rho = np.repeat(np.asarray(densities[i], dtype=np.float64).reshape(-1), len(split))
-        parts.append(Part(names[i], VolumeBody(points, tets, rho, length_scale, names[i])))
-    if not parts:
-        kinds = ", ".join(sorted({b.type for b in mesh.cells})) or "none"
-        raise EmptyGeometryError(
-            f"the file has no 3-D cells (found: {kinds}); send tetrahedra, hexahedra, wedges or pyramids, "
-            "or a closed surface mesh"
-        )
-    return parts
-
-
-def _block_names(mesh: Any) -> list[str]:
-    tags = mesh.cell_data.get("gmsh:physical")
-    by_tag = {int(v[0]): k for k, v in (mesh.field_data or {}).items()}
-    names = []
-    for i, block in enumerate(mesh.cells):
-        name = f"{block.type}_{i}"
-        if tags is not None and len(tags[i]) and np.all(tags[i] == tags[i][0]):
-            name = by_tag.get(int(tags[i][0]), name)
-        names.append(name)
-    return names
-
-
-def _short(exc: BaseException) -> str:
-    text = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
-    return text[:200]

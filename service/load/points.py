@@ -1,4 +1,11 @@
-"""Point masses from records, JSON or CSV."""
+"""Point masses from records, JSON, CSV or XYZ.
+
+A record gives ``mass`` (in ``mass_unit``: kg, or u) or names its ``element``
+(``"O"``, ``"13C"``, ``"D"``; masses from ``elements.atomic_mass``); ``mass``
+wins when both are given.  XYZ files (atom count, comment line, then
+``El x y z`` lines; the de-facto format of chemistry programs such as Open
+Babel and ASE) name elements, by symbol or atomic number.
+"""
 
 from __future__ import annotations
 
@@ -6,6 +13,7 @@ import csv
 import io
 import json
 from collections.abc import Iterable, Mapping
+from dataclasses import replace
 from typing import Any
 
 import numpy as np
@@ -13,19 +21,51 @@ import numpy as np
 from ..body import PointBody
 from ..errors import EmptyGeometryError, InvalidParameterError, UnreadableFileError
 
-__all__ = ["points_from_records", "read_points_file"]
+__all__ = ["MASS_UNITS", "names_elements", "points_from_records", "read_points", "read_points_file"]
+
+MASS_UNITS = ("kg", "u")
 
 
-def points_from_records(records: Iterable[Mapping[str, Any]], length_scale: float = 1.0) -> PointBody:
-    """``[{"mass": m, "position": [x, y, z]}, ...]`` as a ``PointBody``."""
+def names_elements(records: Iterable[Mapping[str, Any]]) -> bool:
+    """Whether any record names its element (the input is then a molecule)."""
+    return any(isinstance(rec, Mapping) and rec.get("element") is not None for rec in records)
+
+
+def _mass(rec: Mapping[str, Any], k: int, isotopes: str, dalton: float | None) -> float:
+    """The record's mass [kg]: its ``mass`` (times ``dalton`` when in u), else its element's."""
+    if rec.get("mass") is not None:
+        return float(rec["mass"]) * (dalton if dalton is not None else 1.0)
+    if rec.get("element") is None:
+        raise KeyError("mass")
+    from ..elements import atomic_mass, dalton_kg
+
+    try:
+        return atomic_mass(str(rec["element"]), isotopes) * dalton_kg()
+    except InvalidParameterError as exc:
+        raise InvalidParameterError(f"point {k}: {exc.message}", index=k, **exc.details) from None
+
+
+def points_from_records(records: Iterable[Mapping[str, Any]], length_scale: float = 1.0, *,
+                        isotopes: str = "standard", mass_unit: str = "kg") -> PointBody:
+    """``[{"mass": m, "position": [x, y, z]}, ...]`` (or ``"element"`` for ``mass``) as a ``PointBody``.
+
+    mass_unit : "kg" or "u" for given masses; element masses are always right.
+    """
+    if mass_unit not in MASS_UNITS:
+        raise InvalidParameterError(f"mass_unit must be 'kg' or 'u', got {mass_unit!r}", parameter="mass_unit")
+    dalton = None
+    if mass_unit == "u":
+        from ..elements import dalton_kg
+
+        dalton = dalton_kg()
     masses, positions = [], []
     for k, rec in enumerate(records):
         try:
-            masses.append(float(rec["mass"]))
+            masses.append(_mass(rec, k, isotopes, dalton))
             pos = [float(x) for x in rec["position"]]
         except (KeyError, TypeError, ValueError) as exc:
             raise InvalidParameterError(
-                f"point {k} needs a numeric 'mass' and a 3-component 'position'", index=k
+                f"point {k} needs a numeric 'mass' (or an 'element') and a 3-component 'position'", index=k
             ) from exc
         if len(pos) != 3:
             raise InvalidParameterError(f"point {k} position must have 3 components, got {len(pos)}", index=k)
@@ -35,9 +75,26 @@ def points_from_records(records: Iterable[Mapping[str, Any]], length_scale: floa
     return PointBody(np.array(masses), np.array(positions).reshape(-1, 3), length_scale)
 
 
-def read_points_file(data: bytes, fmt: str, length_scale: float = 1.0) -> PointBody:
-    """A JSON list of records (or ``{"points": [...]}``) or a CSV with columns mass,x,y,z."""
-    text = data.decode("utf-8-sig", errors="replace")
+def read_points_file(data: bytes, fmt: str, length_scale: float = 1.0, *,
+                     isotopes: str = "standard") -> PointBody:
+    """A JSON list of records (or ``{"points": [...]}``), a CSV with columns mass,x,y,z
+    (or element,x,y,z), or an XYZ file."""
+    return read_points(data, fmt, length_scale, isotopes=isotopes)[0]
+
+
+def read_points(data: bytes, fmt: str, length_scale: float = 1.0, *,
+                isotopes: str = "standard") -> tuple[PointBody, bool]:
+    """The points of a file, and whether it names elements (a molecule: XYZ always does)."""
+    records, warnings = _file_records(data.decode("utf-8-sig", errors="replace"), fmt)
+    body = points_from_records(records, length_scale, isotopes=isotopes)
+    if warnings:
+        body = replace(body, warnings=body.warnings + tuple(warnings))
+    return body, fmt == "xyz" or names_elements(records)
+
+
+def _file_records(text: str, fmt: str) -> tuple[list[Any], list[str]]:
+    if fmt == "xyz":
+        return _xyz_records(text)
     if fmt == "json":
         try:
             doc = json.loads(text)
@@ -46,10 +103,41 @@ def read_points_file(data: bytes, fmt: str, length_scale: float = 1.0) -> PointB
         records = doc.get("points") if isinstance(doc, dict) else doc
         if not isinstance(records, list):
             raise UnreadableFileError('the JSON must be a list of points or {"points": [...]}')
-        return points_from_records(records, length_scale)
+        return records, []
     rows = list(csv.DictReader(io.StringIO(text)))
-    if not rows or not {"mass", "x", "y", "z"} <= set(rows[0]):
-        raise UnreadableFileError("the CSV needs a header with columns mass,x,y,z and one row per point")
-    return points_from_records(
-        ({"mass": r["mass"], "position": [r["x"], r["y"], r["z"]]} for r in rows), length_scale
-    )
+    if not rows or not {"x", "y", "z"} <= set(rows[0]) or not {"mass", "element"} & set(rows[0]):
+        raise UnreadableFileError("the CSV needs a header with columns mass,x,y,z (or element,x,y,z) and one row per point")
+    return [{"mass": r.get("mass") or None, "element": r.get("element") or None,
+             "position": [r["x"], r["y"], r["z"]]} for r in rows], []
+
+
+def _xyz_records(text: str) -> tuple[list[Any], list[str]]:
+    """Atoms of the first frame of an XYZ file: count line, comment line, ``El x y z`` lines."""
+    from ..elements import element_symbol
+
+    lines = text.splitlines()
+    try:
+        count = int(lines[0].split()[0])
+    except (IndexError, ValueError):
+        raise UnreadableFileError("an XYZ file starts with the number of atoms on its first line") from None
+    if count < 1:
+        raise EmptyGeometryError("the XYZ file holds no atoms; send at least one")
+    atoms = lines[2:2 + count]
+    if len(atoms) < count:
+        raise UnreadableFileError(f"the XYZ file announces {count} atoms but holds {len(atoms)} atom lines")
+    records = []
+    for k, line in enumerate(atoms):
+        fields = line.split()
+        try:
+            if len(fields) < 4:
+                raise ValueError
+            position = [float(x) for x in fields[1:4]]
+        except ValueError:
+            raise UnreadableFileError(f"XYZ line {k + 3} must read 'element x y z', got {line.strip()!r}",
+                                      line=k + 3) from None
+        records.append({"element": element_symbol(fields[0]), "position": position})
+    warnings = []
+    if any(line.strip() for line in lines[2 + count:]):
+        warnings.append(f"the XYZ file goes on after its first frame of {count} atoms (a trajectory?); "
+                        "only the first frame was analysed")
+    return records, warnings

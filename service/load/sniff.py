@@ -24,7 +24,7 @@ VOLUME_FORMATS = {
 }
 # formats that can hold several named bodies
 SCENE_FORMATS = ("glb", "gltf", "3mf", "obj", "vtu", "vtk", "msh", "mesh", "inp", "xdmf", "med", "step", "iges")
-POINT_FORMATS = ("json", "csv")
+POINT_FORMATS = ("json", "csv", "xyz")  # xyz: atoms by element, in angstrom
 # B-rep solids read through OpenCASCADE (the ``cad`` extra)
 CAD_FORMATS = ("step", "iges")
 FORMATS = SURFACE_FORMATS + tuple(VOLUME_FORMATS) + CAD_FORMATS

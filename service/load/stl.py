@@ -76,7 +76,7 @@ def _welded(corners: NDArray[np.float32]) -> tuple[NDArray[np.float64], NDArray[
     """Distinct vertices (first-appearance order, widened exactly) and face indices."""
     corners += np.float32(0.0)  # -0.0 + 0.0 is +0.0, so both weld together
     bits = corners.reshape(-1, 3).view(np.uint32)
-    ids, heads = row_ids([bits[:, 0], bits[:, 1], bits[:, 2]])
+    ids, heads = row_ids(bits)
     del bits
     vertices = corners.reshape(-1, 3)[heads].astype(np.float64)
     return vertices, ids.reshape(-1, 3)

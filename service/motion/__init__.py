@@ -23,10 +23,15 @@ The numerical methods need 1/I1, which a linear rotator (I1 = 0) lacks.
 
 Modelling decisions (stated once, here):
 
-- The motion is that of the ideal top the classification reports: moments
-  equal within the classification's tolerance are replaced by their mean,
-  and the smallest moment of a linear rotator by 0 (``invariants`` module).
-  A warning says so when that changes a moment by more than rounding.
+- The motion is that of the moments given.  The classification's
+  ``tolerance`` labels the body (symmetric, spherical, linear); the closed
+  forms of those tops are used only where the moments agree to rounding
+  (``MOTION_ROUNDING`` x the largest moment, ``motion_rotor``), and then the
+  moments that agree are replaced by their mean (a change at rounding level).
+  Moments that differ by more, even if the classification calls them equal,
+  move by the exact asymmetric (Jacobi elliptic) solution: a nearly
+  symmetric top is not replaced by an ideal one whose motion departs from
+  the true one over time.
 - Linear rotator: the component of Omega along its axis carries neither
   angular momentum nor energy and moves no mass, so it is physically
   meaningless; it is dropped (with a warning when it is not negligible) and
@@ -53,7 +58,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ..classify import Classification, RotorClass
+from ..classification import Classification, RotorClass
 from ..errors import InvalidParameterError, MotionError
 from ..principal import PrincipalFrame
 from ..tolerances import DEFAULT_TOLERANCES, EPS, Tolerances
@@ -66,6 +71,8 @@ from .symmetric import SymmetricTop, uniform_rotation
 __all__ = [
     "predict_motion",
     "ideal_moments",
+    "motion_rotor",
+    "MOTION_ROUNDING",
     "FreeMotion",
     "MotionMethod",
     "Regime",
@@ -88,9 +95,10 @@ CAPABILITIES: Mapping[MotionMethod, frozenset[RotorClass]] = {
 }
 """Which rotor classes each method supports; ``predict_motion`` checks it first."""
 
-_IDEALISATION_NOISE = 64 * EPS
-"""Replacing moments by their ideal values is reported when it moves one by
-more than this times the largest moment: below, it is rounding of the input."""
+MOTION_ROUNDING = 64 * EPS
+"""Moments closer than this times the largest moment are equal to rounding: the
+closed form of a symmetric, spherical or linear top is exact for them (their
+spread is below the error of any computed moment)."""
 
 Array = NDArray[np.float64]
 
@@ -133,9 +141,10 @@ def predict_motion(
     omega = _parse_omega(angular_velocity)
     _check_scale(frame, omega)
     times = _parse_times(duration, samples)
-    if classification.rotor not in CAPABILITIES[chosen]:
+    rotor = motion_rotor(frame, classification)
+    if rotor not in CAPABILITIES[chosen]:
         raise MotionError(
-            f"method={chosen.value!r} cannot propagate a {classification.rotor.kind.replace('_', ' ')} "
+            f"method={chosen.value!r} cannot propagate a {rotor.kind.replace('_', ' ')} "
             "(it needs 1/I1 and the smallest moment is zero); use method='exact'",
             parameter="method",
         )
@@ -220,8 +229,9 @@ def _setup(frame: PrincipalFrame, classification: Classification, omega: Array, 
 def _decide(frame: PrincipalFrame, classification: Classification, omega: Array, tol: Tolerances) -> _Setup:
     axes = np.asarray(frame.axes, dtype=np.float64)
     omega_body = axes @ omega
-    moments, warnings = _ideal_moments(np.asarray(frame.moments, dtype=np.float64), classification.rotor)
-    rotor = classification.rotor
+    rotor = motion_rotor(frame, classification)
+    moments = ideal_moments(np.asarray(frame.moments, dtype=np.float64), rotor)
+    warnings: list[str] = []
     if rotor is RotorClass.LINEAR and omega_body[0] != 0.0:
         along = abs(float(omega_body[0]))
         if along > tol.permanent_rotation_rel * float(np.linalg.norm(omega_body)):
@@ -256,8 +266,9 @@ def _decide(frame: PrincipalFrame, classification: Classification, omega: Array,
 def ideal_moments(moments: ArrayLike, rotor: RotorClass) -> Array:
     """Moments of the ideal top of class ``rotor``, the ones the motion is computed with.
 
-    Moments equal within the classification's tolerance become their mean;
-    the smallest moment of a linear rotator becomes 0.
+    Moments of a pair the class makes equal become their mean; the smallest
+    moment of a linear rotator becomes 0.  ``predict_motion`` passes the class
+    of ``motion_rotor``, so this changes moments by rounding only.
     """
     given = np.asarray(moments, dtype=np.float64)
     ideal = given.copy()
@@ -272,17 +283,21 @@ def ideal_moments(moments: ArrayLike, rotor: RotorClass) -> Array:
     return ideal
 
 
-def _ideal_moments(moments: Array, rotor: RotorClass) -> tuple[Array, list[str]]:
-    """``ideal_moments``, and a warning if they moved by more than rounding."""
-    ideal = ideal_moments(moments, rotor)
-    shift = float(np.max(np.abs(ideal - moments)))
-    warnings = []
-    if shift > _IDEALISATION_NOISE * float(moments[2]):
-        warnings.append(
-            f"the motion is that of the ideal {rotor.kind.replace('_', ' ')}: principal moments equal within the "
-            f"tolerance were made equal (largest change {shift / float(moments[2]):.2g} of the largest moment)"
-        )
-    return ideal, warnings
+def motion_rotor(frame: PrincipalFrame, classification: Classification) -> RotorClass:
+    """The rotor class whose motion is computed: the classification's only where its moments agree to rounding.
+
+    The classification labels the body with its own ``tolerance``; the motion
+    uses a closed form (symmetric, spherical, linear) only for moments equal
+    within ``MOTION_ROUNDING`` (or the classification's tolerance, if smaller).
+    Otherwise the class is decided again at that level, so a nearly symmetric
+    top moves as the asymmetric top it is.
+    """
+    from ..classification import classify
+
+    level = min(MOTION_ROUNDING, classification.tolerance)
+    if classification.tolerance <= level:
+        return classification.rotor
+    return classify(frame, level).rotor
 
 
 def _principal_axis_of(omega_body: Array, rel: float) -> int | None:

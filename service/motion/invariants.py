@@ -5,10 +5,10 @@ the angular momentum M (fixed in space, Landau & Lifshitz §36).  Every method
 is judged by how well its trajectory keeps both.
 
 ``RigidProblem`` holds the *effective* moments the motion is computed with:
-moments that ``classify`` called equal within its tolerance are replaced by
-their mean, and the smallest moment of a linear rotator by 0, so that the
-predicted motion is that of the ideal top the classification reports
-(a spherical top's Omega is then exactly constant).
+moments equal to rounding (``motion.MOTION_ROUNDING``) are replaced by their
+mean, and the smallest moment of a linear rotator by 0, so that a closed form
+applies (a spherical top's Omega is then exactly constant); moments that
+differ by more are kept as given.
 """
 
 from __future__ import annotations

@@ -50,9 +50,11 @@ ONE = [{"mass": 1.0, "position": [0, 0, 0]}]
 
 # (error class, code, status, request); the default-settings client
 CASES: list[tuple[type[E.ServiceError], str, int, Callable[[Any], Any]]] = [
-    (E.UnsupportedFormatError, "unsupported_format", 415, mesh(BOX, "part.xyz")),
+    (E.UnsupportedFormatError, "unsupported_format", 415, mesh(BOX, "part.xyz123")),
     (E.UnsupportedFormatError, "unsupported_format", 415, mesh(BOX, format="dwg")),
     (E.UnreadableFileError, "unreadable_file", 422, mesh(TRUNCATED)),
+    (E.ExternalReferenceError, "external_reference", 422,
+     mesh(b"*NODE\n1, 0, 0, 0\n*INCLUDE, INPUT=/etc/passwd\n", "deck.inp")),
     (E.EmptyGeometryError, "empty_geometry", 422, mesh(b"")),
     (E.NotWatertightError, "not_watertight", 422, mesh(OPEN)),
     (E.ZeroVolumeError, "zero_volume", 422, mesh(FLAT)),
@@ -80,6 +82,7 @@ CASES: list[tuple[type[E.ServiceError], str, int, Callable[[Any], Any]]] = [
     (E.InvalidParameterError, "invalid_parameter", 422, raw("/v1/analyze/points", b'{"points": [')),
     (E.InvalidParameterError, "invalid_parameter", 422,
      raw("/v1/analyze/mesh", b"--x\r\nnot multipart", "multipart/form-data; boundary=y")),
+    (E.InvalidInertiaError, "invalid_inertia", 422, points({"points": ONE, "export": "mjcf"})),
     (E.InvalidParameterError, "invalid_parameter", 422, prec({"omega": [0, 0, 1]})),
     (E.InvalidParameterError, "invalid_parameter", 422,
      prec({"principal_moments": [1, 1, 5], "omega": [0, 0, 1]})),
@@ -108,12 +111,29 @@ def test_bad_request_gets_its_code_and_status(client, cls, code, status, request
     assert_envelope(request_(client), code, status)
 
 
+def busy(c: Any) -> Any:
+    """A request while the only compute process is busy and no job may wait."""
+    import threading
+    import time
+
+    pool = c.app.state.pool
+    slow = threading.Thread(target=mesh(torus_stl(400, 400)), args=(c,))
+    slow.start()
+    deadline = time.monotonic() + 30
+    while not (pool._slots and pool._slots[1].locked()) and time.monotonic() < deadline:
+        time.sleep(0.01)
+    response = mesh(BOX)(c)
+    slow.join()
+    return response
+
+
 LIMITED = [
     (E.PayloadTooLargeError, "payload_too_large", 413, Settings(max_upload_bytes=1000, compute_processes=1),
      mesh(box_stl(1, 2, 3) * 10)),
     (E.UnauthorizedError, "unauthorized", 401, Settings(api_key="s3cret", compute_processes=1), mesh(BOX)),
     (E.ComputeTimeoutError, "timeout", 503, Settings(timeout_s=0.05, compute_processes=1),
      mesh(torus_stl(500, 500))),
+    (E.ServerBusyError, "server_busy", 503, Settings(max_waiting=0, compute_processes=1), busy),
 ]
 
 

@@ -86,3 +86,24 @@ def by_name(rows: list[dict[str, Any]]) -> dict[str, dict[str, Any]]:
     out = {r["source"]["filename"]: without_timing(r) for r in rows}
     assert len(out) == len(rows), "duplicate names in the output"
     return out
+
+
+def crashing_task(group: list[Any], options: Any, fmt: str) -> list[tuple[Any, bool]]:
+    """The workers' task, except that a file named ``crash*`` kills its worker process (as the OOM killer would)."""
+    import os
+
+    from inertia.batch.tasks import render_sources
+
+    if any(src.name.rsplit("/", 1)[-1].startswith("crash") for src in group):
+        os._exit(9)
+    return render_sources(group, options, fmt)
+
+
+def cli_error(stderr: str) -> dict[str, str]:
+    """The error the command printed on stderr: ``error: <message> (<code>)`` (or the JSON envelope)."""
+    text = stderr.strip().splitlines()[-1]
+    if text.startswith("{"):
+        return dict(json.loads(text)["error"])
+    assert text.startswith("error: ") and text.endswith(")"), text
+    message, code = text[len("error: "):-1].rsplit(" (", 1)
+    return {"code": code, "message": message}

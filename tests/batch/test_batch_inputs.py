@@ -13,7 +13,7 @@ from pathlib import Path
 from typing import Any
 
 import pytest
-from batchlib import N_FILES, box, stl_bytes, without_timing
+from batchlib import N_FILES, box, cli_error, stl_bytes, without_timing
 
 from inertia.batch import runner, workers
 from inertia.batch.sources import Source, iter_inputs, iter_zip_bytes, list_sources, read_source
@@ -47,7 +47,7 @@ def test_the_same_file_twice_is_one_input_and_clashing_names_stay_unique(library
 def test_a_missing_path_fails_before_any_work(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     code = main(["batch", str(tmp_path / "nope"), "--out", str(tmp_path / "o.jsonl"), "--no-progress"])
     assert code == 2
-    err = json.loads(capsys.readouterr().err)["error"]
+    err = cli_error(capsys.readouterr().err)
     assert err["code"] == "invalid_parameter" and "no such file or folder" in err["message"]
 
 
@@ -55,21 +55,28 @@ def test_an_unknown_output_extension_is_invalid_parameter(library: Library, tmp_
                                                           capsys: pytest.CaptureFixture[str]) -> None:
     code = main(["batch", str(library[0]), "--out", str(tmp_path / "o.xlsx"), "--no-progress"])
     assert code == 2
-    assert ".jsonl, .csv or .parquet" in json.loads(capsys.readouterr().err)["error"]["message"]
+    assert ".jsonl, .csv or .parquet" in cli_error(capsys.readouterr().err)["message"]
 
 
-@pytest.mark.parametrize(("module", "out", "hint"), [
-    ("distributed", "o.jsonl", "pip install 'inertia-service[batch]'"),
-    ("pyarrow", "o.parquet", "pip install 'inertia-service[parquet]'"),
+@pytest.mark.parametrize(("module", "out", "more", "hint"), [
+    ("distributed", "o.jsonl", ["--scheduler", "tcp://127.0.0.1:9"], "pip install 'inertia-service[batch]'"),
+    ("pyarrow", "o.parquet", [], "pip install 'inertia-service[parquet]'"),
 ])
-def test_a_missing_extra_says_what_to_install(module: str, out: str, hint: str, library: Library, tmp_path: Path,
-                                              monkeypatch: pytest.MonkeyPatch,
+def test_a_missing_extra_says_what_to_install(module: str, out: str, more: list[str], hint: str, library: Library,
+                                              tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
                                               capsys: pytest.CaptureFixture[str]) -> None:
     monkeypatch.setitem(sys.modules, module, None)  # import raises ImportError
-    code = main(["batch", str(library[0]), "--out", str(tmp_path / out), "--no-progress"])
+    code = main(["batch", str(library[0]), "--out", str(tmp_path / out), "--no-progress", *more])
     assert code == 2
-    err = json.loads(capsys.readouterr().err)["error"]
+    err = cli_error(capsys.readouterr().err)
     assert err["code"] == "invalid_parameter" and hint in err["message"]
+
+
+def test_the_local_pool_needs_no_dask(library: Library, tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setitem(sys.modules, "distributed", None)  # import raises ImportError
+    out = tmp_path / "o.jsonl"
+    assert main(["batch", str(library[0]), "--out", str(out), "--no-progress", "--workers", "2"]) == 0
+    assert len(out.read_text().splitlines()) == N_FILES
 
 
 def test_importing_the_service_and_the_sources_imports_no_dask() -> None:
@@ -124,15 +131,43 @@ def test_an_unexpected_exception_is_an_internal_error_row(monkeypatch: pytest.Mo
     assert "ZeroDivisionError" in rows[0]["error"]["message"]
 
 
-def test_groups_hold_many_small_files_or_one_large_one() -> None:
+def test_groups_are_sized_by_bytes_largest_files_first() -> None:
     small = [Source(f"s{i}.stl", f"/s{i}", None, 1000) for i in range(1000)]
-    groups = list(runner._groups(small, threads=2))
-    assert all(len(g) == runner.TASK_FILES for g in groups[:-1])
-    assert sum(map(len, groups)) == 1000
-    few = [Source(f"s{i}.stl", f"/s{i}", None, 1000) for i in range(20)]
-    assert max(map(len, runner._groups(few, threads=2))) == 2  # enough tasks to keep both workers busy
-    large = [Source(f"l{i}.stl", f"/l{i}", None, runner.TASK_BYTES) for i in range(3)]
-    assert [len(g) for g in runner._groups(large, threads=2)] == [1, 1, 1]
+    groups = list(runner._groups(small, threads=2, min_bytes=runner.MIN_TASK_BYTES["pool"]))
+    assert sorted(s.name for g in groups for s in g) == sorted(s.name for s in small)
+    work = [sum(runner._cost(s) for s in g) for g in groups]
+    assert len(groups) >= 2 * runner.TASKS_PER_THREAD - 1  # enough tasks to keep both workers busy to the end
+    assert all(w >= runner.MIN_TASK_BYTES["pool"] for w in work[:-1])
+    # a few files, a larger minimum per task: fewer, bigger tasks
+    assert len(list(runner._groups(small, threads=2, min_bytes=runner.MIN_TASK_BYTES["dask"]))) < len(groups)
+    mixed = [Source("big.stl", "/big", None, 3 * runner.MAX_TASK_BYTES), *small[:10],
+             Source("mid.stl", "/mid", None, runner.MAX_TASK_BYTES)]
+    first, second, *rest = runner._groups(mixed, threads=2, min_bytes=runner.MIN_TASK_BYTES["pool"])
+    assert [s.name for s in first] == ["big.stl"] and [s.name for s in second] == ["mid.stl"]
+    assert [s.name for g in rest for s in g] == [s.name for s in small[:10]]  # equal sizes keep their order
+
+
+def test_rendered_rows_are_the_sinks_own_lines(library: Library, tmp_path: Path) -> None:
+    from inertia.batch.sinks import open_sink, render
+    from inertia.batch.tasks import render_sources
+
+    sources = list_sources([str(library[0])])[:6]
+    for fmt in ("jsonl", "csv", "parquet"):
+        if fmt == "parquet":
+            pytest.importorskip("pyarrow")
+        rows = analyze_sources(sources, AnalysisOptions())
+        rendered = render_sources(sources, AnalysisOptions(), fmt)
+        assert [e for _, e in rendered] == ["error" in r for r in rows]
+        a, b = tmp_path / f"a.{fmt}", tmp_path / f"b.{fmt}"
+        sink_a, sink_b = open_sink(str(a), False), open_sink(str(b), False)
+        for row, (text, _) in zip(rows, rendered, strict=True):
+            sink_a.write(row)
+            sink_b.write_rendered(text)
+        sink_a.close()
+        sink_b.close()
+        if fmt != "parquet":  # the same text, but for the elapsed times
+            assert len(a.read_text().splitlines()) == len(b.read_text().splitlines())
+        assert render(rows[0], "jsonl").endswith("\n")
 
 
 class _FailedFuture:
@@ -145,17 +180,20 @@ def test_a_task_whose_worker_died_is_split_into_single_files() -> None:
     again: list[list[Source]] = []
     assert runner._rows(_FailedFuture(), group, again.append) == []
     assert again == [[group[0]], [group[1]]]
-    (row,) = runner._rows(_FailedFuture(), [group[0]], again.append)
-    assert row["source"] == {"filename": "a.stl"} and row["error"]["code"] == "internal_error"
+    ((text, is_error),) = runner._rows(_FailedFuture(), [group[0]], again.append)
+    row = json.loads(text)
+    assert is_error and row["source"] == {"filename": "a.stl"} and row["error"]["code"] == "internal_error"
     assert "more memory" in row["error"]["message"]
 
 
 class _Collect:
+    fmt = "jsonl"
+
     def __init__(self) -> None:
         self.rows: list[dict[str, Any]] = []
 
-    def write(self, rows: list[dict[str, Any]]) -> None:
-        self.rows.extend(rows)
+    def write(self, rendered: list[tuple[str, bool]]) -> None:
+        self.rows.extend(json.loads(text) for text, _ in rendered)
 
 
 def test_head_start_analyses_small_files_until_the_cluster_is_ready(library: Library) -> None:
@@ -203,7 +241,7 @@ def test_an_interrupted_head_start_still_closes_the_cluster_it_started(library: 
         raise KeyboardInterrupt
 
     monkeypatch.setattr(runner, "local_cluster", slow_start)
-    monkeypatch.setattr(runner, "analyze_sources", interrupted)
+    monkeypatch.setattr(runner, "render_sources", interrupted)
     before = sys.getswitchinterval()
     with pytest.raises(KeyboardInterrupt):
         runner._run_local(list_sources([str(library[0])]), 2, AnalysisOptions(), _Collect())  # type: ignore[arg-type]

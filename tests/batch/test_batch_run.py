@@ -11,7 +11,7 @@ from pathlib import Path
 from typing import Any
 
 import pytest
-from batchlib import BROKEN, N_FILES, box, by_name, read_jsonl, stl_bytes, without_timing
+from batchlib import BROKEN, N_FILES, box, by_name, cli_error, read_jsonl, stl_bytes, without_timing
 
 from inertia.batch.rows import COLUMNS, FLOAT_COLUMNS, flat_row
 from inertia.cli import main
@@ -36,7 +36,7 @@ def reference(path: Path, name: str, options: AnalysisOptions = AnalysisOptions(
 
 @pytest.fixture(scope="module")
 def local_rows(library: Library, tmp_path_factory: pytest.TempPathFactory) -> Path:
-    """The library through the default engine: a local cluster of 2 worker processes."""
+    """The library through the default engine: a pool of 2 local worker processes."""
     out = tmp_path_factory.mktemp("local") / "rows.jsonl"
     assert batch(str(library[0]), "--out", str(out), "--workers", "2") == 0
     return out
@@ -44,13 +44,14 @@ def local_rows(library: Library, tmp_path_factory: pytest.TempPathFactory) -> Pa
 
 @pytest.fixture(scope="module")
 def worker_rows(library: Library, tmp_path_factory: pytest.TempPathFactory) -> Path:
-    """The same through the default engine with no head start: every file analysed on a worker."""
+    """The same through a Dask LocalCluster (``engine="dask"``) with no head start: every file on a Dask worker."""
+    pytest.importorskip("distributed")
     from inertia.batch import runner
 
     out = tmp_path_factory.mktemp("workers") / "rows.jsonl"
     with pytest.MonkeyPatch.context() as mp:
         mp.setattr(runner, "HEAD_START_BYTES", -1)
-        assert batch(str(library[0]), "--out", str(out), "--workers", "2") == 0
+        runner.run_batch([str(library[0])], str(out), workers=2, engine="dask", progress=False)
     return out
 
 
@@ -68,7 +69,7 @@ def test_every_row_equals_the_single_file_analysis(local_rows: Path, library: Li
         assert row == reference(root / name, name), name  # exact: floats survive JSON bit for bit
 
 
-def test_local_workers_give_the_rows_of_the_head_start(worker_rows: Path, local_rows: Path, library: Library) -> None:
+def test_a_dask_local_cluster_gives_the_rows_of_the_pool(worker_rows: Path, local_rows: Path, library: Library) -> None:
     rows = by_name(read_jsonl(worker_rows))
     assert set(rows) == set(library[1])
     assert rows == by_name(read_jsonl(local_rows))
@@ -232,7 +233,9 @@ def test_options_pass_through_unchanged(library: Library, cluster: Any, tmp_path
     for path, name in zip(paths, names):
         base = name.rsplit("/", 1)[-1]  # a file given by itself is named by its base name
         assert rows[base] == reference(Path(path), base, options)
-        assert "reference_inertia" in rows[base]
+    assert "reference_inertia" in rows["part_00.stl"]
+    # the other files have no part named part_00: --densities naming it is their error, as in analyze
+    assert rows["part_01.stl"]["error"]["details"]["parameter"] == "densities"
 
 
 def test_progress_bar_shows_rate_on_stderr(library: Library, cluster: Any, tmp_path: Path,
@@ -275,7 +278,7 @@ def test_tasks_in_flight_stay_within_the_window(library: Library, cluster: Any, 
 
     from inertia.batch import runner
 
-    monkeypatch.setattr(runner, "TASK_FILES", 1)  # one file per task: 50 tasks through a window of 2 x 2
+    monkeypatch.setattr(runner, "MAX_TASK_BYTES", 1)  # one file per task: 50 tasks through a window of 2 x 2
     monkeypatch.setattr(runner, "WINDOW_PER_THREAD", 2)
     with Client(cluster) as client:
         counting = _CountingClient(client)
@@ -289,4 +292,50 @@ def test_workers_and_scheduler_together_are_refused(library: Library, tmp_path: 
                                                     capsys: pytest.CaptureFixture[str]) -> None:
     code = batch(str(library[0]), "--out", str(tmp_path / "o.jsonl"), "--workers", "2", "--scheduler", "tcp://x:1")
     assert code == 2
-    assert "not both" in json.loads(capsys.readouterr().err)["error"]["message"]
+    assert "not both" in cli_error(capsys.readouterr().err)["message"]
+
+
+def test_a_file_that_kills_its_worker_is_one_error_row_and_the_rest_complete(library: Library,
+                                                                              tmp_path: Path) -> None:
+    from batchlib import crashing_task
+
+    from inertia.batch import runner
+    from inertia.batch.pool import run_pool
+    from inertia.batch.sources import list_sources
+
+    folder = tmp_path / "lib"
+    shutil.copytree(library[0], folder)
+    (folder / "crash_me.stl").write_bytes(stl_bytes(box((1.0, 1.0, 1.0), 0.0, (0.0, 0.0, 0.0))))
+    sources = list_sources([str(folder)])
+    written: list[tuple[str, bool]] = []
+    groups = runner._groups(sources, 2, 0)
+    run_pool(groups, 2, 4, AnalysisOptions(), "jsonl", written.extend, task=crashing_task)
+    rows = by_name([json.loads(text) for text, _ in written])
+    assert set(rows) == set(library[1]) | {"crash_me.stl"}  # every file once, none lost with the pool
+    assert rows["crash_me.stl"]["error"]["code"] == "internal_error"
+    errors = {name: row["error"]["code"] for name, row in rows.items() if "error" in row}
+    assert errors == {**BROKEN, "crash_me.stl": "internal_error"}
+    for name in library[1]:
+        assert rows[name] == reference(folder / name, name), name
+
+
+def test_the_pool_writes_each_task_as_it_finishes_within_the_window(library: Library, tmp_path: Path,
+                                                                     monkeypatch: pytest.MonkeyPatch) -> None:
+    from inertia.batch import pool, runner
+
+    seen: list[int] = []
+    real = pool.run_pool
+
+    def spy(groups: Any, workers: int, window: int, *args: Any, **kwargs: Any) -> None:
+        seen.extend([workers, window])
+        groups = list(groups)
+        seen.append(len(groups))
+        real(iter(groups), workers, window, *args, **kwargs)
+
+    monkeypatch.setattr(runner, "run_pool", spy)
+    monkeypatch.setattr(runner, "MAX_TASK_BYTES", 1)
+    out = tmp_path / "rows.jsonl"
+    summary = runner.run_batch([str(library[0])], str(out), workers=2, progress=False)
+    assert seen == [2, 2 * runner.WINDOW_PER_THREAD, N_FILES]  # one file per task here
+    assert summary.analysed == N_FILES and summary.errors == len(BROKEN)
+    assert len(read_jsonl(out)) == N_FILES

@@ -32,6 +32,7 @@ import pytest
 pytest.importorskip("OCP")
 
 from cadlib import box, cylinder, nurbs, open_shell, write_iges, write_step
+
 from inertia.errors import NotWatertightError, UnsupportedFormatError
 from inertia.pipeline import AnalysisOptions, analyze
 
@@ -93,6 +94,7 @@ def test_box_matches_closed_form(fmt: str) -> None:
     assert doc["source"]["format"] == fmt
     assert doc["source"]["units"] == "mm" and doc["source"]["units_from"] == "file"
     assert_close(doc["volume"], 6000 * MM**3)
+    assert_close(doc["surface_area"], 2 * (10 * 20 + 20 * 30 + 10 * 30) * MM**2)
 
 
 @pytest.mark.parametrize("fmt", ["step", "iges"])
@@ -104,6 +106,8 @@ def test_cylinder_matches_closed_form(fmt: str) -> None:
     check_body(doc, ref)
     assert_close(doc["inertia_tensor"], ref["tensor"])
     assert doc["classification"]["kind"] == "symmetric_top"
+    r, h = CYL
+    assert_close(doc["surface_area"], (2 * math.pi * r * r + 2 * math.pi * r * h) * MM**2)
 
 
 def test_error_estimate_covers_a_spline_cylinder() -> None:

@@ -9,12 +9,11 @@ import sys
 import mpmath as mp
 import numpy as np
 import pytest
-from scipy.spatial.transform import Rotation
-
-from motion_reference import body, euler_reference, quaternion_matrix
 from inertia.conventions import orient_axes
 from inertia.errors import InvalidParameterError, MotionError
 from inertia.motion import MAX_SAMPLES, MotionMethod, Regime, predict_motion
+from motion_reference import body, euler_reference, quaternion_matrix
+from scipy.spatial.transform import Rotation
 
 # principal axes as rows in the input frame, signs already by the convention's rule
 ROT = orient_axes(Rotation.from_euler("xyz", [0.4, -0.2, 1.1]).as_matrix())
@@ -75,9 +74,12 @@ def test_nearly_symmetric_gap_keeps_its_digits():
     assert motion.body_precession_rate == pytest.approx(omega_rate, rel=1e-14)
     assert motion.spin_rate == pytest.approx(spin, rel=1e-14)
     assert motion.diagnostics.energy_drift <= 1e-12 and motion.diagnostics.momentum_drift <= 1e-12
-    # at the default tolerance the same body is a spherical top, and the warning says so
-    default = _predict(moments, omega, rotation=np.eye(3))
-    assert default.regime is Regime.SPHERICAL and any("ideal spherical" in w for w in default.warnings)
+    # at the default tolerance the same body is labelled a spherical top, but it still moves as the
+    # symmetric top its moments make (issue 12: the tolerance labels, it does not change the motion)
+    default = _predict(moments, omega, rotation=np.eye(3), duration=1e5, samples=1001)
+    assert default.regime is Regime.REGULAR_PRECESSION
+    assert default.body_precession_rate == pytest.approx(omega_rate, rel=1e-14)
+    assert np.array_equal(default.trajectory.omega_body, motion.trajectory.omega_body)
 
 
 def test_spherical_top_keeps_omega_constant():
@@ -101,9 +103,12 @@ def test_linear_rotator_drops_the_axial_component():
 
 
 def test_nearly_linear_body_both_ways():
-    """I = (1e-9, 1, 1): a rotator at the default tolerance, a prolate symmetric top at 1e-12."""
-    assert _predict((1e-9, 1.0, 1.0), (0.3, 0.2, 1.0)).regime is Regime.ROTATOR
+    """I = (1e-9, 1, 1): labelled a rotator at the default tolerance, a prolate symmetric top at 1e-12;
+    both move as the prolate top the moments make (issue 12: the tolerance labels, it does not idealise)."""
     moments, omega = (1e-9, 1.0, 1.0), (0.3, 0.2, 1.0)
+    labelled = _predict(moments, omega)
+    assert labelled.regime is Regime.REGULAR_PRECESSION
+    assert labelled.body_precession_rate == pytest.approx(0.3 * (1e-9 - 1.0) / 1.0, rel=1e-15)
     motion = _predict(moments, omega, tolerance=1e-12, duration=1e5, samples=1001)
     assert motion.regime is Regime.REGULAR_PRECESSION
     assert motion.body_precession_rate == pytest.approx(0.3 * (1e-9 - 1.0) / 1.0, rel=1e-15)

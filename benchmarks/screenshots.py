@@ -1,0 +1,118 @@
+"""Screenshots of the page at ``GET /`` for the README, taken in headless Chromium.
+
+    python -m benchmarks.screenshots            # writes docs/screenshots/*.png
+
+Starts ``python -m inertia serve`` on a free loopback port, drives Debian's ``chromium`` through
+Playwright (as the end-to-end tests do) and saves three views:
+
+- ``asymmetric.png``: the L-bracket (an asymmetric top) with its principal axes and inertia ellipsoid;
+- ``tennis-racket.png``: the 1 x 2 x 3 box spun nearly about its intermediate axis, paused in the middle
+  of its first flip, with Ω(t) and the polhode running along the separatrix;
+- ``phone.png``: the same motion on a 390 x 844 screen.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import shutil
+import socket
+import subprocess
+import sys
+import time
+from pathlib import Path
+from typing import Any
+
+import httpx
+
+ROOT = Path(__file__).resolve().parents[1]
+SAMPLES = ROOT / "sample_meshes"
+OUT = ROOT / "docs" / "screenshots"
+ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
+        "--disable-background-networking", "--disable-component-update", "--disable-sync",
+        "--use-gl=angle", "--use-angle=swiftshader", "--enable-unsafe-swiftshader"]
+FLIP = {"omega": "0.01,1,0.01", "duration": "110", "samples": "1100"}
+
+
+def _serve() -> tuple[subprocess.Popen[bytes], str]:
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        port = int(s.getsockname()[1])
+    env = {k: v for k, v in os.environ.items() if not k.startswith("INERTIA_")}
+    env["INERTIA_COMPUTE_PROCESSES"] = "1"
+    process = subprocess.Popen([sys.executable, "-m", "inertia", "serve", "--host", "127.0.0.1", "--port", str(port)],
+                               cwd=ROOT, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    url = f"http://127.0.0.1:{port}"
+    for _ in range(600):
+        try:
+            if httpx.get(f"{url}/healthz", timeout=1).status_code == 200:
+                return process, url
+        except httpx.TransportError:
+            time.sleep(0.1)
+    process.kill()
+    raise SystemExit("the server did not start")
+
+
+def _analyze(page: Any, url: str, name: str, **fields: str) -> None:
+    page.goto(f"{url}/")
+    page.wait_for_selector("body[data-state=idle]")
+    page.set_input_files("#file", str(SAMPLES / name))
+    for key, value in fields.items():
+        page.fill(f"#{key}", value)
+    page.click("#analyze")
+    page.wait_for_selector("body[data-state=ready]", timeout=120_000)
+    page.evaluate("document.activeElement.blur(); window.scrollTo(0, 0)")
+
+
+def _to_first_flip(page: Any) -> None:
+    """Seek to where Ω2 first passes through zero: the middle of the first flip."""
+    page.evaluate("""() => {
+      const tr = window.inertiaPage.trajectory;
+      const i = tr.omega_body.findIndex((w) => w[1] < 0);
+      const T = tr.t[tr.t.length - 1];
+      const slider = document.getElementById('time');
+      slider.value = String(Math.round(1000 * tr.t[i] / T));
+      slider.dispatchEvent(new Event('input'));
+    }""")
+
+
+def _clip(page: Any, *selectors: str) -> dict[str, float]:
+    boxes = [page.locator(s).bounding_box() for s in selectors]
+    x0, y0 = min(b["x"] for b in boxes), min(b["y"] for b in boxes)
+    x1, y1 = max(b["x"] + b["width"] for b in boxes), max(b["y"] + b["height"] for b in boxes)
+    return {"x": x0, "y": y0, "width": x1 - x0, "height": y1 - y0}
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--chromium", default=shutil.which("chromium") or "/usr/bin/chromium")
+    parser.add_argument("--out", type=Path, default=OUT)
+    args = parser.parse_args()
+    from playwright.sync_api import sync_playwright
+
+    args.out.mkdir(parents=True, exist_ok=True)
+    process, url = _serve()
+    try:
+        with sync_playwright() as p:
+            browser = p.chromium.launch(executable_path=args.chromium, args=ARGS)
+            desktop = browser.new_page(viewport={"width": 1280, "height": 1400})
+            _analyze(desktop, url, "l_bracket.stl")
+            desktop.screenshot(path=args.out / "asymmetric.png", clip={"x": 0, "y": 0, "width": 1280, "height": 760})
+            _analyze(desktop, url, "box.stl", **FLIP)
+            _to_first_flip(desktop)
+            desktop.screenshot(path=args.out / "tennis-racket.png", clip=_clip(desktop, "#view-section", "#motion"))
+            phone = browser.new_page(viewport={"width": 390, "height": 844}, device_scale_factor=2)
+            _analyze(phone, url, "box.stl", **FLIP)
+            _to_first_flip(phone)
+            phone.evaluate("document.getElementById('view-section').scrollIntoView()")
+            phone.screenshot(path=args.out / "phone.png")
+            browser.close()
+    finally:
+        process.terminate()
+        process.wait(10)
+    for name in ("asymmetric.png", "tennis-racket.png", "phone.png"):
+        print(args.out / name)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,135 @@
+"""Atomic masses by element symbol, for molecules given as atoms.
+
+Masses come from the ``periodictable`` package (imported here only), whose
+tables are, for elements, the IUPAC abridged standard atomic weights
+(Prohaska et al., "Standard atomic weights of the elements 2021",
+Pure Appl. Chem. 94, 2022, as published by CIAAW), and for isotopes the
+AME2020 atomic masses (Wang et al., Chinese Phys. C 45, 030003, 2021) with
+the CIAAW 2021 isotopic abundances.
+
+A symbol may carry a mass number in front (``13C``, ``2H``); ``D`` is ``2H``
+and ``T`` is ``3H``.  With ``isotopes="abundant"`` a bare symbol means the
+element's most abundant isotope.  Masses are returned in unified atomic mass
+units (u, dalton); ``DALTON_KG`` converts them (CODATA, through scipy).
+"""
+
+from __future__ import annotations
+
+import re
+from functools import cache
+from typing import Any
+
+from .errors import InvalidParameterError
+
+__all__ = ["ISOTOPE_CHOICES", "atomic_mass", "dalton_kg", "element_symbol"]
+
+ISOTOPE_CHOICES = ("standard", "abundant")
+
+_SPEC = re.compile(r"^\s*(\d*)\s*([A-Za-z]{1,3})\s*$")
+_HYDROGEN_ALIASES = {"D": 2, "T": 3}  # deuterium and tritium, IUPAC-recognised symbols
+# elements with a standard atomic weight whose isotopic abundances the table lacks:
+# uranium is 99.2742 % 238U in the CIAAW 2021 representative composition
+_MOST_ABUNDANT_FALLBACK = {"U": 238}
+
+
+def dalton_kg() -> float:
+    """The unified atomic mass unit [kg] (CODATA value carried by scipy.constants)."""
+    from scipy.constants import physical_constants
+
+    return float(physical_constants["atomic mass constant"][0])
+
+
+def _table() -> Any:
+    try:
+        import periodictable
+    except ImportError as exc:  # pragma: no cover - a core dependency
+        raise InvalidParameterError(
+            "atoms by element need the 'periodictable' package; pip install periodictable", parameter="element"
+        ) from exc
+    return periodictable
+
+
+def element_symbol(spec: str | int) -> str:
+    """The element symbol of an atomic number (XYZ files may give numbers) or a symbol."""
+    if isinstance(spec, int) or (isinstance(spec, str) and spec.strip().isdigit()):
+        number = int(spec)
+        table = _table()
+        if not 1 <= number <= 118:
+            raise InvalidParameterError(f"atomic number {number} is not an element", parameter="element")
+        return str(table.elements[number].symbol)
+    return spec
+
+
+@cache
+def atomic_mass(spec: str, isotopes: str = "standard") -> float:
+    """Mass [u] of one atom named ``spec`` ("O", "13C", "D", "2H").
+
+    isotopes : "standard" (standard atomic weight of a bare symbol) or
+        "abundant" (its most abundant isotope).  A mass number always wins.
+    """
+    if isotopes not in ISOTOPE_CHOICES:
+        raise InvalidParameterError(f"isotopes must be 'standard' or 'abundant', got {isotopes!r}", parameter="isotopes")
+    match = _SPEC.match(spec) if isinstance(spec, str) else None
+    if match is None:
+        raise InvalidParameterError(f"element {spec!r} is not a symbol such as 'O', '13C' or 'D'", parameter="element")
+    number_text, symbol = match.groups()
+    mass_number = int(number_text) if number_text else None
+    if symbol in _HYDROGEN_ALIASES:
+        if mass_number is not None:
+            raise InvalidParameterError(f"element {spec!r}: {symbol} already names an isotope of hydrogen",
+                                        parameter="element")
+        mass_number, symbol = _HYDROGEN_ALIASES[symbol], "H"
+    element = _element(symbol, spec)
+    if mass_number is not None:
+        return _isotope_mass(element, mass_number, spec)
+    if isotopes == "abundant":
+        return _abundant_mass(element, spec)
+    return _standard_weight(element, spec)
+
+
+def _element(symbol: str, spec: str) -> Any:
+    table = _table()
+    # symbols are case-sensitive in chemistry ("Co" vs "CO"); accept "o" or "CL" by normalising
+    canonical = symbol[0].upper() + symbol[1:].lower()
+    element = getattr(table, canonical, None)
+    if element is None or not hasattr(element, "isotopes") or element.number == 0:
+        raise InvalidParameterError(f"element {spec!r} is not an element symbol", parameter="element")
+    return element
+
+
+def _abundances(element: Any) -> dict[int, float]:
+    return {int(a): float(element[a].abundance) for a in element.isotopes if float(element[a].abundance) > 0}
+
+
+def _standard_weight(element: Any, spec: str) -> float:
+    # an element with no stable isotope (Tc, Pm, Po, ...) has no standard atomic weight; the
+    # table then holds a representative isotope's mass, which would be a silent guess here
+    if not _abundances(element) and float(element.mass).is_integer():
+        raise InvalidParameterError(
+            f"element {spec!r} has no standard atomic weight (no stable isotope); give a mass number such as "
+            f"'{int(element.mass)}{element.symbol}' or the mass",
+            parameter="element",
+        )
+    return float(element.mass)
+
+
+def _abundant_mass(element: Any, spec: str) -> float:
+    abundances = _abundances(element)
+    if not abundances and element.symbol in _MOST_ABUNDANT_FALLBACK:
+        return float(element[_MOST_ABUNDANT_FALLBACK[element.symbol]].mass)
+    if not abundances:
+        raise InvalidParameterError(
+            f"element {spec!r} has no naturally abundant isotope; give a mass number or the mass", parameter="element"
+        )
+    mass_number = max(abundances, key=lambda a: abundances[a])
+    return float(element[mass_number].mass)
+
+
+def _isotope_mass(element: Any, mass_number: int, spec: str) -> float:
+    if mass_number not in element.isotopes:
+        known = ", ".join(str(a) for a in element.isotopes)
+        raise InvalidParameterError(
+            f"isotope {spec!r} is not in the AME2020 table; mass numbers of {element.symbol} are {known}",
+            parameter="element",
+        )
+    return float(element[mass_number].mass)

@@ -1,0 +1,184 @@
+"""Wavefront OBJ: polygon geometry and its groups, read exactly and strictly.
+
+Our own reader rather than trimesh's, because trimesh's drops what it does
+not understand without a word (a ``v`` line with two coordinates becomes a
+two-dimensional vertex array; a face index past the end raises a bare
+``IndexError``).  What is read (Wavefront's "Object Files (.obj)", Appendix
+B1 of the Advanced Visualizer manual):
+
+- ``v x y z [w]`` and the common ``v x y z r g b`` colour extension; ``w``
+  other than 1 (a rational weight, meaningful only for curves) is refused;
+- ``f`` with ``v``, ``v/vt``, ``v//vn`` or ``v/vt/vn`` references, 1-based
+  or negative (relative to the vertices read so far); polygons of more than
+  three corners are split into a fan from their first corner, as Blender and
+  trimesh do;
+- ``o`` and ``g`` name the part the following faces belong to (the pair of
+  both names, as trimesh's ``split_objects``/``split_groups``); a name used
+  twice gathers its faces in one part;
+- a trailing backslash continues a line; ``#`` starts a comment.
+Everything else (``vt``, ``vn``, ``usemtl``, ``mtllib``, ``s``, ``l``,
+``p``, curves) is skipped: it does not change the solid.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ..errors import EmptyGeometryError, UnreadableFileError
+
+__all__ = ["read_obj"]
+
+
+def _fail(line_no: int, text: str, why: str) -> UnreadableFileError:
+    shown = text if len(text) <= 60 else text[:57] + "..."
+    return UnreadableFileError(f"the OBJ file's line {line_no} ({shown!r}) {why}; fix that line or re-export the file",
+                               format="obj", line=line_no)
+
+
+def _lines(data: bytes) -> list[str]:
+    try:
+        text = data.decode("utf-8")
+    except UnicodeDecodeError:
+        text = data.decode("latin-1")  # names only; numbers are ASCII in every encoding OBJ files use
+    if "\x00" in text:
+        raise UnreadableFileError("the OBJ file holds binary data (NUL bytes), not OBJ text; check the file and "
+                                  "its extension", format="obj")
+    return text.replace("\\\r\n", " ").replace("\\\n", " ").splitlines()
+
+
+def read_obj(data: bytes) -> list[tuple[str, NDArray[np.float64], NDArray[np.int64]]]:
+    """(name, vertices, triangles) of each named group, in order of first use; vertices shared (all of them).
+
+    One pass sorts the lines by kind (and records, for each face line, its
+    group and how many vertices precede it); numbers are then converted by
+    numpy in bulk.  A line that breaks a rule is found again and named.
+    """
+    lines = _lines(data)
+    v_rows: list[list[str]] = []
+    v_line: list[int] = []
+    f_rows: list[list[str]] = []
+    f_line: list[int] = []
+    f_part: list[int] = []
+    f_seen: list[int] = []
+    names: dict[str, int] = {}
+    obj_name, group_name = "", ""
+    part = -1
+    for line_no, raw in enumerate(lines, start=1):
+        if raw[:2] in ("vt", "vn", "vp"):  # texture coordinates, normals: not geometry (skipped unsplit: fast)
+            continue
+        if "#" in raw:
+            raw = raw.split("#", 1)[0]
+        tokens = raw.split()
+        if not tokens:
+            continue
+        head = tokens[0]
+        if head == "v":
+            v_rows.append(tokens)
+            v_line.append(line_no)
+        elif head == "f":
+            if part < 0:
+                part = names.setdefault(_part_name(obj_name, group_name), len(names))
+            f_rows.append(tokens)
+            f_line.append(line_no)
+            f_part.append(part)
+            f_seen.append(len(v_rows))
+        elif head == "o":
+            obj_name, group_name, part = " ".join(tokens[1:]), "", -1
+        elif head == "g":
+            group_name, part = " ".join(tokens[1:]), -1
+    if not v_rows:
+        raise EmptyGeometryError("the OBJ file has no vertices (v lines); send a mesh with geometry", format="obj")
+    vertices = _vertices(v_rows, v_line, lines)
+    if not f_rows:
+        raise EmptyGeometryError("the OBJ file has vertices but no faces (f lines); a solid needs triangles or "
+                                 "polygons", format="obj")
+    triangles, owner = _faces(f_rows, f_line, f_part, f_seen, lines)
+    order = sorted(names, key=names.__getitem__)
+    parts = []
+    for index, name in enumerate(order):
+        tris = triangles[owner == index]
+        if len(tris):
+            parts.append((name, vertices, tris))
+    return parts
+
+
+def _vertices(rows: list[list[str]], line_nos: list[int], lines: list[str]) -> NDArray[np.float64]:
+    counts = np.fromiter((len(r) - 1 for r in rows), dtype=np.int64, count=len(rows))
+    bad = np.flatnonzero(~np.isin(counts, (3, 4, 6, 7)))
+    if len(bad):
+        i = int(bad[0])
+        raise _fail(line_nos[i], lines[line_nos[i] - 1].strip(), f"gives {counts[i]} numbers; a vertex needs x y z "
+                    "(and optionally w, or r g b)")
+    try:
+        xyz = np.array([r[1:4] for r in rows], dtype=np.float64)
+        weighted = np.flatnonzero(np.isin(counts, (4, 7)))
+        w = np.array([rows[i][4] for i in weighted], dtype=np.float64)
+    except ValueError:
+        for i, r in enumerate(rows):
+            for text in r[1:5] if counts[i] in (4, 7) else r[1:4]:
+                _number(text, line_nos[i], lines[line_nos[i] - 1].strip())
+        raise  # unreachable: some number failed above
+    if np.any(w != 1.0):
+        i = int(weighted[np.flatnonzero(w != 1.0)[0]])
+        raise _fail(line_nos[i], lines[line_nos[i] - 1].strip(), "has a weight w other than 1, which only curves use")
+    return xyz
+
+
+def _faces(rows: list[list[str]], line_nos: list[int], part: list[int], seen: list[int],
+           lines: list[str]) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
+    """Triangles (0-based, polygons split into fans from their first corner) and the part of each."""
+    corners = np.fromiter((len(r) - 1 for r in rows), dtype=np.int64, count=len(rows))
+    short = np.flatnonzero(corners < 3)
+    if len(short):
+        i = int(short[0])
+        raise _fail(line_nos[i], lines[line_nos[i] - 1].strip(), f"has {corners[i]} corners; a face needs at least 3")
+    flat = [c.split("/", 1)[0] if "/" in c else c for r in rows for c in r[1:]]
+    try:
+        refs = np.array(flat, dtype=np.int64)
+    except (ValueError, OverflowError):
+        for i, r in enumerate(rows):
+            for c in r[1:]:
+                _index(c, seen[i], line_nos[i], lines[line_nos[i] - 1].strip())
+        raise
+    face_of = np.repeat(np.arange(len(rows)), corners)
+    before = np.asarray(seen, dtype=np.int64)[face_of]
+    idx = np.where(refs > 0, refs - 1, before + refs)
+    bad = np.flatnonzero((refs == 0) | (idx < 0) | (idx >= before))
+    if len(bad):
+        i = int(face_of[bad[0]])
+        raise _fail(line_nos[i], lines[line_nos[i] - 1].strip(),
+                    f"refers to vertex {int(refs[bad[0]])}, but only {seen[i]} vertices come before it")
+    starts = np.concatenate([[0], np.cumsum(corners)[:-1]])
+    fans = corners - 2  # triangles per face
+    tri_face = np.repeat(np.arange(len(rows)), fans)
+    k = np.arange(len(tri_face)) - np.repeat(np.cumsum(fans) - fans, fans)  # fan step within its face
+    first = starts[tri_face]
+    triangles = np.stack([idx[first], idx[first + 1 + k], idx[first + 2 + k]], axis=1)
+    return triangles, np.asarray(part, dtype=np.int64)[tri_face]
+
+
+def _part_name(obj_name: str, group_name: str) -> str:
+    if obj_name and group_name and obj_name != group_name:
+        return f"{obj_name}/{group_name}"
+    return group_name or obj_name or ""
+
+
+def _number(text: str, line_no: int, line: str) -> float:
+    try:
+        return float(text)
+    except ValueError:
+        raise _fail(line_no, line, f"has {text!r}, which is not a number, where a coordinate belongs") from None
+
+
+def _index(corner: str, count: int, line_no: int, line: str) -> int:
+    ref = corner.split("/", 1)[0]
+    try:
+        k = int(ref)
+    except ValueError:
+        raise _fail(line_no, line, f"has the corner {corner!r}, whose vertex number is not an integer") from None
+    if k > 0 and k <= count:
+        return k - 1
+    if k < 0 and -k <= count:
+        return count + k
+    raise _fail(line_no, line, f"refers to vertex {k}, but only {count} vertices come before it")

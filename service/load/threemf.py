@@ -1,0 +1,613 @@
+"""3MF packages read as the 3MF Core Specification (1.3) and its Production extension say.
+
+Our own reader (zipfile + lxml) rather than trimesh's, for three reasons: the
+object ``type`` decides what is weighed (only ``model`` objects are; ``support``,
+``solidsupport``, ``surface`` and ``other`` are listed in a note and left
+out), the Production extension places objects in separate model parts
+(``p:path``), and a conforming consumer must refuse malformed packages (the 3MF
+Consortium's MUSTFAIL samples) rather than guess.
+
+What is checked, with the specification's chapter:
+
+- OPC package (ch. 2): ``[Content_Types].xml`` and ``_rels/.rels`` present;
+  exactly one 3D Model start-part relationship whose target exists; no
+  relationship to anything outside the package (``TargetMode="External"``);
+  thumbnail targets exist; at most one PrintTicket per part.
+- XML (ch. 2.3): UTF-8 or UTF-16 only; no document type declaration (DTDs
+  are forbidden, and entity expansion is never performed); no ``xml:space``;
+  every prefix declared (the parser refuses an undeclared one).
+- Model (ch. 3): root ``model`` in the core namespace; a known ``unit``;
+  ``requiredextensions`` we can honour (core, production, materials, slice);
+  exactly one ``resources`` and one ``build``; metadata with a name, no name
+  twice.
+- Resources (ch. 4, materials extension ch. 2-6): ids positive integers,
+  unique across every resource of a model part; an object's ``type`` one of
+  the five; ``pid`` names an earlier property resource and ``pindex`` (and
+  triangle ``p1..p3``) lies within it, ``pindex`` never without a ``pid``;
+  colours and texture coordinates complete; composite materials name base
+  materials; multiproperties mix at most one material and one colour group
+  and never another multiproperties.
+- Meshes (ch. 4.1): vertex indices in range and distinct per triangle; the
+  mesh of a ``model`` object closed, manifold and consistently oriented (every
+  edge in exactly two triangles, once in each direction), judged after the
+  welding and seam merge of ``seams`` (CAD exporters such as SolidWorks write
+  each seam vertex once per face; that is a closed solid, reported as merged).  An object holds a
+  mesh or components, not both; components name objects defined before them.
+- Build (ch. 3.4): items name existing objects, never of type ``other``;
+  transforms are 12 finite numbers with a non-zero determinant.  A mirroring
+  transform (negative determinant) reverses the triangles' winding so a part
+  stays wound outward.
+
+Paths are only ever looked up inside the zip: nothing on disk or the network
+is opened.
+"""
+
+from __future__ import annotations
+
+import io
+import math
+import zipfile
+from collections.abc import Iterator
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ..errors import EmptyGeometryError, InvalidParameterError, NotWatertightError, UnreadableFileError, UnsupportedFormatError
+
+__all__ = ["ThreeMF", "read_3mf", "InvalidPackageError"]
+
+CORE = "http://schemas.microsoft.com/3dmanufacturing/core/2015/02"
+PROD = "http://schemas.microsoft.com/3dmanufacturing/production/2015/06"
+MAT = "http://schemas.microsoft.com/3dmanufacturing/material/2015/02"
+SLICE = "http://schemas.microsoft.com/3dmanufacturing/slice/2015/07"
+BEAM = "http://schemas.microsoft.com/3dmanufacturing/beamlattice/2017/02"
+RELS = "http://schemas.openxmlformats.org/package/2006/relationships"
+REL_MODEL = "http://schemas.microsoft.com/3dmanufacturing/2013/01/3dmodel"
+REL_THUMBNAIL = "http://schemas.openxmlformats.org/package/2006/relationships/metadata/thumbnail"
+REL_PRINTTICKET = "http://schemas.microsoft.com/3dmanufacturing/2013/01/printticket"
+XML_NS = "http://www.w3.org/XML/1998/namespace"
+_SUPPORTED = {CORE, PROD, MAT, SLICE}
+_UNITS = {"micron": "um", "millimeter": "mm", "centimeter": "cm", "inch": "in", "foot": "ft", "meter": "m"}
+_TYPES = ("model", "support", "solidsupport", "surface", "other")
+_PROPERTY_TAGS = {f"{{{CORE}}}basematerials": "base", f"{{{MAT}}}colorgroup": "color",
+                  f"{{{MAT}}}texture2dgroup": "tex2coord", f"{{{MAT}}}compositematerials": "composite",
+                  f"{{{MAT}}}multiproperties": "multi"}
+_MAX_DEPTH = 32  # component nesting; deeper is a cycle or a hostile file
+
+
+class InvalidPackageError(UnreadableFileError):
+    """The package breaks a MUST of the 3MF specification (a Consortium MUSTFAIL case)."""
+
+
+def _invalid(what: str, rule: str) -> InvalidPackageError:
+    return InvalidPackageError(f"the 3MF file is invalid: {what} ({rule} of the 3MF specification); "
+                               "re-export it from the program that made it", format="3mf", rule=rule)
+
+
+@dataclass
+class ThreeMF:
+    """What a 3MF package holds: weighed parts (name, vertices, triangles), unit, notes."""
+
+    parts: list[tuple[str, NDArray[np.float64], NDArray[np.int64]]]
+    unit: str
+    notes: list[str] = field(default_factory=list)
+
+
+@dataclass
+class _Object:
+    id: int
+    type: str
+    name: str
+    vertices: NDArray[np.float64] | None = None
+    triangles: NDArray[np.int64] | None = None
+    components: list[tuple[str, int, NDArray[np.float64]]] = field(default_factory=list)
+
+
+@dataclass
+class _Part:
+    path: str
+    objects: dict[int, _Object]
+    unit: str
+    items: list[tuple[str, int, NDArray[np.float64], str]] = field(default_factory=list)
+
+
+def read_3mf(data: bytes) -> ThreeMF:
+    try:
+        archive = zipfile.ZipFile(io.BytesIO(data))
+        names = {"/" + n.lstrip("/").lower(): n for n in archive.namelist()}
+    except (zipfile.BadZipFile, OSError, ValueError, EOFError, NotImplementedError) as exc:
+        raise UnreadableFileError("the 3MF file is not a readable zip package (truncated or not a 3MF file); "
+                                  "check the file or re-export it", format="3mf") from exc
+    reader = _Reader(archive, names)
+    return reader.read()
+
+
+class _Reader:
+    def __init__(self, archive: zipfile.ZipFile, names: dict[str, str]) -> None:
+        self.archive = archive
+        self.names = names
+        self.parts: dict[str, _Part] = {}
+
+    # --- package ---------------------------------------------------------------------------------
+    def member(self, path: str) -> bytes | None:
+        key = "/" + path.lstrip("/").lower()
+        name = self.names.get(key)
+        if name is None:
+            return None
+        try:
+            return self.archive.read(name)
+        except (zipfile.BadZipFile, OSError, ValueError, EOFError, NotImplementedError, RuntimeError) as exc:
+            raise UnreadableFileError(f"the 3MF file's part {path!r} cannot be decompressed (a corrupt or "
+                                      "encrypted zip entry); re-export the file", format="3mf") from exc
+
+    def exists(self, path: str) -> bool:
+        return "/" + path.lstrip("/").lower() in self.names
+
+    def relationships(self, rels_path: str) -> list[dict[str, str]]:
+        raw = self.member(rels_path)
+        if raw is None:
+            return []
+        root = _parse(raw, rels_path)
+        out = []
+        for rel in root.iter(f"{{{RELS}}}Relationship"):
+            attrs = {k: (v or "") for k, v in rel.attrib.items()}
+            target = attrs.get("Target", "")
+            if attrs.get("TargetMode", "").lower() == "external" or ":" in target.split("/", 1)[0] or \
+                    target.startswith("//"):
+                raise _invalid(f"{rels_path} links to a file outside the package ({attrs.get('Target', '')[:80]!r})",
+                               "chapter 2.1")
+            out.append(attrs)
+        return out
+
+    def read(self) -> ThreeMF:
+        if not self.exists("[Content_Types].xml"):
+            raise _invalid("the package has no [Content_Types].xml", "chapter 2.1 (OPC)")
+        rels = self.relationships("_rels/.rels")
+        models = [r for r in rels if r.get("Type") == REL_MODEL]
+        if len(models) != 1:
+            raise _invalid(f"the package names {len(models)} 3D model start parts; it must name exactly one",
+                           "chapter 2.1.1")
+        root_path = _absolute(models[0].get("Target", ""), "/")
+        for rel in rels:
+            if rel.get("Type") == REL_THUMBNAIL and not self.exists(_absolute(rel.get("Target", ""), "/")):
+                raise _invalid(f"the thumbnail {rel.get('Target')!r} named by the package is missing", "chapter 2.1.3")
+        if not self.exists(root_path):
+            raise _invalid(f"the 3D model part {root_path!r} named by the package is missing", "chapter 2.1.1")
+        for key, name in self.names.items():
+            if key.endswith(".rels"):
+                tickets = [r for r in self.relationships(name) if r.get("Type") == REL_PRINTTICKET]
+                if len(tickets) > 1:
+                    raise _invalid(f"{name} names {len(tickets)} print tickets; at most one is allowed",
+                                   "chapter 2.1.4")
+        root = self.part(root_path, is_root=True)
+        return self.flatten(root)
+
+    # --- model parts ------------------------------------------------------------------------------
+    def part(self, path: str, is_root: bool = False) -> _Part:
+        key = path.lower()
+        if key in self.parts:
+            return self.parts[key]
+        raw = self.member(path)
+        if raw is None:
+            raise _invalid(f"the model part {path!r} is missing from the package", "production extension, ch. 3.1")
+        model = _parse(raw, path)
+        part = _parse_model(model, path, is_root, self)
+        self.parts[key] = part
+        return part
+
+    def object(self, path: str, object_id: int, where: str) -> _Object:
+        part = self.part(path)
+        obj = part.objects.get(object_id)
+        if obj is None:
+            raise _invalid(f"{where} names object {object_id}, which {path} does not define", "chapter 3.4.3")
+        return obj
+
+    def flatten(self, root: _Part) -> ThreeMF:
+        parts: list[tuple[str, NDArray[np.float64], NDArray[np.int64]]] = []
+        notes: list[str] = []
+        counts: dict[str, int] = {}
+        for path, object_id, transform, label in root.items:
+            obj = self.object(path, object_id, "a build item")
+            if obj.type == "other":
+                raise _invalid(f"a build item names object {object_id} of type 'other'", "chapter 3.4.3.1")
+            name = label or obj.name or f"object {object_id}"  # an item's partnumber names the placed part
+            counts[name] = counts.get(name, 0) + 1
+            if counts[name] > 1:
+                name = f"{name} #{counts[name]}"
+            if obj.type != "model":
+                notes.append(f"3MF object {name!r} is of type {obj.type!r}: listed but not weighed "
+                             "(only objects of type 'model' are the part)")
+                continue
+            pieces = list(self.meshes(path, obj, transform, 0))
+            if not pieces:
+                raise EmptyGeometryError(f"the 3MF object {name!r} holds no triangles", format="3mf")
+            verts = [v for v, _ in pieces]
+            offsets = np.cumsum([0, *[len(v) for v in verts[:-1]]])
+            parts.append((name, np.concatenate(verts), np.concatenate([f + o for (_, f), o in zip(pieces, offsets)])))
+        if not parts:
+            if notes:
+                raise EmptyGeometryError("the 3MF file's build holds no object of type 'model' (only supports or "
+                                         "other objects), so there is no part to weigh", format="3mf")
+            raise EmptyGeometryError("the 3MF file's build holds no objects; add a build item", format="3mf")
+        return ThreeMF(parts, root.unit, notes)
+
+    def meshes(self, path: str, obj: _Object, transform: NDArray[np.float64],
+               depth: int) -> Iterator[tuple[NDArray[np.float64], NDArray[np.int64]]]:
+        if depth > _MAX_DEPTH:
+            raise _invalid("components nest more than 32 deep (a cycle?)", "chapter 4.2")
+        if obj.vertices is not None and obj.triangles is not None:
+            v = obj.vertices @ transform[:3, :3].T + transform[:3, 3]
+            f = obj.triangles if np.linalg.det(transform[:3, :3]) > 0 else obj.triangles[:, [0, 2, 1]]
+            yield v, f
+        for sub_path, sub_id, sub_transform in obj.components:
+            sub = self.object(sub_path or path, sub_id, f"a component of object {obj.id}")
+            yield from self.meshes(sub_path or path, sub, transform @ sub_transform, depth + 1)
+
+
+def _absolute(target: str, base: str) -> str:
+    if target.startswith("/"):
+        return target
+    folder = base.rsplit("/", 1)[0]
+    return f"{folder}/{target}"
+
+
+def _parse(raw: bytes, path: str) -> Any:
+    from lxml import etree
+
+    head = raw[:200].lstrip(b"\xef\xbb\xbf")
+    if head.startswith((b"\x00\x00\xfe\xff", b"\xff\xfe\x00\x00")) or b'encoding="UTF-32"' in head.upper() \
+            or b"encoding='UTF-32'" in head.upper().replace(b"\x00", b""):
+        raise _invalid(f"{path} is not encoded in UTF-8 or UTF-16", "chapter 2.3")
+    parser = etree.XMLParser(resolve_entities=False, no_network=True, load_dtd=False, dtd_validation=False,
+                             huge_tree=False, remove_comments=True, remove_pis=True)
+    try:
+        tree = etree.parse(io.BytesIO(raw), parser)
+    except etree.XMLSyntaxError as exc:
+        raise _invalid(f"{path} is not well-formed XML (line {exc.lineno}: {str(exc.msg)[:100]})", "chapter 2.3") \
+            from None
+    info = tree.docinfo
+    if info.internalDTD is not None or info.externalDTD is not None or info.doctype:
+        raise _invalid(f"{path} declares a document type (DTD), which 3MF forbids", "chapter 2.3.2")
+    encoding = (info.encoding or "UTF-8").upper()
+    if encoding not in ("UTF-8", "UTF-16", "UTF8", "UTF16"):
+        raise _invalid(f"{path} is encoded in {encoding}, not UTF-8 or UTF-16", "chapter 2.3")
+    root = tree.getroot()
+    for el in root.iter():
+        if f"{{{XML_NS}}}space" in el.attrib:
+            raise _invalid(f"{path} uses xml:space, which 3MF forbids", "chapter 2.3.4")
+    return root
+
+
+def _int(el: Any, attr: str, where: str, required: bool = True) -> int | None:
+    text = el.get(attr)
+    if text is None:
+        if required:
+            raise _invalid(f"{where} lacks the required attribute {attr!r}", "chapter 4")
+        return None
+    try:
+        value = int(text)
+    except ValueError:
+        raise _invalid(f"{where} has {attr}={text[:40]!r}, which is not an integer", "chapter 4") from None
+    if value < 0:
+        raise _invalid(f"{where} has a negative {attr}", "chapter 4")
+    return value
+
+
+def _transform(text: str | None, where: str) -> NDArray[np.float64]:
+    out = np.eye(4)
+    if text is None:
+        return out
+    try:
+        values = [float(t) for t in text.split()]
+    except ValueError:
+        raise _invalid(f"{where} has a transform that is not 12 numbers", "chapter 3.3") from None
+    if len(values) != 12 or not all(math.isfinite(x) for x in values):
+        raise _invalid(f"{where} has a transform of {len(values)} values; it must be 12 finite numbers", "chapter 3.3")
+    m = np.array(values).reshape(4, 3)  # rows: the 3MF matrix is applied to row vectors, last row translation
+    out[:3, :3] = m[:3].T
+    out[:3, 3] = m[3]
+    if abs(np.linalg.det(out[:3, :3])) == 0.0:
+        raise _invalid(f"{where} has a singular transform (determinant 0), which flattens the part", "chapter 3.3")
+    return out
+
+
+def _parse_model(model: Any, path: str, is_root: bool, reader: _Reader) -> _Part:
+    if model.tag != f"{{{CORE}}}model":
+        raise _invalid(f"{path} does not hold a 3MF model element in the core namespace", "chapter 3")
+    unit_name = model.get("unit", "millimeter")
+    if unit_name not in _UNITS:
+        raise _invalid(f"the model's unit {unit_name!r} is not one of {', '.join(_UNITS)}", "chapter 3.2")
+    for prefix in (model.get("requiredextensions") or "").split():
+        ns = model.nsmap.get(prefix)
+        if ns is None:
+            raise _invalid(f"the required extension prefix {prefix!r} is not declared", "chapter 3.4")
+        if ns not in _SUPPORTED:
+            raise UnsupportedFormatError(
+                f"the 3MF file requires the extension {ns}, which this service does not implement (beam lattices, "
+                "volumetric or boolean geometry change the solid); export the part as a plain mesh",
+                format="3mf", extension=ns)
+    _check_namespaces(model, path)
+    children = list(model)
+    metadata = [c for c in children if c.tag == f"{{{CORE}}}metadata"]
+    seen: set[str] = set()
+    for m in metadata:
+        name = m.get("name")
+        if not name:
+            raise _invalid("a metadata element has no name", "chapter 3.4.1")
+        if name in seen:
+            raise _invalid(f"the metadata name {name!r} appears twice", "chapter 3.4.1")
+        seen.add(name)
+    resources = [c for c in children if c.tag == f"{{{CORE}}}resources"]
+    builds = [c for c in children if c.tag == f"{{{CORE}}}build"]
+    if len(resources) != 1:
+        raise _invalid(f"{path} has {len(resources)} resources elements; it must have exactly one", "chapter 3.4")
+    if is_root and len(builds) != 1:
+        raise _invalid(f"{path} has {len(builds)} build elements; it must have exactly one", "chapter 3.4")
+    part = _Part(path, {}, _UNITS[unit_name])
+    _parse_resources(resources[0], part, is_root)
+    if is_root:
+        for item in builds[0]:
+            if item.tag != f"{{{CORE}}}item":
+                continue
+            object_id = _int(item, "objectid", "a build item")
+            assert object_id is not None
+            item_path = item.get(f"{{{PROD}}}path")
+            target = _absolute(item_path, path) if item_path else path
+            if item_path and not reader.exists(target):
+                raise _invalid(f"a build item's p:path {item_path!r} is not a part of the package",
+                               "production extension, ch. 3.1")
+            part.items.append((target, object_id, _transform(item.get("transform"), "a build item"),
+                               item.get("partnumber") or ""))
+    return part
+
+
+_MC = "http://schemas.openxmlformats.org/markup-compatibility/2006"
+_FAMILY = "http://schemas.microsoft.com/3dmanufacturing/"
+
+
+def _check_namespaces(model: Any, path: str) -> None:
+    """Markup in an unknown 3MF-family namespace must be declared ignorable (``mc:Ignorable``) or required.
+
+    Vendor namespaces outside the 3MF family (slicers' own settings) are left
+    alone: they carry no geometry this reader would misread.
+    """
+    known = {CORE, PROD, MAT, SLICE, BEAM, XML_NS, _MC}
+    ignorable = {model.nsmap.get(p) for p in (model.get(f"{{{_MC}}}Ignorable") or "").split()}
+    required = {model.nsmap.get(p) for p in (model.get("requiredextensions") or "").split()}
+    allowed = known | ignorable | required
+
+    def unknown(name: str) -> bool:
+        if not name.startswith("{"):
+            return False
+        ns = name[1:].split("}", 1)[0]
+        return ns.startswith(_FAMILY) and ns not in allowed and not _known_extension(ns)
+
+    for el in model.iter():
+        if not isinstance(el.tag, str):
+            continue
+        bad = [el.tag] if unknown(el.tag) else [a for a in el.attrib if unknown(a)]
+        if bad:
+            raise _invalid(f"{path} uses markup of the unknown namespace {bad[0][1:].split('}')[0]!r} without "
+                           "declaring it ignorable (mc:Ignorable)", "chapter 2.3.3")
+
+
+def _known_extension(ns: str) -> bool:
+    """Published 3MF extension namespaces (their markup is understood, or refused where it matters)."""
+    return any(ns.startswith(_FAMILY + k) for k in ("material/", "production/", "slice/", "beamlattice/",
+                                                    "securecontent/", "trianglesets/", "volumetric/",
+                                                    "displacement/", "implicit/", "booleanoperations/"))
+
+
+def _parse_resources(resources: Any, part: _Part, is_root: bool) -> None:
+    ids: set[int] = set()
+    property_sizes: dict[int, tuple[str, int]] = {}
+    for res in resources:
+        if not isinstance(res.tag, str):
+            continue
+        rid = res.get("id")
+        where = f"resource {rid}" if rid else "a resource"
+        if rid is not None:
+            value = _int(res, "id", where)
+            assert value is not None
+            if value == 0:
+                raise _invalid(f"{where} has id 0; resource ids are positive", "chapter 4")
+            if value in ids:
+                raise _invalid(f"the resource id {value} is used twice", "chapter 4 (resource ids are unique)")
+            ids.add(value)
+        tag = res.tag
+        if tag in _PROPERTY_TAGS:
+            property_sizes[int(rid or 0)] = (tag, _check_property(res, tag, where, property_sizes, part, ids))
+        elif tag == f"{{{MAT}}}texture2d":
+            _check_texture(res, where)
+            property_sizes[int(rid or 0)] = (tag, 0)
+        elif tag == f"{{{CORE}}}object":
+            obj = _parse_object(res, where, property_sizes, part)
+            part.objects[obj.id] = obj
+
+
+def _check_property(res: Any, tag: str, where: str, sizes: dict[int, tuple[str, int]], part: _Part,
+                    ids: set[int]) -> int:
+    child = _PROPERTY_TAGS[tag]
+    ns = CORE if child == "base" else MAT
+    entries = [c for c in res if c.tag == f"{{{ns}}}{child}"]
+    for entry in entries:
+        if child == "base" and (not entry.get("name") or not entry.get("displaycolor")):
+            raise _invalid(f"a base material of {where} lacks its name or displaycolor", "chapter 5.1")
+        if child == "color" and not entry.get("color"):
+            raise _invalid(f"a color of {where} has no color value", "materials extension, ch. 2")
+        if child == "tex2coord" and (entry.get("u") is None or entry.get("v") is None):
+            raise _invalid(f"a texture coordinate of {where} lacks u or v", "materials extension, ch. 3")
+    if child == "tex2coord":
+        texid = _int(res, "texid", where)
+        if texid not in sizes or sizes[texid][0] != f"{{{MAT}}}texture2d":
+            raise _invalid(f"{where} names texture {texid}, which is not a texture2d defined before it",
+                           "materials extension, ch. 3")
+    if child == "composite":
+        matid = _int(res, "matid", where)
+        if matid not in sizes or sizes[matid][0] != f"{{{CORE}}}basematerials":
+            raise _invalid(f"{where} names {matid} as its base materials, which is not a basematerials group "
+                           "defined before it", "materials extension, ch. 4")
+        if res.get("matindices") is None:
+            raise _invalid(f"{where} lacks matindices", "materials extension, ch. 4")
+        for entry in entries:
+            if entry.get("values") is None:
+                raise _invalid(f"a composite of {where} lacks its values", "materials extension, ch. 4")
+    if child == "multi":
+        pids_text = res.get("pids")
+        if not pids_text:
+            raise _invalid(f"{where} lacks pids", "materials extension, ch. 5")
+        kinds: list[str] = []
+        for token in pids_text.split():
+            try:
+                pid = int(token)
+            except ValueError:
+                raise _invalid(f"{where} has a pid {token!r} that is not an integer", "materials extension, ch. 5") \
+                    from None
+            if pid not in sizes:
+                raise _invalid(f"{where} names property group {pid}, which is not defined before it",
+                               "materials extension, ch. 5")
+            kinds.append(sizes[pid][0])
+        materials = sum(k in (f"{{{CORE}}}basematerials", f"{{{MAT}}}compositematerials") for k in kinds)
+        if materials > 1 or kinds.count(f"{{{MAT}}}colorgroup") > 1 or f"{{{MAT}}}multiproperties" in kinds:
+            raise _invalid(f"{where} combines more than one material group or colour group, or another "
+                           "multiproperties", "materials extension, ch. 5")
+    return len(entries)
+
+
+def _check_texture(res: Any, where: str) -> None:
+    if not res.get("path"):
+        raise _invalid(f"the texture {where} has no path", "materials extension, ch. 6")
+    if res.get("contenttype") not in ("image/png", "image/jpeg"):
+        raise _invalid(f"the texture {where} has the content type {res.get('contenttype')!r}; it must be image/png "
+                       "or image/jpeg", "materials extension, ch. 6")
+
+
+def _check_pid(el: Any, where: str, sizes: dict[int, tuple[str, int]], pindex_attrs: tuple[str, ...]) -> int | None:
+    pid = _int(el, "pid", where, required=False)
+    if pid is None:
+        return None
+    if pid not in sizes or sizes[pid][0] == f"{{{MAT}}}texture2d":
+        raise _invalid(f"{where} names property group {pid}, which is not a property resource defined before it",
+                       "chapter 4 (pid)")
+    size = sizes[pid][1]
+    for attr in pindex_attrs:
+        index = _int(el, attr, where, required=False)
+        if index is not None and index >= size:
+            raise _invalid(f"{where} has {attr}={index}, past the {size} entries of property group {pid}",
+                           "chapter 4 (pindex)")
+    return pid
+
+
+def _parse_object(res: Any, where: str, sizes: dict[int, tuple[str, int]], part: _Part) -> _Object:
+    oid = _int(res, "id", where)
+    assert oid is not None
+    kind = res.get("type", "model")
+    if kind not in _TYPES:
+        raise _invalid(f"object {oid} has type {kind!r}; it must be one of {', '.join(_TYPES)}", "chapter 4")
+    if res.get("pindex") is not None and res.get("pid") is None:
+        raise _invalid(f"object {oid} has a pindex but no pid", "chapter 4")
+    object_pid = _check_pid(res, f"object {oid}", sizes, ("pindex",))
+    obj = _Object(oid, kind, res.get("name") or "")
+    meshes = [c for c in res if c.tag == f"{{{CORE}}}mesh"]
+    comps = [c for c in res if c.tag == f"{{{CORE}}}components"]
+    if len(meshes) + len(comps) != 1:
+        raise _invalid(f"object {oid} must hold exactly one mesh or one components element", "chapter 4")
+    if meshes:
+        mesh = meshes[0]
+        if any(c.tag.startswith(f"{{{BEAM}}}") for c in mesh if isinstance(c.tag, str)):
+            raise UnsupportedFormatError(f"object {oid} of the 3MF file carries a beam lattice, whose beams this "
+                                         "service does not integrate; export the part as a plain mesh", format="3mf")
+        if res.get(f"{{{SLICE}}}meshresolution") == "lowres":
+            raise UnsupportedFormatError(f"object {oid} of the 3MF file holds only a low-resolution preview mesh "
+                                         "(its slices are the part); export the full-resolution mesh", format="3mf")
+        obj.vertices, obj.triangles = _parse_mesh(mesh, oid, object_pid, sizes)
+        if kind == "model":
+            _check_closed(obj)
+    else:
+        for comp in comps[0]:
+            if comp.tag != f"{{{CORE}}}component":
+                continue
+            cid = _int(comp, "objectid", f"a component of object {oid}")
+            assert cid is not None
+            comp_path = comp.get(f"{{{PROD}}}path")
+            if not comp_path and cid not in part.objects:
+                raise _invalid(f"a component of object {oid} names object {cid}, which is not defined before it",
+                               "chapter 4.2")
+            obj.components.append((_absolute(comp_path, part.path) if comp_path else "", cid,
+                                   _transform(comp.get("transform"), f"a component of object {oid}")))
+    return obj
+
+
+def _parse_mesh(mesh: Any, oid: int, object_pid: int | None,
+                sizes: dict[int, tuple[str, int]]) -> tuple[NDArray[np.float64], NDArray[np.int64]]:
+    vertices_el = mesh.find(f"{{{CORE}}}vertices")
+    triangles_el = mesh.find(f"{{{CORE}}}triangles")
+    if vertices_el is None or triangles_el is None:
+        raise _invalid(f"the mesh of object {oid} lacks its vertices or triangles", "chapter 4.1")
+    try:
+        coords = [(v.attrib["x"], v.attrib["y"], v.attrib["z"]) for v in vertices_el
+                  if v.tag == f"{{{CORE}}}vertex"]
+        vertices = np.array(coords, dtype=np.float64).reshape(-1, 3)
+    except (KeyError, ValueError):
+        raise _invalid(f"a vertex of object {oid} lacks a coordinate or has one that is not a number",
+                       "chapter 4.1.1") from None
+    if not np.all(np.isfinite(vertices)):
+        raise InvalidParameterError(f"a vertex of 3MF object {oid} has a coordinate that is not finite (NaN or "
+                                    "infinity); fix the file", field="vertex coordinates")
+    tris = [t for t in triangles_el if t.tag == f"{{{CORE}}}triangle"]
+    try:
+        triangles = np.array([(t.attrib["v1"], t.attrib["v2"], t.attrib["v3"]) for t in tris], dtype=np.int64)
+    except (KeyError, ValueError, OverflowError):
+        raise _invalid(f"a triangle of object {oid} lacks a vertex index or has one that is not an integer",
+                       "chapter 4.1.2") from None
+    triangles = triangles.reshape(-1, 3)
+    if len(triangles) and (triangles.min() < 0 or triangles.max() >= len(vertices)):
+        raise _invalid(f"a triangle of object {oid} names a vertex that does not exist", "chapter 4.1.2")
+    if np.any((triangles[:, 0] == triangles[:, 1]) | (triangles[:, 1] == triangles[:, 2])
+              | (triangles[:, 0] == triangles[:, 2])):
+        raise _invalid(f"a triangle of object {oid} uses one vertex twice", "chapter 4.1.2")
+    for t in tris:
+        if any(t.get(a) is not None for a in ("p1", "p2", "p3")):
+            if t.get("pid") is None and object_pid is None:
+                raise _invalid(f"a triangle of object {oid} has property indices but no pid", "chapter 4.1.2")
+            pid = _check_pid(t, f"a triangle of object {oid}", sizes, ("p1", "p2", "p3")) if t.get("pid") else None
+            if pid is None and object_pid is not None:
+                size = sizes[object_pid][1]
+                for a in ("p1", "p2", "p3"):
+                    index = _int(t, a, f"a triangle of object {oid}", required=False)
+                    if index is not None and index >= size:
+                        raise _invalid(f"a triangle of object {oid} has {a}={index}, past the {size} entries of "
+                                       f"property group {object_pid}", "chapter 4.1.2")
+        elif t.get("pid") is not None:
+            _check_pid(t, f"a triangle of object {oid}", sizes, ())
+    return vertices, triangles
+
+
+def _check_closed(obj: _Object) -> None:
+    """A model object's mesh: every edge in exactly two triangles, traversed once each way (ch. 4.1)."""
+    from ..topology import surface_topology
+
+    assert obj.triangles is not None and obj.vertices is not None
+    if len(obj.triangles) == 0:
+        raise EmptyGeometryError(f"the 3MF object {obj.name or obj.id!r} of type model has no triangles",
+                                 format="3mf")
+    topo = surface_topology(obj.triangles, len(obj.vertices))
+    if topo.open_edges or topo.unbalanced_edges:
+        # a CAD exporter may write a seam's vertex twice (equal, or a rounding apart): judged after the same
+        # welding and seam merge the solid stage applies (and reports), not refused for it
+        from ..seams import merge_seams
+        from ..topology import weld
+
+        v, f = weld(obj.vertices, obj.triangles)
+        f = f[(f[:, 0] != f[:, 1]) & (f[:, 1] != f[:, 2]) & (f[:, 0] != f[:, 2])]
+        topo = surface_topology(merge_seams(v, f).faces, len(v))
+    if topo.open_edges or topo.nonmanifold_edges or topo.unbalanced_edges:
+        label = obj.name or f"object {obj.id}"
+        raise NotWatertightError(
+            f"the 3MF object {label!r} is of type model but its mesh is not a closed, consistently oriented "
+            f"manifold ({topo.open_edges} open, {topo.nonmanifold_edges} non-manifold, {topo.unbalanced_edges} "
+            "inconsistently wound edges), as the 3MF core specification requires (chapter 4.1); repair it in the "
+            "program that made it", open_edges=topo.open_edges, nonmanifold_edges=topo.nonmanifold_edges,
+            unbalanced_edges=topo.unbalanced_edges, part=label)

@@ -1,0 +1,454 @@
+"""Volume meshes: VTK files through VTK's own readers, the other formats through meshio.
+
+Decision (measured with meshio 5.3.5 and VTK 9.7 on files written by VTK's own
+writers, see ``tests/load/test_volume_readers.py``): meshio reads VTK's XML
+files with raw, base64, zlib and lzma data, but
+
+- raises ``AssertionError`` on lz4-compressed XML data,
+- drops voxel cells (VTK type 11) without a word, so a voxel file came back
+  as "no 3-D cells",
+- raises ``KeyError`` on quadratic wedges and pyramids (types 26, 27) in both
+  legacy and XML files (its table of cell dimensions lacks them; for the
+  other formats we add the two entries, see ``_MESHIO_MISSING_DIMENSIONS``),
+- refuses (or, with other counts, misreads) a legacy file whose cell lists
+  hold more node ids than the cell type uses, which VTK reads with the
+  first ids of each list,
+
+so ``.vtk`` and ``.vtu`` files are read by VTK's readers (``vtkDataSetReader``,
+``vtkXMLUnstructuredGridReader``): the body is then the one VTK and ParaView
+show.  VTK is the optional extra ``vtk``; without it these two formats are
+refused (415 ``unsupported_format``) with a message naming the extra, rather
+than read by a reader that can get them wrong.  Other formats (Gmsh, Abaqus,
+Medit, TetGen, ...) go through meshio, which converts their node orders to
+VTK's.
+
+Every reader call is fenced: anything it raises (``SystemExit`` from meshio's
+``sys.exit(1)`` included; never ``KeyboardInterrupt``) becomes an
+``UnreadableFileError`` whose message names the file (never a temporary
+path) and what to do, and whatever the library prints is captured, not
+written to our stdout or stderr.
+
+Cells: linear tetrahedra stay a closed-form kernel (``VolumeBody.tets``);
+every other 3-D cell becomes a ``CellBlock`` integrated as its element
+(``cells``), voxels reordered to hexahedra.  A 3-D cell type we cannot
+integrate refuses the file (it is never dropped).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import io
+import os
+import re
+import tempfile
+import threading
+import warnings
+from collections.abc import Iterator, Mapping
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ..body import CellBlock, Part, VolumeBody
+from ..cells import CELL_NODES, VOXEL_TO_HEXAHEDRON
+from ..errors import EmptyGeometryError, UnreadableFileError, UnsupportedFormatError
+from .sniff import VOLUME_FORMATS
+
+__all__ = ["read_volume_parts", "VTK_FORMATS", "VTK_CELL_TYPES"]
+
+VTK_FORMATS = ("vtk", "vtu")
+
+# VTK cell type id -> our (meshio's) name; voxels become hexahedra
+VTK_CELL_TYPES = {
+    10: "tetra", 11: "voxel", 12: "hexahedron", 13: "wedge", 14: "pyramid",
+    24: "tetra10", 25: "hexahedron20", 26: "wedge15", 27: "pyramid13", 29: "hexahedron27", 32: "wedge18",
+}
+# 3-D VTK cells we cannot integrate (refused, never dropped)
+_VTK_OTHER_3D = {
+    15: "pentagonal prism", 16: "hexagonal prism", 33: "24-node hexahedron", 37: "19-node pyramid",
+    42: "polyhedron", 71: "Lagrange tetrahedron", 72: "Lagrange hexahedron", 73: "Lagrange wedge",
+    74: "Lagrange pyramid", 78: "Bezier tetrahedron", 79: "Bezier hexahedron", 80: "Bezier wedge",
+    81: "Bezier pyramid",
+}
+_NODES = {**CELL_NODES, "tetra": 4, "voxel": 8}
+_ALIASES = {"tetra4": "tetra", "hexahedron8": "hexahedron", "wedge6": "wedge", "pyramid5": "pyramid"}
+# meshio names of 3-D cells we cannot integrate
+_MESHIO_OTHER_3D = ("pyramid14", "hexahedron24", "wedge12", "penta_prism", "hexa_prism", "polyhedron",
+                    "tetra20", "tetra35", "tetra56", "hexahedron64", "hexahedron125", "wedge40", "wedge75",
+                    "pyramid30", "pyramid55", "VTK_LAGRANGE_TETRAHEDRON", "VTK_LAGRANGE_HEXAHEDRON",
+                    "VTK_LAGRANGE_WEDGE", "VTK_LAGRANGE_PYRAMID", "VTK_BEZIER_TETRAHEDRON",
+                    "VTK_BEZIER_HEXAHEDRON", "VTK_BEZIER_WEDGE", "VTK_BEZIER_PYRAMID")
+_FORMAT_NAMES = {"vtk": "legacy VTK", "vtu": "VTK XML (.vtu)", "msh": "Gmsh", "mesh": "Medit", "inp": "Abaqus",
+                 "xdmf": "XDMF", "med": "MED", "f3grid": "FLAC3D", "dat": "Tecplot", "ugrid": "UGRID",
+                 "ele": "TetGen"}
+
+
+@dataclass
+class _Block:
+    """Consecutive cells of one 3-D type: name, (k, n) nodes, and their indices in the file's cell list."""
+
+    type: str
+    nodes: NDArray[np.int64]
+    cell_ids: NDArray[np.int64]
+    name: str
+
+
+@dataclass
+class _Mesh:
+    points: NDArray[np.float64]
+    blocks: list[_Block]
+    density: NDArray[np.float64] | None  # one value per cell of the file (all cells, in file order)
+    other: dict[str, int]  # cells that are not 3-D: type -> count (ignored, reported if nothing else)
+    warnings: list[str] = field(default_factory=list)
+
+
+def read_volume_parts(data: bytes, fmt: str, length_scale: float, *, filename: str | None = None,
+                      companions: Mapping[str, bytes] | None = None) -> list[Part]:
+    """Parts of a volume mesh: one per block of 3-D cells.
+
+    companions : other files of the same upload by name (a TetGen ``.node``
+        beside its ``.ele``, an XDMF's HDF5 file), written beside it for the reader.
+    """
+    label = _label(filename, fmt)
+    mesh = _read_vtk(data, fmt, label) if fmt in VTK_FORMATS else _read_meshio(data, fmt, label, filename, companions)
+    return _parts(mesh, label, length_scale)
+
+
+def _label(filename: str | None, fmt: str) -> str:
+    kind = _FORMAT_NAMES.get(fmt, fmt.upper())
+    return f"the {kind} file {os.path.basename(filename)!r}" if filename else f"the {kind} file"
+
+
+# ----------------------------------------------------------------------------------------------
+# Fences around third-party readers
+
+
+@contextlib.contextmanager
+def _quiet() -> Iterator[io.StringIO]:
+    """Capture what a library prints to Python's stdout/stderr and its warnings."""
+    sink = io.StringIO()
+    with contextlib.redirect_stdout(sink), contextlib.redirect_stderr(sink), warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        yield sink
+
+
+@contextlib.contextmanager
+def _upload_dir(data: bytes, fmt: str, filename: str | None,
+                companions: Mapping[str, bytes] | None) -> Iterator[str]:
+    """A private folder holding the upload (and its companion files); yields the main file's path."""
+    stem = _safe_stem(filename)
+    with tempfile.TemporaryDirectory() as tmp:
+        path = os.path.join(tmp, f"{stem}.{fmt}")
+        for name, content in (companions or {}).items():
+            safe = _safe_name(name)
+            if safe and safe != os.path.basename(path):
+                with open(os.path.join(tmp, safe), "wb") as fh:
+                    fh.write(content)
+        with open(path, "wb") as fh:
+            fh.write(data)
+        yield path
+
+
+def _safe_stem(filename: str | None) -> str:
+    base = os.path.basename(filename or "upload")
+    stem = base.rsplit(".", 1)[0] if "." in base else base
+    return re.sub(r"[^A-Za-z0-9_.-]", "_", stem).lstrip(".") or "upload"
+
+
+def _safe_name(name: str) -> str:
+    """A companion's base name, free of folders and odd characters (nothing is written outside the folder)."""
+    base = os.path.basename(name.replace("\\", "/"))
+    return re.sub(r"[^A-Za-z0-9_.-]", "_", base).lstrip(".")
+
+
+def _reason(exc: BaseException, printed: str, tmp_paths: tuple[str, ...]) -> str:
+    """One line saying what the library objected to, without our temporary paths."""
+    text = str(exc).strip() if not isinstance(exc, SystemExit) else ""
+    if not text:
+        text = next((ln.strip() for ln in printed.splitlines() if ln.strip()), "") or type(exc).__name__
+    text = text.splitlines()[0]
+    for p in tmp_paths:
+        text = text.replace(p, "the file")
+    text = re.sub(r"/\S*/(tmp|Temp)\S*", "the file", text)
+    text = re.sub(r"\x1b\[[0-9;]*m|\[/?[a-z ]+\]", "", text)  # terminal colours and rich markup
+    return text[:200]
+
+
+# ----------------------------------------------------------------------------------------------
+# VTK files through VTK
+
+
+_VTK_LOCK = threading.Lock()
+
+
+def _vtk_missing(label: str, fmt: str) -> UnsupportedFormatError:
+    return UnsupportedFormatError(
+        f"reading {label} needs VTK's own reader, the optional extra 'vtk': "
+        "install it with pip install 'inertia-service[vtk]', or convert the mesh to Gmsh (.msh)",
+        format=fmt, extra="vtk",
+    )
+
+
+def _read_vtk(data: bytes, fmt: str, label: str) -> _Mesh:
+    try:
+        from vtkmodules.util.numpy_support import vtk_to_numpy
+        from vtkmodules.vtkCommonCore import vtkLogger, vtkOutputWindow, vtkStringOutputWindow
+        from vtkmodules.vtkFiltersCore import vtkAppendFilter
+        from vtkmodules.vtkIOLegacy import vtkDataSetReader
+        from vtkmodules.vtkIOXML import vtkXMLUnstructuredGridReader
+    except ImportError as exc:
+        raise _vtk_missing(label, fmt) from exc
+
+    window = vtkStringOutputWindow()
+    with _VTK_LOCK, _upload_dir(data, fmt, None, None) as path:  # the output window is process-wide
+        previous = vtkOutputWindow.GetInstance()
+        try:
+            vtkOutputWindow.SetInstance(window)
+            # VTK's logger writes errors to stderr beside the output window; it stays off for the process
+            vtkLogger.SetStderrVerbosity(vtkLogger.VERBOSITY_OFF)
+            with _quiet():
+                reader: Any = vtkXMLUnstructuredGridReader() if fmt == "vtu" else vtkDataSetReader()
+                reader.SetFileName(path)
+                if fmt == "vtk":
+                    reader.ReadAllScalarsOn()
+                reader.Update()
+                grid = reader.GetOutput()
+                if grid is not None and grid.GetClassName() != "vtkUnstructuredGrid":
+                    merge = vtkAppendFilter()  # image data (voxels), structured grids (hexahedra), polydata
+                    merge.SetInputData(grid)
+                    merge.Update()
+                    grid = merge.GetOutput()
+        except KeyboardInterrupt:
+            raise
+        except BaseException as exc:  # VTK's wrappers raise whatever the C++ side threw
+            raise UnreadableFileError(f"could not read {label}: {_reason(exc, _text(window.GetOutput()), (path,))}; "
+                                      "check that it is a complete VTK file", format=fmt) from exc
+        finally:
+            vtkOutputWindow.SetInstance(previous)
+        log = _vtk_errors(_text(window.GetOutput()), path)
+    if grid is None or (log and grid.GetNumberOfCells() == 0):
+        raise UnreadableFileError(f"could not read {label}: {log or 'VTK found no data set in it'}; "
+                                  "check that it is a complete, uncorrupted VTK file", format=fmt)
+    if log:
+        raise UnreadableFileError(f"{label} is damaged: VTK reported '{log}'; re-export it", format=fmt)
+    return _mesh_from_grid(grid, vtk_to_numpy, label)
+
+
+def _text(output: str | bytes) -> str:
+    """VTK's log as text (the wrapper hands back bytes when the file's own bytes are in it)."""
+    return output.decode("utf-8", "replace") if isinstance(output, bytes) else output
+
+
+def _vtk_errors(text: str, path: str) -> str:
+    """The first error VTK logged, as one line without the object address or our path."""
+    for chunk in text.split("ERROR:")[1:]:
+        lines = [ln.strip() for ln in chunk.splitlines()[1:] if ln.strip()]
+        if lines:
+            msg = re.sub(r"^\w+ \(0x[0-9a-f]+\): ", "", lines[0]).replace(path, "the file")
+            return re.sub(r"/\S*/(tmp|Temp)\S*", "the file", msg)[:200]
+    return ""
+
+
+def _mesh_from_grid(grid: Any, to_numpy: Any, label: str) -> _Mesh:
+    n_cells = grid.GetNumberOfCells()
+    if grid.GetPoints() is None or n_cells == 0:
+        raise EmptyGeometryError(f"{label} holds no cells; send a mesh with 3-D cells (tetrahedra, hexahedra, ...)")
+    points = np.asarray(to_numpy(grid.GetPoints().GetData()), dtype=np.float64).reshape(-1, 3)
+    cells = grid.GetCells()
+    offsets = np.asarray(to_numpy(cells.GetOffsetsArray()), dtype=np.int64)
+    conn = np.asarray(to_numpy(cells.GetConnectivityArray()), dtype=np.int64)
+    # GetCellTypes returns the per-cell array from VTK 9.6 on (GetCellTypesArray before)
+    type_array = grid.GetCellTypes() if grid.GetCellTypes().GetClassName() == "vtkUnsignedCharArray" else None
+    types = np.asarray(to_numpy(type_array if type_array is not None else grid.GetCellTypesArray()), dtype=np.int64)
+    density = _vtk_density(grid, to_numpy, n_cells, label)
+    mesh = _Mesh(points, [], density, {})
+    unsupported = {_VTK_OTHER_3D[t]: int(np.count_nonzero(types == t)) for t in _VTK_OTHER_3D if np.any(types == t)}
+    if unsupported:
+        raise UnsupportedFormatError(_unsupported_cells(label, unsupported), cell_types=sorted(unsupported))
+    for t in np.unique(types):
+        if int(t) not in VTK_CELL_TYPES:
+            mesh.other[_VTK_2D_NAMES.get(int(t), f"VTK cell type {int(t)}")] = int(np.count_nonzero(types == t))
+    runs = np.flatnonzero(np.diff(types)) + 1
+    for start, stop in zip(np.r_[0, runs], np.r_[runs, len(types)]):
+        vtk_type = int(types[start])
+        if vtk_type not in VTK_CELL_TYPES:
+            continue
+        name = VTK_CELL_TYPES[vtk_type]
+        ids = np.arange(start, stop)
+        nodes = _fixed_width(conn, offsets, ids, _NODES[name], name, label, mesh.warnings)
+        if name == "voxel":
+            nodes, name = nodes[:, VOXEL_TO_HEXAHEDRON], "hexahedron"
+        mesh.blocks.append(_Block(name, nodes, ids, f"{VTK_CELL_TYPES[vtk_type]}_{len(mesh.blocks)}"))
+    return mesh
+
+
+_VTK_2D_NAMES = {1: "vertex", 2: "polyvertex", 3: "line", 4: "polyline", 5: "triangle", 6: "triangle strip",
+                 7: "polygon", 8: "pixel", 9: "quad", 21: "quadratic edge", 22: "quadratic triangle",
+                 23: "quadratic quad", 28: "biquadratic quad"}
+
+
+def _fixed_width(conn: NDArray[np.int64], offsets: NDArray[np.int64], ids: NDArray[np.int64], width: int,
+                 name: str, label: str, notes: list[str]) -> NDArray[np.int64]:
+    """The first ``width`` node ids of each cell, as VTK's cells use them; refuse too-short lists."""
+    counts = offsets[ids + 1] - offsets[ids]
+    if np.any(counts < width):
+        bad = int(ids[np.argmax(counts < width)])
+        raise UnreadableFileError(
+            f"{label} is inconsistent: cell {bad} is a {name} but lists {int(counts[np.argmax(counts < width)])} "
+            f"node ids where {width} are needed; fix the cell's type or its node list",
+        )
+    longer = int(np.count_nonzero(counts > width))
+    if longer:
+        notes.append(f"{longer} {name} cells list more node ids than a {name} has ({int(counts.max())} for {width}); "
+                     f"their first {width} were used, as VTK reads them: if the cells are meant to be quadratic, "
+                     "write them with the quadratic cell type")
+    nodes: NDArray[np.int64] = conn[offsets[ids][:, None] + np.arange(width)[None, :]]
+    return nodes
+
+
+def _vtk_density(grid: Any, to_numpy: Any, n_cells: int, label: str) -> NDArray[np.float64] | None:
+    array = grid.GetCellData().GetArray("density")
+    if array is None:
+        return None
+    values = np.asarray(to_numpy(array), dtype=np.float64)
+    if values.shape != (n_cells,):
+        raise UnreadableFileError(f"{label} has a 'density' cell array of shape {values.shape}; "
+                                  f"it needs one value per cell ({n_cells})", field="density")
+    return values
+
+
+# ----------------------------------------------------------------------------------------------
+# Other formats through meshio
+
+
+# meshio 5.3.5's table of cell dimensions lacks these 3-D types, so reading them raised KeyError in
+# every format (its readers and node orders know them); the entries are added, never changed
+_MESHIO_MISSING_DIMENSIONS = {"wedge15": 3, "pyramid13": 3, "hexahedron24": 3}
+
+
+def _read_meshio(data: bytes, fmt: str, label: str, filename: str | None,
+                 companions: Mapping[str, bytes] | None) -> _Mesh:
+    import meshio
+    from meshio import _mesh
+
+    table = getattr(_mesh, "topological_dimension", None)
+    if isinstance(table, dict):
+        for key, dim in _MESHIO_MISSING_DIMENSIONS.items():
+            table.setdefault(key, dim)
+
+    with _upload_dir(data, fmt, filename, companions) as path, _quiet() as printed:
+        try:
+            mesh = meshio.read(path, file_format=VOLUME_FORMATS[fmt])
+        except KeyboardInterrupt:
+            raise
+        except BaseException as exc:  # meshio calls sys.exit(1) and raises KeyError, ValueError, ...
+            raise UnreadableFileError(_meshio_failure(exc, printed.getvalue(), path, fmt, label, companions),
+                                      format=fmt) from exc
+    return _mesh_from_meshio(mesh, label)
+
+
+def _meshio_failure(exc: BaseException, printed: str, path: str, fmt: str, label: str,
+                    companions: Mapping[str, bytes] | None) -> str:
+    reason = _reason(exc, printed, (path, os.path.dirname(path)))
+    if fmt == "ele" and isinstance(exc, (FileNotFoundError, OSError)) and not companions:
+        return (f"{label} needs its companion .node file (the point coordinates): upload both, "
+                "as a .zip or as two files")
+    if isinstance(exc, (FileNotFoundError, OSError)) and ".node" in str(exc):
+        return f"{label} refers to a companion file that was not uploaded ({reason}); upload it with the mesh"
+    return f"could not read {label}: {reason}; check that the file is complete and of the format its name says"
+
+
+def _mesh_from_meshio(mesh: Any, label: str) -> _Mesh:
+    try:
+        points = np.asarray(mesh.points, dtype=np.float64)
+    except (TypeError, ValueError) as exc:
+        raise UnreadableFileError(f"{label} has point coordinates that are not numbers") from exc
+    if points.ndim != 2 or points.shape[1] not in (2, 3) or len(points) == 0:
+        raise EmptyGeometryError(f"{label} holds no points; send a mesh with 3-D cells")
+    if points.shape[1] == 2:
+        raise EmptyGeometryError(f"{label} is two-dimensional; a volume needs 3-D cells (tetrahedra, hexahedra, ...)")
+    densities = mesh.cell_data.get("density")
+    names = _block_names(mesh)
+    out = _Mesh(points, [], None, {})
+    unsupported: dict[str, int] = {}
+    per_cell: list[NDArray[np.float64]] = []
+    start = 0
+    for i, block in enumerate(mesh.cells):
+        ctype = _ALIASES.get(block.type, block.type)
+        nodes = np.asarray(block.data, dtype=np.int64)
+        ids = np.arange(start, start + len(nodes))
+        start += len(nodes)
+        if densities is not None:
+            per_cell.append(np.asarray(densities[i], dtype=np.float64).reshape(-1))
+        if ctype in _MESHIO_OTHER_3D:
+            unsupported[ctype] = unsupported.get(ctype, 0) + len(nodes)
+        elif ctype not in _NODES:
+            out.other[ctype] = out.other.get(ctype, 0) + len(nodes)
+        elif len(nodes):
+            if nodes.ndim != 2 or nodes.shape[1] != _NODES[ctype]:
+                raise UnreadableFileError(f"{label} has {ctype} cells with {nodes.shape[-1]} nodes each; "
+                                          f"a {ctype} has {_NODES[ctype]}: the file is inconsistent")
+            if ctype == "voxel":
+                nodes, ctype = nodes[:, VOXEL_TO_HEXAHEDRON], "hexahedron"
+            out.blocks.append(_Block(ctype, nodes, ids, names[i]))
+    if unsupported:
+        raise UnsupportedFormatError(_unsupported_cells(label, unsupported), cell_types=sorted(unsupported))
+    if densities is not None:
+        values = np.concatenate(per_cell) if per_cell else np.empty(0)
+        if len(values) != start:
+            raise UnreadableFileError(f"{label} has a 'density' cell array that does not give one value per cell",
+                                      field="density")
+        out.density = values
+    return out
+
+
+def _block_names(mesh: Any) -> list[str]:
+    tags = mesh.cell_data.get("gmsh:physical")
+    by_tag = {int(v[0]): k for k, v in (mesh.field_data or {}).items() if np.size(v)}
+    names = []
+    for i, block in enumerate(mesh.cells):
+        name = f"{block.type}_{i}"
+        if tags is not None and len(tags[i]) and np.all(tags[i] == tags[i][0]):
+            name = by_tag.get(int(tags[i][0]), name)
+        names.append(name)
+    return names
+
+
+# ----------------------------------------------------------------------------------------------
+# Parts
+
+
+def _unsupported_cells(label: str, counts: Mapping[str, int]) -> str:
+    listed = ", ".join(f"{n} {t}" for t, n in sorted(counts.items()))
+    return (f"{label} holds 3-D cells we cannot integrate exactly ({listed}); convert them to tetrahedra, "
+            "hexahedra, wedges or pyramids (linear or quadratic), for example with Gmsh")
+
+
+def _parts(mesh: _Mesh, label: str, length_scale: float) -> list[Part]:
+    if not mesh.blocks:
+        found = ", ".join(f"{n} {t}" for t, n in sorted(mesh.other.items())) or "no cells at all"
+        raise EmptyGeometryError(
+            f"{label} has no 3-D cells (it holds {found}); send tetrahedra, hexahedra, wedges or pyramids, "
+            "or a closed surface mesh in a surface format (STL, OBJ, PLY, ...)"
+        )
+    if not np.all(np.isfinite(mesh.points)):
+        raise UnreadableFileError(f"{label} has point coordinates that are NaN or infinite; fix the mesh")
+    if mesh.density is not None and mesh.blocks and np.any(mesh.density[np.concatenate([b.cell_ids for b in mesh.blocks])] <= 0):
+        raise UnreadableFileError(f"{label} has cells whose 'density' is zero or negative; densities must be "
+                                  "positive (kg/m^3)", field="density")
+    for b in mesh.blocks:
+        if b.nodes.size and (b.nodes.min() < 0 or b.nodes.max() >= len(mesh.points)):
+            raise UnreadableFileError(f"{label} has a {b.type} cell that refers to a point that does not exist; "
+                                      "the file is corrupt")
+    parts: list[Part] = []
+    for i, b in enumerate(mesh.blocks):
+        notes = tuple(mesh.warnings) if i == 0 else ()  # file-wide notes, said once
+        rho = None if mesh.density is None else mesh.density[b.cell_ids]
+        if b.type == "tetra":
+            body = VolumeBody(mesh.points, b.nodes, rho, length_scale, b.name, notes)
+        else:
+            body = VolumeBody(mesh.points, np.empty((0, 4), np.int64), None, length_scale, b.name, notes,
+                              (CellBlock(b.type, b.nodes, rho),))
+        parts.append(Part(b.name, body))
+    return parts

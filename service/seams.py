@@ -1,0 +1,237 @@
+"""Seams: one point written twice with different rounding, and parts that close only together.
+
+CAD exporters write each face of a B-rep as its own triangle patch, and the
+vertices on the edge two patches share are computed twice: ``0.0`` in one
+triangle, ``-2.7e-16`` in the next.  Bit-exact welding (``topology.weld``)
+leaves such a seam open.  Here the vertices that lie on open edges and are
+closer than ``Tolerances.seam_rel`` times the part's bounding-box diagonal
+are merged onto one of them (the lowest-numbered), unless the merge would
+collapse a triangle (two corners of one face in one cluster), in which case
+that cluster is not merged at all.  The merged polyhedron is a polyhedron in
+its own right, with the coordinates of the kept vertices, and every integral
+of it is exact; what moved, and by how much at most, is reported.
+
+A file may also split one closed surface into parts that are open each (OBJ
+``g``/``o`` groups, glTF primitives): ``join_open_parts`` finds the sets of
+open parts that share their open edges and whose union is closed, and makes
+each such set one body.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from .body import MeshBody, Part
+from .tolerances import DEFAULT_TOLERANCES, Tolerances
+from .topology import face_components, surface_topology, weld
+
+__all__ = ["SeamMerge", "merge_seams", "close_pairs", "open_edge_vertices", "join_open_parts"]
+
+
+@dataclass(frozen=True, slots=True)
+class SeamMerge:
+    """The outcome of ``merge_seams``.
+
+    faces : the faces re-indexed onto the kept vertices (vertices are unchanged).
+    merged : how many vertices were moved onto another one.
+    largest_gap : the largest distance from a moved vertex to the vertex it
+        was merged onto [file units].
+    tolerance : the merge distance used [file units].
+    refused : clusters not merged because a triangle would have collapsed.
+    """
+
+    faces: NDArray[np.int64]
+    merged: int
+    largest_gap: float
+    tolerance: float
+    refused: int
+
+    def warning(self) -> str:
+        text = (f"{self.merged} seam vertices merged onto a neighbour closer than {self.tolerance:.3g} "
+                f"(1e-12 of the part's size; largest gap {self.largest_gap:.3g} file units); "
+                "the results are exact for the merged surface")
+        if self.refused:
+            text += f"; {self.refused} closer groups were left apart because merging them would collapse a triangle"
+        return text
+
+
+def open_edge_vertices(faces: NDArray[np.int64]) -> NDArray[np.int64]:
+    """Indices of the vertices on edges used by exactly one face."""
+    edges = np.sort(np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]]), axis=1)
+    unique, counts = np.unique(edges, axis=0, return_counts=True)
+    return np.unique(unique[counts == 1])
+
+
+_SWEEP = np.array([0.8017837257372732, 0.5345224838248488, 0.2672612419124244])  # (3, 2, 1)/sqrt(14)
+
+
+def close_pairs(points: NDArray[np.float64], tol: float) -> NDArray[np.int64]:
+    """Index pairs (i < j) of points at most ``tol`` apart: a sweep along one oblique direction.
+
+    Points closer than ``tol`` are closer than ``tol`` along any direction, so
+    after sorting by the projection only neighbours within ``tol`` of it need
+    a full test; an oblique direction keeps the grid-aligned vertices of CAD
+    parts from sharing one projection.  No spatial index (and no scipy import)
+    is needed for the common case of no close pair at all.
+    """
+    proj = points @ _SWEEP
+    order = np.argsort(proj, kind="stable")
+    ps, xs = proj[order], points[order]
+    found: list[NDArray[np.int64]] = []
+    k = 1
+    while k < len(ps):
+        near = np.flatnonzero(ps[k:] - ps[:-k] <= tol)
+        if len(near) == 0:
+            break
+        d = np.linalg.norm(xs[near + k] - xs[near], axis=1)
+        hit = near[d <= tol]
+        if len(hit):
+            found.append(np.stack([order[hit], order[hit + k]], axis=1))
+        k += 1
+    if not found:
+        return np.empty((0, 2), dtype=np.int64)
+    pairs = np.concatenate(found)
+    return np.sort(pairs, axis=1)
+
+
+def merge_seams(vertices: NDArray[np.float64], faces: NDArray[np.int64],
+                tolerances: Tolerances = DEFAULT_TOLERANCES) -> SeamMerge:
+    """Merge the vertices of open edges that are closer than the seam tolerance.
+
+    ``vertices`` must already be bit-exactly welded (distinct rows) and
+    ``faces`` free of degenerate triangles.
+    """
+    used = vertices[np.unique(faces)]
+    diagonal = float(np.linalg.norm(used.max(axis=0) - used.min(axis=0)))
+    tol = tolerances.seam_rel * diagonal
+    candidates = open_edge_vertices(faces)
+    none = SeamMerge(faces, 0, 0.0, tol, 0)
+    if len(candidates) < 2 or tol <= 0:
+        return none
+    pts = vertices[candidates]
+    pairs = close_pairs(pts, tol)
+    if len(pairs) == 0:
+        return none
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    n = len(candidates)
+    graph = coo_matrix((np.ones(len(pairs)), (pairs[:, 0], pairs[:, 1])), shape=(n, n))
+    _, label = connected_components(graph, directed=False)
+    # representative of each cluster: its lowest-numbered vertex (candidates are sorted)
+    first = np.full(label.max() + 1, n, dtype=np.int64)
+    np.minimum.at(first, label, np.arange(n))
+    target = np.arange(len(vertices), dtype=np.int64)
+    target[candidates] = candidates[first[label]]
+    cluster_of = np.full(len(vertices), -1, dtype=np.int64)
+    cluster_of[candidates] = label
+    mapped = target[faces]
+    collapsed = (mapped[:, 0] == mapped[:, 1]) | (mapped[:, 1] == mapped[:, 2]) | (mapped[:, 0] == mapped[:, 2])
+    refused_clusters = np.unique(cluster_of[faces[collapsed]])
+    refused_clusters = refused_clusters[refused_clusters >= 0]
+    refused_clusters = refused_clusters[np.bincount(label)[refused_clusters] > 1]
+    if len(refused_clusters):
+        undo = np.isin(label, refused_clusters)
+        target[candidates[undo]] = candidates[undo]
+        mapped = target[faces]  # undoing merges can only remove collapses, never create one
+    moved = np.flatnonzero(target != np.arange(len(vertices)))
+    if len(moved) == 0:
+        return SeamMerge(faces, 0, 0.0, tol, len(refused_clusters))
+    gap = float(np.max(np.linalg.norm(vertices[moved] - vertices[target[moved]], axis=1)))
+    return SeamMerge(mapped, len(moved), gap, tol, len(refused_clusters))
+
+
+def _welded_faces(vertices: NDArray[np.float64], faces: NDArray[np.int64]) -> tuple[NDArray[np.float64], NDArray[np.int64]]:
+    vertices, faces = weld(vertices, faces)
+    good = (faces[:, 0] != faces[:, 1]) & (faces[:, 1] != faces[:, 2]) & (faces[:, 0] != faces[:, 2])
+    return vertices, faces[good]
+
+
+def _closed_after_seams(vertices: NDArray[np.float64], faces: NDArray[np.int64],
+                        tolerances: Tolerances) -> tuple[bool, NDArray[np.int64]]:
+    topo = surface_topology(faces, len(vertices))
+    if topo.open_edges:
+        faces = merge_seams(vertices, faces, tolerances).faces
+        topo = surface_topology(faces, len(vertices))
+    return topo.open_edges == 0, faces
+
+
+def join_open_parts(parts: list[Part], tolerances: Tolerances = DEFAULT_TOLERANCES) -> tuple[list[Part], list[str]]:
+    """Join open surface parts that together bound a closed surface.
+
+    Parts that are closed on their own, and open parts whose neighbours do not
+    close them, are returned as they are (an open part is then refused, by
+    name, when it is integrated).  Each set of open parts that shares its open
+    edges and is closed as a whole becomes one part named ``a+b+...``, with
+    a warning: the parts' own mass properties are not defined (an open
+    surface bounds no volume), only the whole's.
+    """
+    meshes = [(i, p) for i, p in enumerate(parts) if isinstance(p.body, MeshBody)]
+    if len(meshes) < 2:
+        return parts, []
+    open_ids: list[int] = []
+    for i, part in meshes:
+        assert isinstance(part.body, MeshBody)
+        v, f = _welded_faces(part.body.vertices, part.body.faces)
+        if len(f) and not _closed_after_seams(v, f, tolerances)[0]:
+            open_ids.append(i)
+    if len(open_ids) < 2:
+        return parts, []
+    bodies = [parts[i].body for i in open_ids]
+    scales = {b.length_scale for b in bodies}
+    if len(scales) != 1:
+        return parts, []
+    all_v = np.concatenate([b.vertices for b in bodies if isinstance(b, MeshBody)])
+    offsets = np.cumsum([0, *[len(b.vertices) for b in bodies if isinstance(b, MeshBody)][:-1]])
+    all_f = np.concatenate([b.faces + off for b, off in zip(bodies, offsets) if isinstance(b, MeshBody)])
+    owner = np.repeat(np.arange(len(bodies)), [len(b.faces) for b in bodies if isinstance(b, MeshBody)])
+    v, f = weld(all_v, all_f)
+    good = (f[:, 0] != f[:, 1]) & (f[:, 1] != f[:, 2]) & (f[:, 0] != f[:, 2])
+    f, owner = f[good], owner[good]
+    f = merge_seams(v, f, tolerances).faces
+    topo = surface_topology(f, len(v))
+    _, comp = face_components(f, topo)
+    # parts linked when they share a face component (i.e. a manifold edge)
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    k = len(bodies)
+    links = np.unique(np.stack([owner, comp + k], axis=1), axis=0)
+    size = k + int(comp.max()) + 1
+    graph = coo_matrix((np.ones(len(links)), (links[:, 0], links[:, 1])), shape=(size, size))
+    _, group = connected_components(graph, directed=False)
+    part_group = group[:k]
+    joined: dict[int, Part] = {}
+    drop: set[int] = set()
+    warnings: list[str] = []
+    for g in np.unique(part_group):
+        members = np.flatnonzero(part_group == g)
+        if len(members) < 2:
+            continue
+        sel = np.isin(owner, members)
+        sub = f[sel]
+        if surface_topology(sub, len(v)).open_edges:
+            continue
+        names = [parts[open_ids[m]].name for m in members]
+        name = "+".join(names)
+        note = (f"parts {', '.join(repr(n) for n in names)} are open each but close together; "
+                f"analysed as one body {name!r} (an open part bounds no volume of its own)")
+        member_bodies = [bodies[m] for m in members]
+        body = MeshBody(
+            np.concatenate([b.vertices for b in member_bodies if isinstance(b, MeshBody)]),
+            np.concatenate([b.faces + off for b, off in zip(
+                member_bodies, np.cumsum([0, *[len(b.vertices) for b in member_bodies if isinstance(b, MeshBody)][:-1]]))
+                if isinstance(b, MeshBody)]),
+            scales.copy().pop(), name,
+            (*(w for b in member_bodies for w in b.warnings), note),
+        )
+        joined[open_ids[members[0]]] = Part(name, body)
+        drop.update(open_ids[m] for m in members[1:])
+        warnings.append(note)
+    if not joined:
+        return parts, []
+    out = [joined.get(i, p) for i, p in enumerate(parts) if i not in drop]
+    return out, warnings

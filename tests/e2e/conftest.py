@@ -1,0 +1,146 @@
+"""A real headless Chromium (Debian's ``chromium``) driven by Playwright, against a live server.
+
+The tests are skipped only when no Chromium or no Playwright is found; CI (``.ci/run``) installs both.
+Every page a test opens collects its console errors and uncaught exceptions, and the test fails on any.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+import shutil
+import socket
+import subprocess
+import sys
+import time
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Any
+
+import httpx
+import pytest
+
+ROOT = Path(__file__).resolve().parents[2]
+STARTUP_S = 60.0
+HTTP_ERROR = re.compile(r"^Failed to load resource: the server responded with a status of 4\d\d")
+# headless without a GPU: WebGL through SwiftShader (software), nothing fetched from the network
+CHROMIUM_ARGS = [
+    "--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
+    "--disable-background-networking", "--disable-component-update", "--disable-sync",
+    "--use-gl=angle", "--use-angle=swiftshader", "--enable-unsafe-swiftshader",
+]
+
+
+def chromium_path() -> str | None:
+    for candidate in (os.environ.get("INERTIA_CHROMIUM"), "/usr/bin/chromium", shutil.which("chromium"),
+                      shutil.which("chromium-browser")):
+        if candidate and Path(candidate).exists():
+            return candidate
+    return None
+
+
+class Server:
+    """``python -m inertia serve`` on a free loopback port."""
+
+    def __init__(self, **settings: str) -> None:
+        with socket.socket() as s:
+            s.bind(("127.0.0.1", 0))
+            self.port = int(s.getsockname()[1])
+        self.url = f"http://127.0.0.1:{self.port}"
+        env = {k: v for k, v in os.environ.items() if not k.startswith("INERTIA_")}
+        env["INERTIA_COMPUTE_PROCESSES"] = "1"
+        env.update(settings)
+        (ROOT / ".pytest_cache").mkdir(exist_ok=True)
+        self.log = open(ROOT / ".pytest_cache" / f"e2e-serve-{self.port}.log", "w+b")  # noqa: SIM115
+        self.process = subprocess.Popen(
+            [sys.executable, "-m", "inertia", "serve", "--host", "127.0.0.1", "--port", str(self.port)],
+            cwd=ROOT, env=env, stdout=self.log, stderr=subprocess.STDOUT)
+        deadline = time.monotonic() + STARTUP_S
+        while time.monotonic() < deadline:
+            if self.process.poll() is not None:
+                raise RuntimeError(f"server exited: {self.output()}")
+            try:
+                if httpx.get(f"{self.url}/healthz", timeout=1.0).status_code == 200:
+                    return
+            except httpx.TransportError:
+                time.sleep(0.1)
+        raise RuntimeError(f"server did not start in {STARTUP_S} s: {self.output()}")
+
+    def output(self) -> str:
+        self.log.flush()
+        self.log.seek(0)
+        return self.log.read().decode(errors="replace")
+
+    def stop(self) -> None:
+        self.process.terminate()
+        try:
+            self.process.wait(10)
+        except subprocess.TimeoutExpired:
+            self.process.kill()
+            self.process.wait()
+        self.log.close()
+
+
+@pytest.fixture(scope="session")
+def server() -> Iterator[Server]:
+    s = Server()
+    yield s
+    s.stop()
+
+
+@pytest.fixture(scope="session")
+def browser() -> Iterator[Any]:
+    sync_api = pytest.importorskip("playwright.sync_api")
+    path = chromium_path()
+    if path is None:
+        pytest.skip("no Chromium found (Debian: apt-get install chromium)")
+    with sync_api.sync_playwright() as p:
+        b = p.chromium.launch(executable_path=path, args=CHROMIUM_ARGS)
+        yield b
+        b.close()
+
+
+class Console:
+    """Console errors, uncaught exceptions and any request that left the loopback host."""
+
+    def __init__(self, page: Any, server: Server) -> None:
+        self.errors: list[str] = []
+        self.external: list[str] = []
+        # Chromium logs every 4xx answer as a console error; a test that provokes one sets this
+        self.expect_http_errors = False
+        self.http_errors: list[str] = []
+        page.on("console", self._message)
+        page.on("pageerror", lambda e: self.errors.append(f"uncaught: {e}"))
+
+        def route(r: Any) -> None:
+            if r.request.url.startswith(server.url) or r.request.url.startswith(("blob:", "data:")):
+                r.continue_()
+            else:  # offline: nothing may be fetched from elsewhere (a CDN)
+                self.external.append(r.request.url)
+                r.abort()
+
+        page.route("**/*", route)
+
+    def _message(self, message: Any) -> None:
+        if message.type != "error":
+            return
+        if HTTP_ERROR.search(message.text):
+            self.http_errors.append(message.text)
+        else:
+            self.errors.append(f"console.{message.type}: {message.text}")
+
+
+@pytest.fixture
+def console_page(browser: Any, server: Server, request: pytest.FixtureRequest) -> Iterator[tuple[Any, Console]]:
+    """A fresh page (desktop size, or ``@pytest.mark.parametrize``'d ``viewport``) that fails the test on
+    console errors or external requests."""
+    viewport = getattr(request, "param", {"width": 1280, "height": 900})
+    context = browser.new_context(viewport=viewport, accept_downloads=True)
+    page = context.new_page()
+    page.set_default_timeout(60_000)
+    console = Console(page, server)
+    yield page, console
+    context.close()
+    assert console.errors == [], console.errors
+    assert console.expect_http_errors or console.http_errors == [], console.http_errors
+    assert console.external == [], console.external

@@ -1,0 +1,382 @@
+"""Volume readers: VTK files as VTK reads them, never a crash, companion files.
+
+Files are written by VTK's own writers (or by hand where a writer would not
+produce the oddity), and the expected volumes come from VTK
+(``vtkCellSizeFilter``) for linear cells, from VTK's shape functions
+integrated independently (``volref``) for curved ones.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import io
+import sys
+import zipfile
+from pathlib import Path
+
+import meshio
+import numpy as np
+import pytest
+
+from inertia import load_body
+from inertia.errors import EmptyGeometryError, LoadError, UnreadableFileError, UnsupportedFormatError
+from inertia.load.volume import VTK_CELL_TYPES
+from inertia.mass import assembly_properties, mass_properties
+from inertia.pipeline import AnalysisOptions, analyze
+
+vtk = pytest.importorskip("vtk")
+import volref  # noqa: E402  (needs vtk)
+
+HEX = [(0, 0, 0), (1, 0, 0), (1, 1, 0), (0, 1, 0), (0, 0, 1), (1, 0, 1), (1, 1, 1), (0, 1, 1)]
+
+
+def grid(cells: list[tuple[int, list[int]]], points: np.ndarray, density: list[float] | None = None):
+    ug = vtk.vtkUnstructuredGrid()
+    pts = vtk.vtkPoints()
+    pts.SetDataTypeToDouble()  # VTK stores float32 unless told
+    for p in np.asarray(points, dtype=float):
+        pts.InsertNextPoint(*p)
+    ug.SetPoints(pts)
+    for ctype, ids in cells:
+        idl = vtk.vtkIdList()
+        for i in ids:
+            idl.InsertNextId(int(i))
+        ug.InsertNextCell(ctype, idl)
+    if density is not None:
+        arr = vtk.vtkDoubleArray()
+        arr.SetName("density")
+        for d in density:
+            arr.InsertNextValue(d)
+        ug.GetCellData().AddArray(arr)
+    return ug
+
+
+def write_vtu(ug, path: Path, mode: str = "appended", compressor: str | None = "zlib", encode: bool = True) -> bytes:
+    w = vtk.vtkXMLUnstructuredGridWriter()
+    w.SetFileName(str(path))
+    w.SetInputData(ug)
+    {"appended": w.SetDataModeToAppended, "binary": w.SetDataModeToBinary, "ascii": w.SetDataModeToAscii}[mode]()
+    w.SetEncodeAppendedData(encode)
+    {None: w.SetCompressorTypeToNone, "zlib": w.SetCompressorTypeToZLib, "lz4": w.SetCompressorTypeToLZ4,
+     "lzma": w.SetCompressorTypeToLZMA}[compressor]()
+    assert w.Write() == 1
+    return path.read_bytes()
+
+
+def write_legacy(ug, path: Path, binary: bool = False) -> bytes:
+    w = vtk.vtkUnstructuredGridWriter()
+    w.SetFileName(str(path))
+    w.SetInputData(ug)
+    if binary:
+        w.SetFileTypeToBinary()
+    assert w.Write() == 1
+    return path.read_bytes()
+
+
+def points_as_vtk_reads_them(path: Path) -> np.ndarray:
+    """The coordinates VTK reads back (a legacy ASCII file keeps fewer digits than float64 has)."""
+    reader = vtk.vtkXMLUnstructuredGridReader() if path.suffix == ".vtu" else vtk.vtkUnstructuredGridReader()
+    reader.SetFileName(str(path))
+    reader.Update()
+    data = reader.GetOutput().GetPoints().GetData()
+    return np.array([data.GetTuple3(i) for i in range(data.GetNumberOfTuples())])
+
+
+def vtk_volume(ug) -> float:
+    f = vtk.vtkCellSizeFilter()
+    f.SetInputData(ug)
+    f.Update()
+    vols = f.GetOutput().GetCellData().GetArray("Volume")
+    # signed by each cell's node order (an inverted wedge comes out negative): sizes are the absolute values
+    return float(sum(abs(vols.GetValue(i)) for i in range(vols.GetNumberOfTuples())))
+
+
+def volume_of(data: bytes, filename: str) -> float:
+    loaded = load_body(data, filename=filename)
+    if loaded.is_assembly:
+        return assembly_properties([(p.body, 1.0) for p in loaded.parts]).mass
+    return mass_properties(loaded.body, density=1.0).mass
+
+
+def warped_hexes() -> tuple[np.ndarray, list[tuple[int, list[int]]]]:
+    """Two hexahedra sharing a face, with warped (non-planar) outer faces."""
+    pts = np.array(HEX + [(x, y, z + 1) for x, y, z in HEX[4:]], dtype=float)
+    pts[6] += (0.1, 0.05, 0.3)
+    pts[9] += (-0.05, 0.0, 0.4)
+    return pts, [(12, list(range(8))), (12, [4, 5, 6, 7, 8, 9, 10, 11])]
+
+
+# ---------------------------------------------------------------------------------------------
+# VTK's formats, as VTK reads them
+
+
+@pytest.mark.parametrize("mode", ["appended", "binary", "ascii"])
+@pytest.mark.parametrize("compressor", [None, "zlib", "lz4", "lzma"])
+def test_vtu_data_modes_and_compressors_read_as_vtk_reads_them(tmp_path: Path, mode: str, compressor: str | None) -> None:
+    pts, cells = warped_hexes()
+    ug = grid(cells, pts)
+    data = write_vtu(ug, tmp_path / "m.vtu", mode, compressor)
+    reference = sum(volref.reference_integrals("hexahedron", pts[ids])[0] for _, ids in cells)
+    assert volume_of(data, "m.vtu") == pytest.approx(reference, rel=1e-14)
+
+
+def test_raw_appended_data_is_read(tmp_path: Path) -> None:
+    pts, cells = warped_hexes()
+    data = write_vtu(grid(cells, pts), tmp_path / "raw.vtu", "appended", None, encode=False)
+    assert b'encoding="raw"' in data
+    reference = sum(volref.reference_integrals("hexahedron", pts[ids])[0] for _, ids in cells)
+    assert volume_of(data, "raw.vtu") == pytest.approx(reference, rel=1e-14)
+
+
+def test_linear_cells_agree_with_vtks_cell_sizes_where_vtk_is_exact(tmp_path: Path) -> None:
+    """Tetrahedra, planar-faced hexahedra, wedges and pyramids: VTK's own volumes (vtkCellSizeFilter)."""
+    rng = np.random.default_rng(3)
+    affine = np.eye(3) + 0.2 * rng.uniform(-1, 1, (3, 3))
+    base = np.array(HEX, dtype=float) @ affine.T
+    apex = base[:4].mean(axis=0) + affine @ np.array([0.0, 0.0, 1.0])
+    pts = np.vstack([base, base + affine @ np.array([2.0, 0, 0]), apex])
+    cells = [(12, list(range(8))), (13, [8, 9, 12, 11, 10, 13]), (14, [0, 1, 2, 3, 16]), (10, [8, 9, 11, 16])]
+    ug = grid(cells, pts)
+    for name, data in [("m.vtu", write_vtu(ug, tmp_path / "m.vtu")), ("m.vtk", write_legacy(ug, tmp_path / "m.vtk"))]:
+        as_read = grid(cells, points_as_vtk_reads_them(tmp_path / name))
+        assert volume_of(data, name) == pytest.approx(vtk_volume(as_read), rel=1e-14)
+
+
+@pytest.mark.parametrize("ext", ["vtu", "vtk"])
+def test_voxels_are_read_in_vtks_node_order(tmp_path: Path, ext: str) -> None:
+    pts = np.array([(0, 0, 0), (2, 0, 0), (0, 3, 0), (2, 3, 0), (0, 0, 5), (2, 0, 5), (0, 3, 5), (2, 3, 5)], float)
+    ug = grid([(11, list(range(8)))], pts)
+    data = write_vtu(ug, tmp_path / f"v.{ext}") if ext == "vtu" else write_legacy(ug, tmp_path / f"v.{ext}")
+    props = mass_properties(load_body(data, filename=f"v.{ext}").body, density=1.0)
+    assert props.mass == pytest.approx(30.0, rel=1e-15) == vtk_volume(ug)
+    # a box 2 x 3 x 5: I_xx = m (b^2 + c^2) / 12
+    np.testing.assert_allclose(np.diag(props.inertia.matrix), 30 * np.array([3**2 + 5**2, 2**2 + 5**2, 2**2 + 3**2]) / 12,
+                               rtol=1e-14)
+
+
+@pytest.mark.parametrize("name", ["tetra10", "hexahedron20", "hexahedron27", "wedge15", "wedge18", "pyramid13"])
+@pytest.mark.parametrize("ext", ["vtu", "vtk"])
+def test_quadratic_cells_in_vtk_files(tmp_path: Path, name: str, ext: str) -> None:
+    rng = np.random.default_rng(11)
+    nodes = volref.parametric_nodes(name) + 0.05 * rng.uniform(-1, 1, (len(volref.parametric_nodes(name)), 3))
+    if name == "pyramid13":
+        nodes[4] = (0.5, 0.5, 1.0)
+        nodes[9:13] = 0.5 * (nodes[[0, 1, 2, 3]] + nodes[4])
+    ug = grid([(volref.VTK_TYPE_IDS[name], list(range(len(nodes))))], nodes, density=[2500.0])
+    data = write_vtu(ug, tmp_path / f"q.{ext}") if ext == "vtu" else write_legacy(ug, tmp_path / f"q.{ext}")
+    props = mass_properties(load_body(data, filename=f"q.{ext}").body)
+    m0 = volref.reference_integrals(name, points_as_vtk_reads_them(tmp_path / f"q.{ext}"))[0]
+    assert props.mass == pytest.approx(2500.0 * m0, rel=1e-13)  # the cell's own density
+
+
+def test_legacy_cell_lists_longer_than_the_type_use_vtks_first_ids(tmp_path: Path) -> None:
+    """A hexahedron20 written with the linear type 12: VTK uses the first 8 ids, and we say so."""
+    corners = np.array(HEX, dtype=float) * 2
+    edges = [(0, 1), (1, 2), (2, 3), (3, 0), (4, 5), (5, 6), (6, 7), (7, 4), (0, 4), (1, 5), (2, 6), (3, 7)]
+    pts = np.vstack([corners, [(corners[a] + corners[b]) / 2 for a, b in edges]])
+    text = ["# vtk DataFile Version 3.0", "hex20 as type 12", "ASCII", "DATASET UNSTRUCTURED_GRID",
+            f"POINTS {len(pts)} double", *(" ".join(repr(float(v)) for v in p) for p in pts),
+            "CELLS 1 21", "20 " + " ".join(map(str, range(20))), "CELL_TYPES 1", "12", ""]
+    data = "\n".join(text).encode()
+    path = tmp_path / "long.vtk"
+    path.write_bytes(data)
+    reader = vtk.vtkUnstructuredGridReader()
+    reader.SetFileName(str(path))
+    reader.Update()
+    loaded = load_body(data, filename="long.vtk")
+    props = mass_properties(loaded.body, density=1.0)
+    assert props.mass == pytest.approx(vtk_volume(reader.GetOutput()), rel=1e-14) == 8.0
+    assert any("first 8" in w for w in props.warnings)
+
+
+def test_legacy_cell_lists_shorter_than_the_type_are_refused() -> None:
+    text = "\n".join(["# vtk DataFile Version 3.0", "short", "ASCII", "DATASET UNSTRUCTURED_GRID", "POINTS 4 double",
+                      "0 0 0", "1 0 0", "0 1 0", "0 0 1", "CELLS 1 5", "4 0 1 2 3", "CELL_TYPES 1", "12", ""])
+    with pytest.raises(LoadError) as info:
+        load_body(text.encode(), filename="short.vtk")
+    assert "hexahedron" in info.value.message
+
+
+def test_cell_density_arrays_apply_to_every_cell_kind(tmp_path: Path) -> None:
+    pts, cells = warped_hexes()
+    data = write_vtu(grid(cells, pts, density=[1000.0, 3000.0]), tmp_path / "d.vtu")
+    doc = analyze(data, filename="d.vtu").as_dict()
+    v = [volref.reference_integrals("hexahedron", pts[ids])[0] for _, ids in cells]
+    assert doc["mass"] == pytest.approx(1000 * v[0] + 3000 * v[1], rel=1e-13)
+    assert doc["source"]["cells"] == 2
+
+
+def test_surface_only_vtk_file_says_what_it_holds(tmp_path: Path) -> None:
+    pts = np.array([(0, 0, 0), (1, 0, 0), (0, 1, 0)], float)
+    data = write_vtu(grid([(5, [0, 1, 2])], pts), tmp_path / "tri.vtu")
+    with pytest.raises(EmptyGeometryError) as info:
+        load_body(data, filename="tri.vtu")
+    assert "1 triangle" in info.value.message and "found: none" not in info.value.message
+
+
+def test_cells_we_cannot_integrate_refuse_the_file_rather_than_vanish(tmp_path: Path) -> None:
+    pts = np.array(HEX, float)
+    ug = grid([(12, list(range(8)))], pts)
+    # a Lagrange hexahedron (type 72) beside it
+    ids = vtk.vtkIdList()
+    for i in range(8):
+        ids.InsertNextId(i)
+    ug.InsertNextCell(72, ids)
+    data = write_vtu(ug, tmp_path / "lagrange.vtu")
+    with pytest.raises(UnsupportedFormatError) as info:
+        load_body(data, filename="lagrange.vtu")
+    assert "Lagrange hexahedron" in info.value.message
+
+
+def test_every_vtk_type_we_map_is_a_3d_cell_of_the_right_size() -> None:
+    for type_id, name in VTK_CELL_TYPES.items():
+        cell = vtk.vtkGenericCell()
+        cell.SetCellType(type_id)
+        assert cell.GetCellDimension() == 3
+        assert cell.GetNumberOfPoints() in (0, volref.vtk_cell(name).GetNumberOfPoints())
+
+
+def test_without_the_vtk_extra_vtk_files_get_a_message_naming_it(monkeypatch: pytest.MonkeyPatch, tmp_path: Path) -> None:
+    pts, cells = warped_hexes()
+    data = write_vtu(grid(cells, pts), tmp_path / "m.vtu")
+    for module in ("vtkmodules.vtkIOXML", "vtkmodules.vtkIOLegacy"):
+        monkeypatch.setitem(sys.modules, module, None)
+    with pytest.raises(UnsupportedFormatError) as info:
+        load_body(data, filename="m.vtu")
+    assert "inertia-service[vtk]" in info.value.message and info.value.code == "unsupported_format"
+
+
+# ---------------------------------------------------------------------------------------------
+# never a crash, never chatter
+
+
+GARBAGE = [b"", b"\x00\x01\x02garbage" * 50, b"$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Nodes\n1 2 3\n",
+           b"# vtk DataFile Version 3.0\nx\nASCII\nDATASET UNSTRUCTURED_GRID\nPOINTS 3 double\n0 0",
+           b'<?xml version="1.0"?><VTKFile type="UnstructuredGrid"><UnstructuredGrid><Piece NumberOfPoints="2"',
+           "caf\u00e9 \u2603".encode("utf-16"), b"*NODE\n1, 0, 0\n*ELEMENT, TYPE=C3D8\n1, 1, 2\n",
+           b"MeshVersionFormatted 2\nDimension 3\nVertices\n2\n0 0 0 1\n"]
+
+
+@pytest.mark.parametrize("ext", ["vtu", "vtk", "msh", "mesh", "inp", "xdmf", "med", "f3grid", "dat", "ugrid", "ele"])
+@pytest.mark.parametrize("blob", range(len(GARBAGE)))
+def test_broken_files_are_classified_errors_without_chatter(capfd: pytest.CaptureFixture[str], ext: str, blob: int) -> None:
+    with pytest.raises(LoadError) as info:
+        load_body(GARBAGE[blob], filename=f"broken.{ext}")
+    out, err = capfd.readouterr()
+    assert out == "" and err == ""
+    message = info.value.message
+    assert "/tmp" not in message and "upload." not in message and "Traceback" not in message
+    assert info.value.code in ("unreadable_file", "empty_geometry", "unsupported_format")
+
+
+def test_meshio_sys_exit_becomes_unreadable_file(capfd: pytest.CaptureFixture[str]) -> None:
+    with pytest.raises(UnreadableFileError) as info:
+        load_body(b"$MeshFormat\n9.9 0 8\n$EndMeshFormat\n", filename="future.msh")
+    assert "future.msh" in info.value.message
+    assert capfd.readouterr() == ("", "")
+
+
+def test_cli_json_stays_json_on_a_broken_volume_file(tmp_path: Path, capfd: pytest.CaptureFixture[str]) -> None:
+    import json
+
+    from inertia.cli import main
+
+    path = tmp_path / "broken.msh"
+    path.write_bytes(b"$MeshFormat\n9.9 0 8\n$EndMeshFormat\n")
+    with contextlib.suppress(SystemExit):
+        main(["analyze", str(path), "--json"])
+    out, err = capfd.readouterr()
+    if out.strip():
+        json.loads(out)
+    assert str(tmp_path) not in out + err.replace(str(path), "")
+
+
+# ---------------------------------------------------------------------------------------------
+# companion files
+
+
+def tetgen_files() -> tuple[bytes, bytes]:
+    node = b"5 3 0 0\n1 0 0 0\n2 1 0 0\n3 0 1 0\n4 0 0 1\n5 1 1 1\n"
+    ele = b"2 4 0\n1 1 2 3 4\n2 2 3 4 5\n"
+    return node, ele
+
+
+def test_tetgen_ele_with_its_node_file_as_pairs_and_as_a_zip() -> None:
+    node, ele = tetgen_files()
+    expected = 1 / 6 + 1 / 3  # the corner tetrahedron; the second has |det [e1 e2 e3]| = 2
+    pairs = load_body([("cube/mesh.ele", ele), ("cube/mesh.node", node)])
+    assert pairs.format == "ele" and pairs.filename == "mesh.ele"
+    assert assembly_properties([(p.body, 1.0) for p in pairs.parts]).mass == pytest.approx(expected, rel=1e-15)
+    buf = io.BytesIO()
+    with zipfile.ZipFile(buf, "w") as zf:
+        zf.writestr("mesh.node", node)
+        zf.writestr("mesh.ele", ele)
+    zipped = load_body(buf.getvalue(), filename="mesh.zip")
+    assert assembly_properties([(p.body, 1.0) for p in zipped.parts]).mass == pytest.approx(expected, rel=1e-15)
+
+
+def test_tetgen_ele_alone_asks_for_its_node_file() -> None:
+    _, ele = tetgen_files()
+    with pytest.raises(UnreadableFileError) as info:
+        load_body(ele, filename="mesh.ele")
+    assert ".node" in info.value.message
+
+
+def test_an_upload_of_several_meshes_is_refused() -> None:
+    node, ele = tetgen_files()
+    with pytest.raises(LoadError) as info:
+        load_body([("a.ele", ele), ("b.ele", ele), ("a.node", node)])
+    assert "a.ele" in info.value.message and "b.ele" in info.value.message
+
+
+def test_meshio_reorders_gmsh_quadratic_cells_to_vtk_order(tmp_path: Path) -> None:
+    """A curved tetra10 through Gmsh's format: meshio's node reordering, then our element."""
+    nodes = volref.parametric_nodes("tetra10") + np.random.default_rng(2).uniform(-0.04, 0.04, (10, 3))
+    path = tmp_path / "t.msh"
+    meshio.write(path, meshio.Mesh(nodes, [("tetra10", np.arange(10)[None, :])]), file_format="gmsh", binary=False)
+    props = mass_properties(load_body(path).body, density=1.0)
+    assert props.mass == pytest.approx(volref.reference_integrals("tetra10", nodes)[0], rel=1e-13)
+
+
+def test_analyze_options_still_apply_to_volume_cells(tmp_path: Path) -> None:
+    pts, cells = warped_hexes()
+    data = write_vtu(grid(cells, pts), tmp_path / "m.vtu")
+    doc = analyze(data, filename="m.vtu", options=AnalysisOptions(mass=2.0)).as_dict()
+    assert doc["mass"] == pytest.approx(2.0, rel=1e-14)
+
+
+@pytest.mark.parametrize("kind", ["image", "rectilinear", "structured"])
+def test_structured_vtk_data_sets_are_their_voxels_and_hexahedra(tmp_path: Path, kind: str) -> None:
+    """Legacy STRUCTURED_POINTS, RECTILINEAR_GRID and STRUCTURED_GRID files: the cells VTK makes of them."""
+    xs, ys, zs = [0.0, 1.0, 3.0], [0.0, 2.0], [0.0, 0.5, 1.0, 4.0]
+    if kind == "image":
+        data_set = vtk.vtkImageData()
+        data_set.SetDimensions(3, 2, 4)
+        data_set.SetSpacing(1.5, 2.0, 0.5)
+        expected = (2 * 1.5) * 2.0 * (3 * 0.5)
+    elif kind == "rectilinear":
+        data_set = vtk.vtkRectilinearGrid()
+        data_set.SetDimensions(len(xs), len(ys), len(zs))
+        for setter, values in ((data_set.SetXCoordinates, xs), (data_set.SetYCoordinates, ys),
+                               (data_set.SetZCoordinates, zs)):
+            arr = vtk.vtkDoubleArray()
+            for v in values:
+                arr.InsertNextValue(v)
+            setter(arr)
+        expected = 3.0 * 2.0 * 4.0
+    else:
+        data_set = vtk.vtkStructuredGrid()
+        data_set.SetDimensions(len(xs), len(ys), len(zs))
+        pts = vtk.vtkPoints()
+        pts.SetDataTypeToDouble()
+        for z in zs:
+            for y in ys:
+                for x in xs:
+                    pts.InsertNextPoint(x, y, z + 0.25 * x * y)  # sheared: hexahedra with warped faces
+        data_set.SetPoints(pts)
+        expected = 3.0 * 2.0 * 4.0  # the shear moves top and bottom alike: volume unchanged
+    writer = vtk.vtkDataSetWriter()
+    writer.SetFileName(str(tmp_path / "grid.vtk"))
+    writer.SetInputData(data_set)
+    assert writer.Write() == 1
+    assert volume_of((tmp_path / "grid.vtk").read_bytes(), "grid.vtk") == pytest.approx(expected, rel=1e-14)

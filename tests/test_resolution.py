@@ -1,0 +1,187 @@
+"""Issue 12 (and issue 13's collinear points): nothing negative, non-finite or made of rounding comes back.
+
+- A float32 STL of a part at growing offsets from the origin: while the stored
+  coordinates still represent it, the moments are those of the stored float32
+  polyhedron (exact rational integration, ``tests/exact.py``) within the
+  estimate; once float32 resolution at the offset is comparable to the part,
+  the file is refused as ``insufficient_precision`` with a message that names
+  the float32 resolution and says to export in float64 or nearer the origin.
+- Zero-volume polyhedra made of many flat shells (float32 and float64) are
+  refused; flipping their shells never makes them a body.
+- Collinear points with omega are a linear rotator, with finite numbers and
+  no negative moment, through the library, the HTTP API and the CLI's JSON.
+"""
+
+from __future__ import annotations
+
+import json
+import struct
+import subprocess
+import sys
+import warnings
+from collections.abc import Iterator
+
+import numpy as np
+import pytest
+from exact import exact_moments, relative_error
+from paths import ROOT
+from scipy.spatial.transform import Rotation
+
+from inertia import analyze, analyze_points
+from inertia.errors import DegenerateBodyError, InsufficientPrecisionError
+from inertia.pipeline import AnalysisOptions
+
+# a 1 x 0.5 x 0.2 box, turned so that no coordinate lies on a float32 grid line
+ROT = Rotation.from_euler("zyx", [0.3, 0.5, -0.7]).as_matrix()
+CORNERS = np.array([[x, y, z] for x in (0, 1) for y in (0, 1) for z in (0, 1)], float) * [1.0, 0.5, 0.2]
+FACES = np.array([[0, 1, 3], [0, 3, 2], [4, 6, 7], [4, 7, 5], [0, 4, 5], [0, 5, 1],
+                  [2, 3, 7], [2, 7, 6], [0, 2, 6], [0, 6, 4], [1, 5, 7], [1, 7, 3]])
+
+
+def binary_stl(vertices: np.ndarray, faces: np.ndarray) -> bytes:
+    """A binary STL written here with struct: 80-byte header, count, 50-byte records of float32."""
+    records = vertices[faces].astype(np.float32)
+    body = b"".join(struct.pack("<12fH", 0.0, 0.0, 0.0, *tri.ravel(), 0) for tri in records)
+    return b"\0" * 80 + struct.pack("<I", len(faces)) + body
+
+
+def flat_shells(offset: float, count: int = 189) -> tuple[np.ndarray, np.ndarray]:
+    """``count`` closed tetrahedral shells whose four corners lie in one plane: zero volume."""
+    rng = np.random.default_rng(0)
+    vertices, faces = [], []
+    for _ in range(count):
+        centre = rng.normal(size=3) * 10 + offset
+        u, v = rng.normal(size=3), rng.normal(size=3)
+        n = len(vertices)
+        vertices += [centre + a * u + b * v for a, b in ((0, 0), (1, 0), (0, 1), (0.3, 0.4))]
+        faces += [[n, n + 1, n + 2], [n, n + 3, n + 1], [n + 1, n + 3, n + 2], [n, n + 2, n + 3]]
+    return np.array(vertices), np.array(faces)
+
+
+def obj_text(vertices: np.ndarray, faces: np.ndarray) -> bytes:
+    lines = [f"v {float(x)!r} {float(y)!r} {float(z)!r}" for x, y, z in vertices]
+    lines += [f"f {a + 1} {b + 1} {c + 1}" for a, b, c in faces]
+    return ("\n".join(lines) + "\n").encode()
+
+
+@pytest.mark.parametrize("exponent", range(9))
+def test_float32_part_at_growing_offsets_is_exact_or_refused(exponent):
+    offset = 10.0**exponent * np.array([1.0, 0.7, 0.4])
+    vertices = CORNERS @ ROT.T + offset
+    data = binary_stl(vertices, FACES)
+    stored = vertices.astype(np.float32).astype(np.float64)
+    resolution = 2.0**-24 * np.abs(stored).max()
+    try:
+        result = analyze(data, filename="part.stl")
+    except InsufficientPrecisionError as exc:
+        assert exc.code == "insufficient_precision"
+        assert "float32" in exc.message and "float64" in exc.message and "nearer the origin" in exc.message
+        assert resolution > 0.01  # refused only where float32 steps are a sizeable part of the 0.2 wall
+        return
+    except DegenerateBodyError as exc:  # the last offsets collapse every triangle: zero volume, naming float32
+        assert exc.code == "zero_volume" and resolution > 0.1 and "float32" in exc.message, exc
+        return
+    assert resolution < 0.05, "a part whose wall is a few float32 steps thick must be refused"
+    moments = np.sort(result.props.principal_moments)
+    est = result.props.relative_error_estimate
+    assert np.all(moments > 0) and np.isfinite(est) and est < 1e-9
+    for got, want in zip(moments, exact_moments(stored, FACES)):
+        assert relative_error(got / 1000.0, want) <= est
+    json.dumps(result.as_dict(), allow_nan=False)
+    if resolution > 1e-5:
+        assert any("float32" in w for w in result.warnings)
+
+
+def test_the_part_collapses_within_the_range():
+    refused = []
+    for exponent in range(9):
+        vertices = CORNERS @ ROT.T + 10.0**exponent * np.array([1.0, 0.7, 0.4])
+        try:
+            analyze(binary_stl(vertices, FACES), filename="part.stl")
+        except DegenerateBodyError:  # insufficient_precision, or zero_volume once every triangle collapses
+            refused.append(exponent)
+    assert refused and refused == list(range(refused[0], refused[-1] + 1)) and refused[0] <= 7
+
+
+def test_zero_volume_float32_shells_are_refused_not_flipped_into_a_body():
+    vertices, faces = flat_shells(1e4)
+    with pytest.raises(InsufficientPrecisionError, match="float32"):
+        analyze(binary_stl(vertices, faces), filename="shells.stl")
+
+
+def test_zero_volume_float64_shells_are_refused_not_flipped_into_a_body():
+    vertices, faces = flat_shells(1e6)
+    with pytest.raises(InsufficientPrecisionError, match="degenerate shells"):
+        analyze(obj_text(vertices, faces), filename="shells.obj")
+
+
+COLLINEAR = [{"mass": 1.0, "position": [0.0, 0.0, 1e5]}, {"mass": 2.0, "position": [1.0, 1.0, 1e5 + 1.0]},
+             {"mass": 1.0, "position": [3.0, 3.0, 1e5 + 3.0]}]
+
+
+def _collinear(seed: int) -> list[dict[str, object]]:
+    rng = np.random.default_rng(seed)
+    d, p0 = rng.normal(size=3), rng.normal(size=3) * 10 ** rng.uniform(-3, 5)
+    return [{"mass": float(m), "position": (p0 + t * d).tolist()}
+            for m, t in zip(rng.uniform(0.1, 10, 4), rng.normal(size=4))]
+
+
+@pytest.mark.parametrize("points", [COLLINEAR] + [_collinear(s) for s in range(20)])
+def test_collinear_points_with_omega_are_a_rotator(points):
+    result = analyze_points(points, AnalysisOptions(omega=(0.1, 1.0, 0.3)))
+    assert result.classification.kind == "linear_rotator"
+    assert result.motion is not None and result.motion.regime.value == "rotator"
+    assert np.all(result.frame.moments >= 0) and result.frame.moments[0] == 0.0
+    assert np.isfinite(result.props.relative_error_estimate) and result.props.relative_error_estimate < 1e-6
+    # the exact moments of the points as given: the two equal ones within the estimate
+    m = np.array([p["mass"] for p in points])
+    x = np.array([p["position"] for p in points])
+    d = x - m @ x / m.sum()
+    with np.errstate(all="ignore"):
+        along = np.linalg.svd(d)[2][0]
+    about_normal = np.sum(m * (d @ along) ** 2)  # a normal axis through the centre: sum m |d|^2
+    assert result.frame.moments[2] == pytest.approx(about_normal, rel=1e-9)
+    json.dumps(result.as_dict(), allow_nan=False)
+
+
+@pytest.fixture(scope="module")
+def client() -> Iterator[object]:
+    with warnings.catch_warnings():
+        warnings.filterwarnings("ignore", message="Using `httpx` with `starlette.testclient`")
+        from fastapi.testclient import TestClient
+    from inertia.app import app
+
+    with TestClient(app) as c:
+        yield c
+
+
+def test_http_collinear_points_with_omega(client):
+    res = client.post("/v1/analyze/points", json={"points": COLLINEAR, "omega": [0.1, 1, 0.3]})
+    assert res.status_code == 200, res.text
+    doc = res.json()
+    assert doc["precession"]["regime"] == "rotator" and doc["principal"]["moments"][0] == 0.0
+    assert "Infinity" not in res.text and "NaN" not in res.text
+
+
+def test_http_float32_collapse_is_a_422_naming_the_cause(client):
+    vertices = CORNERS @ ROT.T + 1e7 * np.array([1.0, 0.7, 0.4])
+    res = client.post("/v1/analyze/mesh", files={"file": ("part.stl", binary_stl(vertices, FACES))})
+    assert res.status_code == 422
+    err = res.json()["error"]
+    assert err["code"] == "insufficient_precision" and "float32" in err["message"]
+
+
+def test_cli_json_never_prints_infinity(tmp_path):
+    path = tmp_path / "line.json"
+    path.write_text(json.dumps({"points": COLLINEAR}))
+    out = subprocess.run([sys.executable, "-m", "inertia", "analyze", str(path), "--json", "--omega", "0.1,1,0.3"],
+                         capture_output=True, text=True, cwd=ROOT)
+    assert out.returncode == 0, out.stderr
+    assert "Infinity" not in out.stdout and "NaN" not in out.stdout
+    assert json.loads(out.stdout)["precession"]["regime"] == "rotator"
+    stl = tmp_path / "far.stl"
+    stl.write_bytes(binary_stl(CORNERS @ ROT.T + 1e7 * np.array([1.0, 0.7, 0.4]), FACES))
+    out = subprocess.run([sys.executable, "-m", "inertia", "analyze", str(stl), "--json"],
+                         capture_output=True, text=True, cwd=ROOT)
+    assert out.returncode == 4
+    assert json.loads(out.stderr)["error"]["code"] == "insufficient_precision"

@@ -1,0 +1,179 @@
+"""Seams merged within the documented tolerance, open parts closed together, shells oriented by nesting."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from exact import exact_solid
+from generate import box, icosahedron
+
+from inertia.body import MeshBody, Part
+from inertia.errors import NotWatertightError, ZeroVolumeError
+from inertia.mass import mass_properties
+from inertia.pipeline import analyze
+from inertia.seams import join_open_parts, merge_seams
+from inertia.solid import closed_surface, winding_numbers
+from inertia.tolerances import DEFAULT_TOLERANCES
+
+
+def unshared_box(gap: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """A box whose +x face has its own copies of its four vertices, written ``gap`` away (a CAD seam)."""
+    v, f = box(1.0, 2.0, 3.0)
+    on_face = np.flatnonzero(v[:, 0] == 1.0)
+    copies = v[on_face].copy()
+    copies[:, 1] -= gap * (copies[:, 1] == 0)  # 0.0 in one patch, -gap in the other
+    remap = np.arange(len(v))
+    remap[on_face] = len(v) + np.arange(len(on_face))
+    face_normal_x = np.all(v[f][:, :, 0] == 1.0, axis=1)
+    f2 = f.copy()
+    f2[face_normal_x] = remap[f[face_normal_x]]
+    v2 = np.vstack([v, copies])
+    return v2, f2, v, f
+
+
+def test_a_seam_of_a_few_ulps_is_merged_and_the_numbers_are_exact_for_the_merged_surface() -> None:
+    v, f, _, _ = unshared_box(2.7e-16)
+    body = MeshBody(v, f, name="part")
+    props = mass_properties(body, density=1.0)
+    merged_v, merged_f, _ = closed_surface(body)
+    volume, _, tensor = exact_solid(merged_v, merged_f)
+    assert props.mass == pytest.approx(float(volume), rel=1e-15)
+    np.testing.assert_allclose(props.inertia.matrix, np.array(tensor, dtype=float), rtol=1e-14, atol=1e-15)
+    assert any("seam vertices merged" in w and "largest gap 2.7e-16" in w for w in props.warnings)
+
+
+def test_a_gap_above_the_tolerance_stays_open_and_names_the_part() -> None:
+    diag = np.sqrt(1 + 4 + 9)
+    v, f, _, _ = unshared_box(10 * DEFAULT_TOLERANCES.seam_rel * diag)
+    with pytest.raises(NotWatertightError) as err:
+        mass_properties(MeshBody(v, f, name="bracket"))
+    assert "'bracket'" in err.value.message and err.value.details["part"] == "bracket"
+
+
+def test_a_merge_that_would_collapse_a_triangle_is_not_made() -> None:
+    # a sliver whose two close corners are both on open edges: merging them would collapse it
+    v = np.array([[0, 0, 0], [1, 0, 0], [1, 1e-14, 0], [0, 1, 0]], dtype=float)
+    f = np.array([[0, 1, 2], [0, 2, 3]])
+    out = merge_seams(v, f)
+    assert out.merged == 0 and out.refused == 1
+    np.testing.assert_array_equal(out.faces, f)
+
+
+def test_open_groups_that_close_together_are_one_body() -> None:
+    v, f = box(1.0, 2.0, 3.0)
+    half = len(f) // 2
+    parts = [Part("lid", MeshBody(v, f[:half], name="lid")), Part("tray", MeshBody(v, f[half:], name="tray"))]
+    joined, warnings = join_open_parts(parts)
+    assert [p.name for p in joined] == ["lid+tray"] and "open each but close together" in warnings[0]
+
+
+def test_grouped_obj_is_analysed_as_one_closed_body() -> None:
+    v, f = box(1.0, 2.0, 3.0)
+    lines = [f"v {float(x)!r} {float(y)!r} {float(z)!r}" for x, y, z in v]
+    lines.append("g top")
+    lines += [f"f {a + 1} {b + 1} {c + 1}" for a, b, c in f[:5]]
+    lines.append("g rest")
+    lines += [f"f {a + 1} {b + 1} {c + 1}" for a, b, c in f[5:]]
+    doc = analyze("\n".join(lines).encode(), filename="split.obj").as_dict()
+    assert doc["mass"] == pytest.approx(6000, rel=1e-14)
+    assert any("close together" in w for w in doc["warnings"])
+
+
+def test_an_open_group_beside_a_closed_one_is_refused_by_name() -> None:
+    v, f = box(1.0, 1.0, 1.0)
+    lines = [f"v {float(x)!r} {float(y)!r} {float(z)!r}" for x, y, z in v]
+    lines += [f"v {float(x) + 5!r} {float(y)!r} {float(z)!r}" for x, y, z in v]
+    lines.append("g whole")
+    lines += [f"f {a + 1} {b + 1} {c + 1}" for a, b, c in f]
+    lines.append("g broken")
+    lines += [f"f {a + 9} {b + 9} {c + 9}" for a, b, c in f[:-1]]
+    with pytest.raises(NotWatertightError) as err:
+        analyze("\n".join(lines).encode(), filename="two.obj")
+    assert "broken" in err.value.message
+
+
+def sphere_shell(radius: float, centre: tuple[float, float, float] = (0, 0, 0)) -> tuple[np.ndarray, np.ndarray]:
+    v, f = icosahedron(1.0)
+    v = v / np.linalg.norm(v[0]) * radius + np.asarray(centre)
+    return v, f
+
+
+def test_winding_number_is_one_inside_and_zero_outside() -> None:
+    v, f = box(2.0, 2.0, 2.0, origin=(-1.0, -1.0, -1.0))
+    w = winding_numbers(v, f, np.array([[0.0, 0.0, 0.0], [3.0, 0.0, 0.0], [0.5, 0.9, -0.2]]))
+    np.testing.assert_allclose(np.abs(w), [1.0, 0.0, 1.0], atol=1e-12)
+
+
+def test_a_cavity_wound_outward_beside_a_part_wound_inward_is_set_right_by_nesting() -> None:
+    # outer box inverted, inner box (the cavity) outward, a separate small box beside them inverted:
+    # the bounding-box rule would get the separate box wrong when it lies within the outer box's range
+    ov, of = box(4.0, 4.0, 4.0)
+    iv, i_f = box(1.0, 1.0, 1.0, origin=(1.5, 1.5, 1.5))
+    # an L-shaped neighbour's box lies within the outer box's bounding box in two axes only
+    sv, sf = box(1.0, 1.0, 1.0, origin=(5.0, 1.5, 1.5))
+    v = np.vstack([ov, iv, sv])
+    f = np.vstack([of[:, [0, 2, 1]], i_f + 8, sf[:, [0, 2, 1]] + 16])
+    props = mass_properties(MeshBody(v, f), density=1.0)
+    assert props.mass == pytest.approx(64 - 1 + 1, rel=1e-14)
+
+
+def test_a_shell_inside_another_without_a_bounding_box_hint_is_a_cavity() -> None:
+    # an icosahedral cavity in a box; the cavity's bounding box is inside, and so is a point of it
+    bv, bf = box(4.0, 4.0, 4.0, origin=(-2.0, -2.0, -2.0))
+    sv, sf = sphere_shell(1.0)
+    v = np.vstack([bv, sv])
+    f = np.vstack([bf, sf + 8])  # both outward: consistent, the file says two solids; keep
+    both = mass_properties(MeshBody(v, f), density=1.0)
+    f_bad = np.vstack([bf[:, [0, 2, 1]], sf + 8])  # outer inverted, inner outward
+    fixed = mass_properties(MeshBody(v, f_bad), density=1.0)
+    sphere_volume = float(exact_solid(sv, sf)[0])
+    assert fixed.mass == pytest.approx(64 - sphere_volume, rel=1e-14)
+    assert both.mass == pytest.approx(64 + sphere_volume, rel=1e-14)
+    assert any("winding corrected" in w for w in fixed.warnings)
+
+
+def test_zero_stored_volume_is_never_turned_into_a_body() -> None:
+    # one box stored twice, the copy inverted and coincident: the stored polyhedron encloses nothing
+    v, f = box(1.0, 2.0, 3.0)
+    v2 = np.vstack([v, v])
+    f2 = np.vstack([f, f[:, [0, 2, 1]] + 8])
+    with pytest.raises(ZeroVolumeError):
+        mass_properties(MeshBody(v2, f2, welded=True))
+
+
+def test_a_separate_inverted_copy_is_turned_outward() -> None:
+    v, f = box(1.0, 2.0, 3.0)
+    v2 = np.vstack([v, v + np.array([5.0, 0.0, 0.0])])
+    f2 = np.vstack([f, f[:, [0, 2, 1]] + 8])
+    assert mass_properties(MeshBody(v2, f2), density=1.0).mass == pytest.approx(12.0, rel=1e-15)
+
+
+def test_close_pairs_agree_with_brute_force() -> None:
+    rng = np.random.default_rng(5)
+    grid = rng.integers(0, 4, size=(300, 3)).astype(float)  # many equal projections on the axes
+    pts = np.vstack([grid, grid[:40] + rng.normal(scale=1e-13, size=(40, 3))])
+    from inertia.seams import close_pairs
+
+    got = {tuple(p) for p in close_pairs(pts, 1e-12).tolist()}
+    d = np.linalg.norm(pts[:, None] - pts[None], axis=2)
+    i, j = np.nonzero(np.triu(d <= 1e-12, 1))
+    assert got == set(zip(i.tolist(), j.tolist()))
+
+
+def test_a_stacked_inverted_cube_touching_another_is_turned_outward() -> None:
+    # the second cube's largest faces include the shared one: its test point must move off it
+    a_v, a_f = box(1.0, 1.0, 1.0)
+    b_v, b_f = box(1.0, 1.0, 1.0, origin=(0.0, 0.0, 1.0))
+    v = np.vstack([a_v, b_v])
+    f = np.vstack([a_f, b_f[:, [0, 2, 1]] + 8])
+    props = mass_properties(MeshBody(v, f, welded=True), density=1.0)
+    assert props.mass == pytest.approx(2.0, rel=1e-15)
+
+
+def test_winding_numbers_agree_point_by_point() -> None:
+    v, f = sphere_shell(1.0)
+    pts = np.array([[0.0, 0.0, 0.0], [0.5, 0.1, 0.0], [2.0, 0.0, 0.0], [0.0, -3.0, 1.0]])
+    together = winding_numbers(v, f, pts)
+    alone = [winding_numbers(v, f, p[None, :])[0] for p in pts]
+    np.testing.assert_allclose(together, alone, atol=1e-12)
+    np.testing.assert_allclose(np.abs(together), [1, 1, 0, 0], atol=1e-12)
