@@ -333,7 +333,7 @@ def test_workspace_is_empty_after_requests(client: Any) -> None:
 def test_gltf_with_its_buffer_as_a_second_file_part_is_read(client: Any) -> None:
     import base64
 
-    name, embedded = H.gltf()
+    _, embedded = H.gltf()
     doc = json.loads(embedded)
     buffer = base64.b64decode(doc["buffers"][0]["uri"].split(",", 1)[1])
     doc["buffers"][0]["uri"] = "tet.bin"
