@@ -13,6 +13,8 @@ OPTIONAL_READERS: dict[str, tuple[str, str]] = {
     "med": ("h5py", "the 'hdf5' extra: pip install 'inertia-service[hdf5]'"),
     "vtk": ("vtkmodules", "the 'vtk' extra: pip install 'inertia-service[vtk]'"),
     "vtu": ("vtkmodules", "the 'vtk' extra: pip install 'inertia-service[vtk]'"),
+    "step": ("OCP", "the 'cad' extra: pip install 'inertia-service[cad]'"),
+    "iges": ("OCP", "the 'cad' extra: pip install 'inertia-service[cad]'"),
 }
 
 
