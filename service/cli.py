@@ -89,6 +89,10 @@ def add_analysis_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("--reference", type=_triple, metavar="X,Y,Z",
                    help="point (file units): also report the tensor about it; negative values as written: -1,0,0")
     p.add_argument("--densities", help="JSON file: part name -> density (kg/m^3) for files of several parts")
+    p.add_argument("--geometry", choices=("brep", "mesh"), default="brep",
+                   help="CAD files: integrate the exact B-rep (default) or a tessellation of it")
+    p.add_argument("--deflection", type=float,
+                   help="with --geometry mesh: chordal deflection relative to the bounding-box diagonal (default 1e-3)")
     p.add_argument("--frame", type=_quaternion, metavar="W,X,Y,Z",
                    help="unit quaternion carrying a named frame's axes into the file's: also report the centre of "
                    "mass and tensors along that frame's axes")
@@ -122,6 +126,8 @@ def options_from_args(args: argparse.Namespace) -> Any:
         samples=getattr(args, "samples", None),
         method=getattr(args, "method", "exact"),
         densities=densities,
+        geometry=getattr(args, "geometry", "brep"),
+        deflection=getattr(args, "deflection", None),
         export=getattr(args, "export", None),
         frame=getattr(args, "frame", None),
         isotopes=getattr(args, "isotopes", "standard"),

@@ -20,6 +20,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import NDArray
 
+from .body import BrepBody
 from .classification import Classification, classify
 from .conventions import length_scale
 from .errors import InvalidParameterError
@@ -80,6 +81,8 @@ class AnalysisOptions:
     samples: int | None = None
     method: str = "exact"
     densities: Mapping[str, float] | None = None
+    geometry: str = "brep"
+    deflection: float | None = None
     export: str | None = None
     frame: tuple[float, float, float, float] | None = None
     isotopes: str = "standard"
@@ -110,6 +113,7 @@ class AnalysisOptions:
             for name, rho in self.densities.items():
                 _positive(f"densities[{name!r}]", rho)
         _check_v11(self)
+        _check_geometry(self.geometry, self.deflection)
 
 
 def _check_v11(options: AnalysisOptions) -> None:
@@ -128,6 +132,20 @@ def _check_v11(options: AnalysisOptions) -> None:
                                     parameter="isotopes")
     if options.mass_unit not in ("kg", "u"):
         raise InvalidParameterError(f"mass_unit must be 'kg' or 'u', got {options.mass_unit!r}", parameter="mass_unit")
+
+
+def _check_geometry(geometry: str, deflection: float | None) -> None:
+    """CAD files: ``geometry`` brep or mesh; ``deflection`` (mesh only) relative to the bounding-box diagonal."""
+    if geometry not in ("brep", "mesh"):
+        raise InvalidParameterError("geometry must be 'brep' or 'mesh'", parameter="geometry")
+    if deflection is None:
+        return
+    _positive("deflection", deflection)
+    if not deflection < 1:
+        raise InvalidParameterError("deflection is relative to the bounding-box diagonal: give a number below 1",
+                                    parameter="deflection")
+    if geometry != "mesh":
+        raise InvalidParameterError("deflection applies to geometry=mesh", parameter="deflection")
 
 
 @dataclass(frozen=True, slots=True)
@@ -153,6 +171,7 @@ class AnalysisResult:
     parts: tuple[PartResult, ...] | None = None
     warnings: tuple[str, ...] = ()
     elapsed_s: float = 0.0
+    tessellation_error: float | None = None
     surface_area: float | None = None
     rotational_constants: RotationalConstants | None = None
     named_frame: NamedFrame | None = None
@@ -223,6 +242,8 @@ def analyze_points(records: list[dict[str, Any]], options: AnalysisOptions = Ana
 def analyze_loaded(loaded: Loaded, options: AnalysisOptions, start: float | None = None) -> AnalysisResult:
     """The stages after loading."""
     start = time.perf_counter() if start is None else start
+    if loaded.kind == "cad" and options.geometry == "mesh":
+        return _tessellated_cad(loaded, options, start)
     if loaded.kind == "points" and options.model == Model.SHELL:
         raise InvalidParameterError("model=shell applies to surface meshes, not point masses", parameter="model")
     _check_part_names(loaded, options)
@@ -248,7 +269,7 @@ def analyze_loaded(loaded: Loaded, options: AnalysisOptions, start: float | None
         frame = principal_frame(props, options.tolerance)
         cls = classify(frame)
         parts = part_results
-    warnings = list(props.warnings)
+    warnings = list(loaded.warnings) + list(props.warnings)
     if loaded.units_from == "file":
         warnings.append(f"length unit {loaded.units!r} taken from the file")
     warnings.extend(_unit_warning(loaded))
@@ -276,6 +297,19 @@ def analyze_loaded(loaded: Loaded, options: AnalysisOptions, start: float | None
         elapsed_s=time.perf_counter() - start,
         **extra,
     )
+
+
+def _tessellated_cad(loaded: Loaded, options: AnalysisOptions, start: float) -> AnalysisResult:
+    """geometry=mesh: the tessellation through the polyhedron pipeline, and its difference to the B-rep."""
+    from .cad import DEFAULT_DEFLECTION, tessellated, tessellation_error
+
+    exact = analyze_loaded(loaded, replace(options, geometry="brep", deflection=None, reference=None, omega=None,
+                                           duration=None, samples=None))
+    deflection = options.deflection or DEFAULT_DEFLECTION
+    result = analyze_loaded(tessellated(loaded, deflection), replace(options, geometry="brep", deflection=None), start)
+    source = {**result.source, "geometry": "mesh", "deflection": deflection}
+    return replace(result, source=source, tessellation_error=tessellation_error(exact.props, result.props),
+                   elapsed_s=time.perf_counter() - start)
 
 
 def _v11_sections(loaded: Loaded, props: MassProperties, frame: PrincipalFrame, cls: Classification,
@@ -399,8 +433,13 @@ def _part(name: str, body: Any, options: AnalysisOptions, single: bool) -> PartR
     density = _part_density(name, options)
     # several parts: a total mass is shared out after all parts are integrated
     mass = options.mass if single else None
-    props = mass_properties(body, density=None if mass is not None else density, mass=mass,
-                            model=options.model, thickness=options.thickness)
+    if isinstance(body, BrepBody):
+        from .cad import brep_mass_properties
+
+        props = brep_mass_properties(body, density=None if mass is not None else density, mass=mass, model=options.model)
+    else:
+        props = mass_properties(body, density=None if mass is not None else density, mass=mass,
+                                model=options.model, thickness=options.thickness)
     frame = principal_frame(props, options.tolerance)
     return PartResult(name, props, frame, classify(frame))
 
@@ -422,7 +461,12 @@ def _scaled(part: PartResult, factor: float) -> PartResult:
 def _combined(loaded: Loaded, parts: Sequence[PartResult], options: AnalysisOptions,
               factor: float) -> MassProperties:
     """The whole assembly, integrated as one body with each part's material."""
-    pairs = [(part.body, _part_density(part.name, options)) for part in loaded.parts]
+    if loaded.kind == "cad" and isinstance(loaded.parts[0].body, BrepBody):
+        from .cad import combined_properties
+
+        return combined_properties([p.props for p in parts])
+    pairs = [(part.body, _part_density(part.name, options)) for part in loaded.parts
+             if not isinstance(part.body, BrepBody)]
     whole = assembly_properties(pairs, model=options.model, thickness=options.thickness, factor=factor)
     volumes = [p.props.volume for p in parts]
     densities = {p.props.density for p in parts}
@@ -453,7 +497,11 @@ def _source(loaded: Loaded, parts: Sequence[PartResult]) -> dict[str, Any]:
     if loaded.filename is not None:
         out = {"filename": loaded.filename, **out}
     bodies = [p.body for p in loaded.parts]
-    if loaded.kind == "mesh":
+    if loaded.kind == "cad":
+        from .cad import source_counts
+
+        out.update(source_counts(loaded, "brep", None))
+    elif loaded.kind == "mesh":
         meshes = [b for b in bodies if isinstance(b, MeshBody)]
         closed = [_surface_counts(b, r.props) for b, r in zip(meshes, parts)]
         out["vertices"] = int(sum(n for n, _ in closed))

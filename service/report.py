@@ -100,6 +100,8 @@ def analysis_dict(result: AnalysisResult) -> dict[str, Any]:
         "elapsed_s": float(result.elapsed_s),
         "relative_error_estimate": float(p.relative_error_estimate),
     }
+    if result.tessellation_error is not None:
+        out["diagnostics"]["tessellation_error"] = float(result.tessellation_error)
     return out
 
 

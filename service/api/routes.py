@@ -9,7 +9,7 @@ from fastapi.responses import StreamingResponse
 from starlette.background import BackgroundTask
 from starlette.concurrency import run_in_threadpool
 
-from ..load.sniff import POINT_FORMATS, SCENE_FORMATS, SURFACE_FORMATS, VOLUME_FORMATS
+from ..load.sniff import CAD_FORMATS, POINT_FORMATS, SCENE_FORMATS, SURFACE_FORMATS, VOLUME_FORMATS
 from .compute import ComputePool, memory_limit
 from .formats import unavailable_formats
 from .jobs import Job, MeshJob, PointsJob, PrecessionJob, is_small, run_job
@@ -77,11 +77,13 @@ async def formats() -> FormatsOut:
     surface = [f for f in SURFACE_FORMATS if f not in missing]
     volume = [f for f in VOLUME_FORMATS if f not in missing]
     points = [f for f in POINT_FORMATS if f not in missing]
+    cad = [f for f in CAD_FORMATS if f not in missing]
     kinds = [(f, "surface") for f in surface] + [(f, "volume") for f in volume] + [(f, "points") for f in points]
+    kinds += [(f, "cad") for f in cad]
     table = [FormatOut(format=f, kind=k, parts=f in SCENE_FORMATS)  # type: ignore[arg-type]
              for f, k in kinds]
     return FormatsOut(formats=table, surface=surface, volume=volume,
-                      scene=[f for f in SCENE_FORMATS if f not in missing], points=points,
+                      scene=[f for f in SCENE_FORMATS if f not in missing], points=points, cad=cad,
                       unavailable=[UnavailableFormatOut(format=f, needs=n) for f, n in sorted(missing.items())])
 
 

@@ -281,6 +281,9 @@ def test_an_unreadable_file_and_bad_pasted_text_get_readable_messages(
     page.fill("#paste", '[{"mass": -1, "position": [0, 0, 0]}]')
     assert analyze(page) == "error"
     assert page.is_visible("#paste-error") and "mass" in page.inner_text("#paste-error")
+    page.fill("#paste", '[{"mass": 1, "position": [0, 0, 0]}, {"mass": 1, "position": [1, 0, 0]}]')
+    assert analyze(page, density="7850") == "error"
+    assert "leave density empty" in page.inner_text("#density-error")
 
 
 def test_download_buttons_give_the_json_and_the_offered_snippets(console_page: tuple[Any, Console], server: Server) -> None:
@@ -336,6 +339,13 @@ def test_controls_have_labels_and_are_keyboard_reachable(console_page: tuple[Any
     page.focus("#analyze")
     page.keyboard.press("Enter")
     page.wait_for_selector("body[data-state=ready]")
+    page.focus("#viewer")  # the view turns and zooms from the keyboard too
+    before = page.evaluate(PIXELS, [0, 0, 1, 1])["hash"]
+    page.keyboard.press("Shift+ArrowLeft")
+    turned = page.evaluate(PIXELS, [0, 0, 1, 1])["hash"]
+    page.keyboard.press("+")
+    zoomed = page.evaluate(PIXELS, [0, 0, 1, 1])["hash"]
+    assert len({before, turned, zoomed}) == 3
 
 
 @pytest.mark.parametrize(("path", "text"), [("/docs", "/v1/analyze/mesh"), ("/redoc", "/v1/analyze/mesh")])
