@@ -28,6 +28,7 @@ from __future__ import annotations
 
 import math
 import os
+import re
 import tempfile
 from dataclasses import dataclass
 from typing import Any
@@ -37,6 +38,7 @@ from numpy.typing import NDArray
 
 from ..errors import (
     EmptyGeometryError,
+    ExternalReferenceError,
     NotWatertightError,
     ServiceError,
     UnreadableFileError,
@@ -124,7 +126,22 @@ def read_solids(data: bytes, fmt: str) -> tuple[list[Solid], str | None]:
         raise _translated(exc, f"read the {fmt.upper()} file") from exc
 
 
+# A STEP assembly may name its parts' files (DOCUMENT_FILE / EXTERNAL_SOURCE entities), which
+# OpenCASCADE's XDE reader then opens from disk: the server never opens a file an upload names.
+_STEP_EXTERNAL = re.compile(rb"EXTERNAL_SOURCE\s*\(|DOCUMENT_FILE\s*\(\s*'[^']*\.(?:stp|step|p21)'", re.IGNORECASE)
+
+
+def _refuse_external(data: bytes, fmt: str) -> None:
+    match = _STEP_EXTERNAL.search(data) if fmt == "step" else None
+    if match:
+        raise ExternalReferenceError(
+            "the STEP file refers to other files for its parts (" + match.group(0).decode("ascii", "replace")[:80]
+            + "...); the server never opens files named by an upload: export the assembly as one self-contained STEP",
+            format=fmt)
+
+
 def _read(data: bytes, fmt: str) -> tuple[list[Solid], str | None]:
+    _refuse_external(data, fmt)
     from OCP.IFSelect import IFSelect_RetDone
     from OCP.TCollection import TCollection_ExtendedString
     from OCP.TDocStd import TDocStd_Document

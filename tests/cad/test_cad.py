@@ -222,6 +222,15 @@ def test_garbage_step_is_unreadable() -> None:
         analyze(b"ISO-10303-21;\nHEADER;\nthis is not STEP\n", filename="junk.step")
 
 
+def test_step_naming_another_file_is_refused(step_assembly: bytes) -> None:
+    """An assembly whose parts live in other files: the server never opens a file an upload names."""
+    from inertia.errors import ExternalReferenceError
+
+    text = step_assembly.replace(b"DATA;", b"DATA;\n#999999=DOCUMENT_FILE('/etc/part.stp','',$,#1,'',$);", 1)
+    with pytest.raises(ExternalReferenceError):
+        analyze(text, filename="bracket.step")
+
+
 def test_step_is_recognised_by_content() -> None:
     doc = analyze(write_step([("plate", box(*BOX, CORNER))])).as_dict()
     assert doc["source"]["format"] == "step"
