@@ -146,3 +146,39 @@ def test_volume_mesh_has_no_surface_area(client: Any) -> None:
 def test_precession_endpoint_is_unchanged(client: Any) -> None:
     doc = client.post("/v1/precession", json={"principal_moments": [1.0, 2.0, 3.0], "omega": [0, 0, 1]}).json()
     assert "radii_of_gyration" not in doc["principal"]
+
+
+def _unit_quaternions() -> Any:
+    from hypothesis import strategies as st
+
+    component = st.floats(-1.0, 1.0, allow_nan=False)
+    return st.tuples(component, component, component, component).filter(
+        lambda q: sum(v * v for v in q) > 1e-2).map(lambda q: tuple(v / math.sqrt(sum(u * u for u in q)) for v in q))
+
+
+def test_any_rotation_of_points_seen_in_its_frame_is_invariant() -> None:
+    """Hypothesis: rotating a point set by q and naming the frame q gives back the unrotated tensor and centre."""
+    from hypothesis import given, settings
+    from hypothesis import strategies as st
+
+    import inertia
+
+    coords = st.lists(st.tuples(*(st.floats(-5, 5, allow_nan=False),) * 3), min_size=3, max_size=6)
+
+    @settings(max_examples=40, deadline=None)
+    @given(q=_unit_quaternions(), positions=coords)
+    def check(q: tuple[float, float, float, float], positions: list[tuple[float, float, float]]) -> None:
+        w, x, y, z = q
+        R = Rotation.from_quat([x, y, z, w]).as_matrix()
+        masses = [1.0 + k for k in range(len(positions))]
+        plain = inertia.analyze_points([{"mass": m, "position": list(p)} for m, p in zip(masses, positions)])
+        turned = inertia.analyze_points(
+            [{"mass": m, "position": (R @ np.array(p)).tolist()} for m, p in zip(masses, positions)],
+            inertia.AnalysisOptions(frame=q))
+        frame = turned.as_dict()["frame"]
+        base = plain.as_dict()
+        scale = max(np.abs(base["inertia_tensor"]).max(), 1e-300)
+        np.testing.assert_allclose(frame["inertia_tensor"], base["inertia_tensor"], rtol=0, atol=1e-12 * scale)
+        np.testing.assert_allclose(frame["center_of_mass"], base["center_of_mass"], rtol=0, atol=1e-12 * 5)
+
+    check()
