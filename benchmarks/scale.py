@@ -53,7 +53,7 @@ from typing import Any
 
 import numpy as np
 
-from benchmarks.batch import ANALYZE_SCRIPT, TRIMESH_SCRIPT, available_cores, uv_sphere, write_stl
+from benchmarks.batch import ANALYZE_SCRIPT, TRIMESH_SCRIPT, available_cores, uv_sphere, write_section, write_stl
 
 ROOT = Path(__file__).resolve().parents[1]
 DOC = ROOT / "docs" / "scaling.md"
@@ -436,8 +436,6 @@ def render(results: list[SetResult], workers: list[int], overheads: dict[str, di
            starts: dict[int, Run], loads: list[float], rounds: int, command: str) -> str:
     m = _machine()
     lines = [
-        "# Scaling of `inertia batch`",
-        "",
         f"Regenerate: `{command}` (from the repository root; needs the `batch` extra, trimesh and psutil).",
         "",
         f"Machine: {m['cpu']}, **{m['cores']} cores** ({m['usable']} usable by this process), Python {m['python']}, "
@@ -584,8 +582,8 @@ def main(argv: list[str] | None = None) -> int:
     text = render(results, workers, overheads, starts, loads, rounds, command.strip())
     if str(args.out) == "-":
         print(text)
-    else:
-        args.out.write_text(text + "\n")
+    else:  # the measured part, between the markers; text around them is kept
+        write_section(args.out, text)
         print(text)
     return 0
 
