@@ -50,7 +50,7 @@ SLOW_NUMPY_STL = 1_000_000  # numpy-stl's exact mass path takes ~36 s at 1e6: on
 NO_NUMPY_STL = 5_000_000  # ... and minutes from 5e6 up: not run
 # peak memory of each tool as a multiple of the file size (measured at 1e6-5e6), to decide whether a run fits
 MEMORY_FACTOR = {"inertia": 3.5, "trimesh": 13.0, "numpy-stl": 36.0}
-MEMORY_MARGIN = 2 << 30  # left free for everyone else on the machine
+MEMORY_MARGIN = 8 << 30  # left free for everyone else on the machine (shared)
 
 TRIMESH_SCRIPT = """
 import json, sys, trimesh
