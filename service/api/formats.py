@@ -11,6 +11,8 @@ __all__ = ["unavailable_formats", "OPTIONAL_READERS"]
 OPTIONAL_READERS: dict[str, tuple[str, str]] = {
     "xdmf": ("h5py", "the 'hdf5' extra: pip install 'inertia-service[hdf5]'"),
     "med": ("h5py", "the 'hdf5' extra: pip install 'inertia-service[hdf5]'"),
+    "vtk": ("vtkmodules", "the 'vtk' extra: pip install 'inertia-service[vtk]'"),
+    "vtu": ("vtkmodules", "the 'vtk' extra: pip install 'inertia-service[vtk]'"),
     "step": ("OCP", "the 'cad' extra: pip install 'inertia-service[cad]'"),
     "iges": ("OCP", "the 'cad' extra: pip install 'inertia-service[cad]'"),
 }

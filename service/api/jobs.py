@@ -141,8 +141,9 @@ def _load(source: bytes | str | tuple[tuple[str, str], ...], filename: str | Non
 
     try:
         if isinstance(source, tuple):
-            return load_body(_read_files(source), format=options.format, units=options.units)
-        return load_body(source, filename=filename, format=options.format, units=options.units)
+            return load_body(_read_files(source), format=options.format, units=options.units, isotopes=options.isotopes)
+        return load_body(source, filename=filename, format=options.format, units=options.units,
+                         isotopes=options.isotopes)
     except (ServiceError, MemoryError):
         raise
     except RecursionError:

@@ -1,7 +1,7 @@
 """Fuzzing the running server: no 500, no hang, no memory past its bound, no temporary file left.
 
 A real server (``python -m inertia serve`` on a loopback port, its own TMPDIR) gets mutated files of
-every format from a few concurrent clients for a bounded time (``INERTIA_FUZZ_SECONDS``, default 30 s;
+every format from a few concurrent clients for a bounded time (``INERTIA_FUZZ_SECONDS``, default 20 s;
 the longer run of docs/reliability.md sets it higher, with ``INERTIA_FUZZ_REPORT`` naming a JSON file
 for the counts). Hypothesis adds arbitrary bytes under every format name, arbitrary JSON bodies and
 query values, and batches with corrupt members, in process.
@@ -40,7 +40,7 @@ with warnings.catch_warnings():
     warnings.filterwarnings("ignore", message="Using `httpx` with `starlette.testclient`")
     from fastapi.testclient import TestClient
 
-FUZZ_SECONDS = float(os.environ.get("INERTIA_FUZZ_SECONDS", "30"))
+FUZZ_SECONDS = float(os.environ.get("INERTIA_FUZZ_SECONDS", "20"))
 FUZZ_SEED = int(os.environ.get("INERTIA_FUZZ_SEED", "13"))
 REPORT = os.environ.get("INERTIA_FUZZ_REPORT")
 CLIENTS = 3
@@ -193,7 +193,7 @@ def _assert_no_500(response: Any) -> None:
         assert set(response.json()["error"]) == {"code", "message", "details"}
 
 
-@settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
 @given(data=st.binary(max_size=2048), ext=st.sampled_from(EXTENSIONS))
 def test_arbitrary_bytes_under_any_format_name_are_never_a_500(app_client: TestClient, data: bytes,
                                                                ext: str) -> None:
@@ -206,7 +206,7 @@ JSON = st.recursive(st.none() | st.booleans() | st.floats() | st.integers() | st
                                                                                 max_size=4), max_leaves=20)
 
 
-@settings(max_examples=80, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@settings(max_examples=50, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
 @given(body=JSON | st.fixed_dictionaries({"points": st.lists(st.fixed_dictionaries(
     {"mass": st.floats(), "position": st.lists(st.floats(), min_size=3, max_size=3)}), max_size=4)}),
     depth=st.sampled_from([0, 0, 0, 50, 5000]))
@@ -219,7 +219,7 @@ def test_arbitrary_json_bodies_and_parameters_are_never_a_500(app_client: TestCl
     _assert_no_500(app_client.post("/v1/analyze/mesh", files={"file": box}, params={"densities": text[:4000]}))
 
 
-@settings(max_examples=15, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@settings(max_examples=10, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
 @given(pick=st.lists(st.integers(0, 10_000), min_size=1, max_size=5), corrupt=st.integers(0, 5),
        seed=st.integers(0, 2**32))
 def test_batch_of_a_zip_with_bad_members_ends_well_formed(app_client: TestClient, pick: list[int], corrupt: int,

@@ -380,3 +380,19 @@ def test_structured_vtk_data_sets_are_their_voxels_and_hexahedra(tmp_path: Path,
     writer.SetInputData(data_set)
     assert writer.Write() == 1
     assert volume_of((tmp_path / "grid.vtk").read_bytes(), "grid.vtk") == pytest.approx(expected, rel=1e-14)
+
+
+def test_alternating_cell_types_make_one_part_per_type(tmp_path: Path) -> None:
+    """Cells of two types interleaved: two parts (one per type), each cell keeping its own density."""
+    pts = np.array([*HEX, *[(x + 1.0, y, z) for x, y, z in HEX]], dtype=float)
+    cells = []
+    density = []
+    for k in range(6):
+        offset = 8 * (k % 2)
+        cells.append((12, [i + offset for i in range(8)]) if k % 3 else (10, [offset, offset + 1, offset + 3, offset + 4]))
+        density.append(1000.0 + k)
+    data = write_vtu(grid(cells, pts, density=density), tmp_path / "mixed.vtu")
+    loaded = load_body(data, filename="mixed.vtu")
+    assert [p.name for p in loaded.parts] == ["tetra_0", "hexahedron_1"]
+    expected = sum(rho * (1.0 if ctype == 12 else 1 / 6) for (ctype, _), rho in zip(cells, density))
+    assert assembly_properties([(p.body, None) for p in loaded.parts]).mass == pytest.approx(expected, rel=1e-14)
