@@ -13,7 +13,8 @@ WORKDIR /app
 
 # 1. dependencies, read from pyproject.toml alone (this layer is cached while it is unchanged)
 COPY pyproject.toml ./
-RUN python -c "import tomllib; print('\n'.join(tomllib.load(open('pyproject.toml', 'rb'))['project']['dependencies']))" \
+# (with the vtk extra: .vtk/.vtu files are read by VTK's own readers, which need no graphics libraries)
+RUN python -c "import tomllib; p = tomllib.load(open('pyproject.toml', 'rb'))['project']; print('\n'.join(p['dependencies'] + p['optional-dependencies']['vtk']))" \
         > /tmp/requirements.txt \
     && pip install -r /tmp/requirements.txt && rm /tmp/requirements.txt
 

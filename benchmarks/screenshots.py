@@ -97,7 +97,7 @@ def main() -> None:
             browser = p.chromium.launch(executable_path=args.chromium, args=ARGS)
             desktop = browser.new_page(viewport={"width": 1280, "height": 1400})
             _analyze(desktop, url, "l_bracket.stl")
-            desktop.screenshot(path=args.out / "asymmetric.png", clip={"x": 0, "y": 0, "width": 1280, "height": 760})
+            desktop.screenshot(path=args.out / "asymmetric.png", clip={"x": 0, "y": 0, "width": 1280, "height": 790})
             _analyze(desktop, url, "box.stl", **FLIP)
             _to_first_flip(desktop)
             desktop.screenshot(path=args.out / "tennis-racket.png", clip=_clip(desktop, "#view-section", "#motion"))

@@ -15,7 +15,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from .errors import EmptyGeometryError, InvalidParameterError
 
-__all__ = ["MeshBody", "VolumeBody", "CellBlock", "PointBody", "Part", "Body"]
+__all__ = ["MeshBody", "VolumeBody", "CellBlock", "PointBody", "BrepBody", "Part", "Body"]
 
 
 def _frozen(arr: ArrayLike, dtype: type[np.generic]) -> NDArray[Any]:
@@ -178,9 +178,26 @@ Body = MeshBody | VolumeBody | PointBody
 
 
 @dataclass(frozen=True, slots=True)
+class BrepBody:
+    """A solid of a CAD file, kept as its exact boundary representation.
+
+    solid : the CAD binding's solid (``inertia.cad.occ.Solid``; opaque here),
+        coordinates in the binding's model unit (millimetres), converted from
+        the file's own unit.
+    length_scale : metres per model unit: 1e-3, times (requested unit) /
+        (file unit) when the request overrides the file's unit.
+    """
+
+    solid: Any
+    length_scale: float = 1.0
+    name: str | None = None
+    warnings: tuple[str, ...] = ()
+
+
+@dataclass(frozen=True, slots=True)
 class Part:
     """One named body of a scene or assembly, already placed in the scene frame."""
 
     name: str
-    body: Body
+    body: Body | BrepBody
     extras: dict[str, object] = field(default_factory=dict)

@@ -279,14 +279,15 @@ class CellRule:
     """(n, q) contiguous: products with it run in BLAS (a transposed view takes a loop 400x slower)."""
     grad_t: NDArray[np.float64] = field(init=False)
     """(3, n, q) contiguous."""
-    shape_sum: NDArray[np.float64] = field(init=False)
-    """(q,) sum over nodes a >= 1 of |N_a|: bounds the positions' rounding with the edges."""
-    grad_sum: NDArray[np.float64] = field(init=False)
-    """(3, q) sum over nodes a >= 1 of |dN_a/dxi_d|."""
+    abs_shape_t: NDArray[np.float64] = field(init=False)
+    """|shape_t|: sum_a |N_a| |D_a| scales the positions' rounding."""
+    abs_grad_t: NDArray[np.float64] = field(init=False)
+    """|grad_t|: sum_a |dN_a| |D_a| scales each Jacobian entry's rounding."""
 
     def __post_init__(self) -> None:
-        derived = {"shape_t": np.ascontiguousarray(self.shape.T), "grad_t": np.ascontiguousarray(self.grad.transpose(0, 2, 1)),
-                   "shape_sum": np.abs(self.shape[:, 1:]).sum(axis=1), "grad_sum": np.abs(self.grad[:, :, 1:]).sum(axis=2)}
+        shape_t = np.ascontiguousarray(self.shape.T)
+        grad_t = np.ascontiguousarray(self.grad.transpose(0, 2, 1))
+        derived = {"shape_t": shape_t, "grad_t": grad_t, "abs_shape_t": np.abs(shape_t), "abs_grad_t": np.abs(grad_t)}
         for key, value in derived.items():
             value.flags.writeable = False
             object.__setattr__(self, key, value)
@@ -319,7 +320,7 @@ def shape_functions(name: str, xi: NDArray[np.float64]) -> tuple[NDArray[np.floa
 # ----------------------------------------------------------------------------------------------
 # Integration
 
-_BLOCK_POINTS = 1 << 18  # quadrature points per vectorised block: (cells, q) temporaries of ~2 MB
+_BLOCK_POINTS = 1 << 16  # quadrature points per vectorised block: its ~40 (cells, q) temporaries take ~20 MB
 
 
 def _jacobians(xyz: list[NDArray[np.float64]], cells: NDArray[np.int64], rule: CellRule
@@ -333,11 +334,11 @@ def _jacobians(xyz: list[NDArray[np.float64]], cells: NDArray[np.int64], rule: C
     nodes = [x.take(cells) for x in xyz]  # 3 of (c, n)
     base = [xk[:, :1] for xk in nodes]
     edges = [np.ascontiguousarray(xk[:, 1:] - b) for xk, b in zip(nodes, base)]  # 3 of (c, n - 1)
-    reach = [np.abs(e).max(axis=1, initial=0.0)[:, None] for e in edges]  # largest |D_a| per coordinate
+    magnitude = [np.abs(e) for e in edges]
     pos = [b + e @ rule.shape_t[1:] for b, e in zip(base, edges)]
-    pos_scale = [np.abs(b) + r * rule.shape_sum[None, :] for b, r in zip(base, reach)]
+    pos_scale = [np.abs(b) + m @ rule.abs_shape_t[1:] for b, m in zip(base, magnitude)]
     jac = [[e @ rule.grad_t[d, 1:] for e in edges] for d in range(3)]  # jac[d][k] = dx_k / dxi_d
-    jac_abs = [[r * rule.grad_sum[d][None, :] for r in reach] for d in range(3)]  # bounds of sum |dN_a| |D_a|
+    jac_abs = [[m @ rule.abs_grad_t[d, 1:] for m in magnitude] for d in range(3)]  # sum |dN_a| |D_a|
     a, b, c = jac
     det = (a[0] * (b[1] * c[2] - b[2] * c[1]) + a[1] * (b[2] * c[0] - b[0] * c[2]) + a[2] * (b[0] * c[1] - b[1] * c[0]))
     aa, ba, ca = jac_abs

@@ -78,7 +78,8 @@ def _quaternion(text: str) -> tuple[float, float, float, float]:
 def add_analysis_options(p: argparse.ArgumentParser) -> None:
     """Options shared by ``analyze`` and ``batch`` (the API's query parameters)."""
     p.add_argument("--format", help="file format; inferred from the name when absent")
-    p.add_argument("--units", help="length unit of the file: m, cm, mm, um, in, ft (default: the file's, else m)")
+    p.add_argument("--units", help="length unit of the file: m, cm, mm, um, in, ft, angstrom "
+                   "(default: the file's; angstrom for .xyz; else m)")
     group = p.add_mutually_exclusive_group()
     group.add_argument("--density", type=float, help="density in kg/m^3 (default 1000)")
     group.add_argument("--mass", type=float, help="total mass in kg (density is derived)")
@@ -88,6 +89,11 @@ def add_analysis_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("--reference", type=_triple, metavar="X,Y,Z",
                    help="point (file units): also report the tensor about it; negative values as written: -1,0,0")
     p.add_argument("--densities", help="JSON file: part name -> density (kg/m^3) for files of several parts")
+    p.add_argument("--geometry", choices=("brep", "mesh"),
+                   help="CAD files: integrate the exact B-rep (default) or a tessellation of it")
+    p.add_argument("--deflection", type=float,
+                   help="CAD files: tessellate (implies --geometry mesh) with this chordal deflection relative to "
+                   "the bounding-box diagonal (default 1e-3)")
     p.add_argument("--frame", type=_quaternion, metavar="W,X,Y,Z",
                    help="unit quaternion carrying a named frame's axes into the file's: also report the centre of "
                    "mass and tensors along that frame's axes")
@@ -121,6 +127,8 @@ def options_from_args(args: argparse.Namespace) -> Any:
         samples=getattr(args, "samples", None),
         method=getattr(args, "method", "exact"),
         densities=densities,
+        geometry=getattr(args, "geometry", None) or ("mesh" if getattr(args, "deflection", None) else "brep"),
+        deflection=getattr(args, "deflection", None),
         export=getattr(args, "export", None),
         frame=getattr(args, "frame", None),
         isotopes=getattr(args, "isotopes", "standard"),
@@ -355,6 +363,9 @@ def render_table(doc: dict[str, Any], output_units: str = "si") -> str:
                          f"moments {_vec(moments)} {inertia_unit}"))
     diag = doc["diagnostics"]
     rows.append(("relative error", f"{diag['relative_error_estimate']:.2g}"))
+    if "tessellation_error" in diag:
+        rows.append(("tessellation error", f"{diag['tessellation_error']:.2g} vs the exact B-rep "
+                     f"(deflection {doc['source'].get('deflection')})"))
     rows.append(("elapsed", f"{diag['elapsed_s'] * 1e3:.2f} ms"))
     width = max(len(k) for k, _ in rows)
     lines += [f"  {k:<{width}}  {v}" for k, v in rows]

@@ -216,8 +216,9 @@ def join_open_parts(parts: list[Part], tolerances: Tolerances = DEFAULT_TOLERANC
         if surface_topology(sub, len(v)).open_edges:
             continue
         names = [parts[open_ids[m]].name for m in members]
-        name = "+".join(names)
-        note = (f"parts {', '.join(repr(n) for n in names)} are open each but close together; "
+        name = "+".join(names) if len(names) <= 4 else f"{names[0]}+{len(names) - 1} more"
+        listed = ", ".join(repr(n) for n in names[:8]) + (f" and {len(names) - 8} more" if len(names) > 8 else "")
+        note = (f"{len(names)} parts ({listed}) are open each but close together; "
                 f"analysed as one body {name!r} (an open part bounds no volume of its own)")
         member_bodies = [bodies[m] for m in members]
         body = MeshBody(

@@ -279,3 +279,30 @@ def test_cli_export_prints_the_snippet_alone(tmp_path: Path) -> None:
 def test_export_rejects_an_unknown_format(client: Any) -> None:
     r = client.post("/v1/analyze/points", json={"points": POINTS, "export": "step"})
     assert r.status_code == 422 and r.json()["error"]["code"] == "invalid_parameter"
+
+
+@pytest.mark.parametrize("fmt", ["mjcf", "urdf"])
+def test_moments_rounded_just_past_the_triangle_inequality_still_load(fmt: str) -> None:
+    """A lamina's I3 one ulp above I1 + I2 (rounding) is written so that MuJoCo's exact check passes."""
+    from inertia.export import Inertial, inertial_snippet
+
+    i3 = np.nextafter(np.nextafter(3.0, 4.0), 4.0)  # 1 + 2 = 3 < i3 by two ulps: MuJoCo refuses these moments as they are
+    with pytest.raises(ValueError):
+        _mjcf_model([f'<inertial pos="0 0 0" mass="1" diaginertia="1 2 {i3!r}"/>'])
+    R = _rotation([0.3, 1.0, -0.4], 1.1)
+    body = Inertial(2.0, np.array([0.5, -0.25, 1.0]), R @ np.diag([1.0, 2.0, i3]) @ R.T, np.array([1.0, 2.0, i3]),
+                    R.T, _quaternion_of(R), relative_error=1e-15)
+    snippet = inertial_snippet(fmt, body)
+    assert any("planar" in w for w in snippet.warnings)
+    model = (_mjcf_model if fmt == "mjcf" else _urdf_model)([snippet.text])
+    mass, _, tensor = _compiled(model, 1)
+    assert mass == 2.0
+    np.testing.assert_allclose(tensor, body.tensor, rtol=0, atol=1e-13 * i3)
+
+
+def _quaternion_of(R: np.ndarray) -> np.ndarray:
+    """[w, x, y, z] of a rotation matrix (scipy's, scalar last, reordered)."""
+    from scipy.spatial.transform import Rotation
+
+    x, y, z, w = Rotation.from_matrix(R).as_quat()
+    return np.array([w, x, y, z])

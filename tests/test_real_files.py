@@ -2,18 +2,14 @@
 
 from __future__ import annotations
 
-import sys
-from pathlib import Path
-
 import pytest
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 from benchmarks.real_files import EXPECTED, run_one
 
 
 @pytest.mark.parametrize("rel", sorted(EXPECTED))
 def test_real_file_is_read_right_or_refused_with_a_reason(rel: str) -> None:
     row = run_one(rel)
-    assert row.outcome in ("read right", "refused"), f"{row.outcome}: {row.detail}"
+    assert row.outcome in ("read right", "read, no reference", "refused"), f"{row.outcome}: {row.detail}"
     if row.outcome == "refused":
         assert len(row.detail) > 40  # a sentence, not a bare library message

@@ -5,12 +5,13 @@ from __future__ import annotations
 import io
 import json
 import zipfile
+from pathlib import Path
 
 import numpy as np
 import pytest
 import trimesh
-from generate import box
 
+from benchmarks.cases import box
 from inertia.errors import (
     EmptyGeometryError,
     NotWatertightError,
@@ -278,3 +279,12 @@ def test_a_zip_slip_name_is_refused() -> None:
         zf.writestr("../../evil.obj", b"v 0 0 0\n")
     with pytest.raises(UnreadableFileError):
         load_body(buf.getvalue(), filename="upload.zip")
+
+
+def test_a_zip_needing_a_newer_extractor_is_unreadable_not_a_crash() -> None:
+    data = bytearray((Path(__file__).parent / "data/real/3mf/box.3mf").read_bytes())
+    at = data.index(b"PK\x01\x02")
+    data[at + 6 : at + 8] = (999).to_bytes(2, "little")  # "version needed to extract" 99.9
+    for name in ("box.3mf", "upload.zip"):
+        with pytest.raises(UnreadableFileError):
+            load_body(bytes(data), filename=name)

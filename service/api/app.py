@@ -12,10 +12,11 @@ from fastapi.security import APIKeyHeader
 
 from .compute import ComputePool
 from .errors import install_error_handlers
-from .middleware import AccessLog, Guard
+from .middleware import AccessLog, Guard, LastResort
 from .pages import install_pages
 from .routes import health, v1
 from .settings import Settings
+from .uploads import Workspace
 
 __all__ = ["create_app"]
 
@@ -38,7 +39,8 @@ def _configure_logging() -> None:
 def create_app(settings: Settings | None = None) -> FastAPI:
     settings = settings or Settings()  # type: ignore[call-arg]  # fields come from INERTIA_* variables
     _configure_logging()
-    pool = ComputePool(settings.compute_processes, settings.timeout_s)
+    pool = ComputePool(settings.compute_processes, settings.timeout_s, settings.max_waiting)
+    workspace = Workspace()
 
     @asynccontextmanager
     async def lifespan(app: FastAPI) -> AsyncIterator[None]:
@@ -47,17 +49,20 @@ def create_app(settings: Settings | None = None) -> FastAPI:
             yield
         finally:
             pool.close()
+            workspace.close()
 
     # docs_url/redoc_url off: install_pages serves both with vendored assets (no CDN)
     app = FastAPI(title="inertia", version="1", description=DESCRIPTION, lifespan=lifespan, docs_url=None, redoc_url=None)
     app.state.settings = settings
     app.state.pool = pool
+    app.state.workspace = workspace
     install_error_handlers(app)
     # the key is checked by Guard before the body is read; the dependency only documents it
     security = [Depends(APIKeyHeader(name="X-API-Key", auto_error=False))] if settings.api_key else []
     app.include_router(health)
     app.include_router(v1, dependencies=security)
     install_pages(app)
+    app.add_middleware(LastResort)
     app.add_middleware(Guard, settings=settings)
     app.add_middleware(AccessLog)
     return app

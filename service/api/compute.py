@@ -16,16 +16,26 @@ preloaded, so a replacement starts in milliseconds.
 
 Deadlines: waiting for a free process is bounded by ``timeout_s``, and the job
 itself by ``timeout_s`` from the moment it is handed over; starting a process
-is not counted.
+is not counted. At most ``max_waiting`` jobs wait for a process; one more is
+refused at once (503 ``server_busy`` with ``Retry-After``), so a burst of
+heavy uploads cannot pile up without bound.
+
+Memory: each job carries a limit (see :func:`memory_limit`); the compute
+process sets it as its address-space limit (``RLIMIT_AS``, above what the
+process already maps) for the job's duration and restores it after, so an
+input that needs more fails with ``MemoryError`` (413) in that process only.
 """
 
 from __future__ import annotations
 
 import asyncio
 import logging
+import math
 import multiprocessing
+import os
 import sys
 import threading
+import time
 import traceback
 from collections.abc import Iterator
 from concurrent.futures import ThreadPoolExecutor
@@ -33,10 +43,27 @@ from contextlib import contextmanager
 from multiprocessing.connection import Connection
 from typing import Any
 
-from ..errors import ComputeTimeoutError, ServiceError
-from .jobs import Job, run_job
+from ..errors import ComputeTimeoutError, ServerBusyError, ServiceError, UnreadableFileError
+from .jobs import Job, MeshJob, run_job
 
-__all__ = ["ComputePool", "WorkerCrashError"]
+__all__ = ["ComputePool", "WorkerCrashError", "memory_limit", "MEMORY_FLOOR_BYTES", "MEMORY_FACTOR",
+           "COMPRESSED_MEMORY_FACTOR"]
+
+MIB = 1024 * 1024
+# A job may map this much more than its process did before it, plus a multiple of its upload's size.
+# Measured peaks (docs/security.md): 3x the file for binary STL, 9-20x for OBJ/PLY/OFF/GLB text and
+# buffers, plus ~60 MiB of readers imported on first use; formats whose content is compressed (3MF,
+# VTK XML) may inflate up to 100x before parsing (load/guard.py), hence their larger factor.
+MEMORY_FLOOR_BYTES = 768 * MIB
+MEMORY_FACTOR = 32
+COMPRESSED_MEMORY_FACTOR = 256
+_COMPRESSED = (".3mf", ".vtu", ".vtp", ".vts", ".vtr", ".zip")
+
+
+def memory_limit(size: int, filename: str | None, cap: int) -> int:
+    """Bytes a job on an upload of ``size`` bytes may add to its process's address space."""
+    factor = COMPRESSED_MEMORY_FACTOR if (filename or "").lower().endswith(_COMPRESSED) else MEMORY_FACTOR
+    return min(cap, MEMORY_FLOOR_BYTES + factor * size)
 
 _ROOT = __name__.split(".")[0]  # "inertia" when installed; the folder's name when run from a checkout
 log = logging.getLogger("inertia.api")
@@ -57,6 +84,38 @@ def _context() -> multiprocessing.context.BaseContext:
     return multiprocessing.get_context("spawn")
 
 
+def _address_space() -> int | None:
+    """This process's mapped address space [bytes], where /proc tells it."""
+    try:
+        with open("/proc/self/statm") as fh:
+            return int(fh.read().split()[0]) * os.sysconf("SC_PAGE_SIZE")
+    except (OSError, ValueError, IndexError):
+        return None
+
+
+@contextmanager
+def _memory_bounded(limit: int | None) -> Iterator[None]:
+    """``RLIMIT_AS`` = what the process maps now + ``limit``, for the block only."""
+    try:
+        import resource
+    except ImportError:  # not on this platform: the deadline still bounds the job
+        yield
+        return
+    current = _address_space()
+    if limit is None or current is None:
+        yield
+        return
+    soft, hard = resource.getrlimit(resource.RLIMIT_AS)
+    wanted = current + limit
+    if hard != resource.RLIM_INFINITY:
+        wanted = min(wanted, hard)
+    resource.setrlimit(resource.RLIMIT_AS, (wanted, hard))
+    try:
+        yield
+    finally:
+        resource.setrlimit(resource.RLIMIT_AS, (soft, hard))
+
+
 def _serve_jobs(conn: Connection) -> None:
     """Main loop of a compute process: receive a job, send back its outcome."""
     while True:
@@ -65,7 +124,8 @@ def _serve_jobs(conn: Connection) -> None:
         except (EOFError, OSError):
             return
         try:
-            outcome: tuple[str, Any] = ("ok", run_job(job))
+            with _memory_bounded(job.memory_limit_bytes):
+                outcome: tuple[str, Any] = ("ok", run_job(job))
         except ServiceError as exc:
             outcome = ("error", exc)
         except BaseException:
@@ -123,12 +183,26 @@ class _Worker:
         self.process.join(KILL_GRACE_S)
 
 
+def _died_on(job: MeshJob, worker: _Worker) -> UnreadableFileError:
+    """A compute process that died while reading a client's file: a reader crashed on it (or ran out of memory
+    where a library aborts instead of raising); the file is the cause the client can act on."""
+    code = worker.process.exitcode
+    log.error("compute process died (exit code %s) on file %r", code, job.filename)
+    return UnreadableFileError(
+        f"the reader stopped abnormally on this file (exit code {code}); the file may be corrupt or need more "
+        f"than the {job.memory_limit_bytes or 0} bytes of memory allowed for it; check it or send a simpler one",
+        exit_code=code, limit_bytes=job.memory_limit_bytes)
+
+
 class ComputePool:
     """At most ``size`` jobs at once, each in its own reusable process."""
 
-    def __init__(self, size: int, timeout_s: float) -> None:
+    def __init__(self, size: int, timeout_s: float, max_waiting: int | None = None) -> None:
         self.size = size
         self.timeout_s = timeout_s
+        self.max_waiting = 4 * size if max_waiting is None else max_waiting
+        self._waiting = 0
+        self._job_s = 1.0  # running mean of job durations, for Retry-After
         self._ctx = _context()
         self._idle: list[_Worker] = []
         self._lock = threading.Lock()
@@ -154,14 +228,30 @@ class ComputePool:
     async def run(self, job: Job) -> dict[str, Any]:
         """The job's result; its ``ServiceError``, ``ComputeTimeoutError`` or ``WorkerCrashError``."""
         slots = self._slots_of(asyncio.get_running_loop())
+        if slots.locked() and self._waiting >= self.max_waiting:
+            raise self._busy()
+        self._waiting += 1
         try:
             await asyncio.wait_for(slots.acquire(), self.timeout_s)
         except TimeoutError:
-            raise self._timeout("the server is busy; no compute process became free") from None
+            raise self._timeout("the server is busy; no compute process became free",
+                                retry_after_s=self._retry_after()) from None
+        finally:
+            self._waiting -= 1
+        start = time.monotonic()
         try:
             return await self._run_in_worker(job)
         finally:
             slots.release()
+            self._job_s = 0.8 * self._job_s + 0.2 * (time.monotonic() - start)
+
+    def _retry_after(self) -> int:
+        return max(1, math.ceil(self._job_s * (self._waiting + 1) / self.size))
+
+    def _busy(self) -> ServerBusyError:
+        return ServerBusyError(f"the server is busy: {self.size} analyses are running and {self._waiting} are "
+                               "waiting; retry after the time in the Retry-After header",
+                               retry_after_s=self._retry_after(), waiting=self._waiting)
 
     def _slots_of(self, loop: asyncio.AbstractEventLoop) -> asyncio.Semaphore:
         # a semaphore belongs to one event loop; a server has one, test clients may make several
@@ -178,6 +268,11 @@ class ComputePool:
         except TimeoutError:
             await loop.run_in_executor(self._threads, worker.kill)
             raise self._timeout("the computation took too long and was stopped") from None
+        except WorkerCrashError as exc:
+            await loop.run_in_executor(self._threads, worker.kill)
+            if isinstance(job, MeshJob):
+                raise _died_on(job, worker) from exc
+            raise
         except BaseException:
             await asyncio.shield(loop.run_in_executor(self._threads, worker.kill))
             raise
@@ -188,9 +283,9 @@ class ComputePool:
             raise payload
         raise WorkerCrashError(f"compute process failed:\n{payload}")
 
-    def _timeout(self, what: str) -> ComputeTimeoutError:
+    def _timeout(self, what: str, **details: Any) -> ComputeTimeoutError:
         return ComputeTimeoutError(f"{what} (limit {self.timeout_s:g} s); send a smaller input or "
-                                   "raise INERTIA_TIMEOUT_S", timeout_s=self.timeout_s)
+                                   "raise INERTIA_TIMEOUT_S", timeout_s=self.timeout_s, **details)
 
     def _acquire(self) -> _Worker:
         with self._lock:

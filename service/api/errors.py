@@ -23,12 +23,13 @@ from ..errors import (
     InvalidParameterError,
     LoadError,
     PayloadTooLargeError,
+    ServerBusyError,
     ServiceError,
     UnauthorizedError,
     UnsupportedFormatError,
 )
 
-__all__ = ["STATUS", "error_response", "install_error_handlers", "status_of"]
+__all__ = ["STATUS", "error_response", "install_error_handlers", "status_of", "internal_error_response"]
 
 log = logging.getLogger("inertia.api")
 
@@ -43,6 +44,7 @@ STATUS: dict[type[ServiceError], int] = {
     PayloadTooLargeError: 413,
     UnauthorizedError: 401,
     ComputeTimeoutError: 503,
+    ServerBusyError: 503,
     ServiceError: 500,
 }
 
@@ -55,7 +57,22 @@ def status_of(exc: ServiceError) -> int:
 
 
 def error_response(exc: ServiceError) -> JSONResponse:
-    return JSONResponse(exc.as_dict(), status_code=status_of(exc))
+    status = status_of(exc)
+    headers = {}
+    retry = exc.details.get("retry_after_s")
+    if isinstance(retry, int):  # 503: when to come back
+        headers["Retry-After"] = str(retry)
+    if status >= 500 and status != 503:
+        headers["Connection"] = "close"  # a bug: start the client's next request on a fresh connection
+    return JSONResponse(exc.as_dict(), status_code=status, headers=headers)
+
+
+def internal_error_response() -> JSONResponse:
+    """The envelope of an unexpected failure; the connection is closed cleanly after it (``Connection: close``),
+    so a keep-alive client's next request goes on a new connection instead of into a reset one."""
+    return JSONResponse({"error": {"code": "internal_error", "message": "the server failed unexpectedly; the error "
+                                   "was logged, please report it with the input that caused it", "details": {}}},
+                        status_code=500, headers={"Connection": "close"})
 
 
 def _envelope(status: int, code: str, message: str, **details: Any) -> JSONResponse:
@@ -83,7 +100,7 @@ def invalid_request(exc: RequestValidationError) -> InvalidParameterError:
 
 async def _service_error(request: Request, exc: Exception) -> JSONResponse:
     assert isinstance(exc, ServiceError)
-    if status_of(exc) >= 500:
+    if status_of(exc) >= 500 and status_of(exc) != 503:
         log.error("internal error on %s %s: %s", request.method, request.url.path, exc.message)
     return error_response(exc)
 
@@ -106,8 +123,7 @@ async def _http_error(request: Request, exc: Exception) -> JSONResponse:
 
 async def _unexpected_error(request: Request, exc: Exception) -> JSONResponse:
     log.error("unexpected error on %s %s", request.method, request.url.path, exc_info=exc)
-    return _envelope(500, "internal_error", "the server failed unexpectedly; the error was logged, "
-                     "please report it with the input that caused it")
+    return internal_error_response()
 
 
 def install_error_handlers(app: FastAPI) -> None:

@@ -11,12 +11,13 @@ from typing import Any
 from starlette.types import ASGIApp, Message, Receive, Scope, Send
 
 from ..errors import PayloadTooLargeError, ServiceError, UnauthorizedError
-from .errors import error_response
+from .errors import error_response, internal_error_response
 from .settings import Settings
 
-__all__ = ["AccessLog", "Guard"]
+__all__ = ["AccessLog", "Guard", "LastResort"]
 
 access_log = logging.getLogger("inertia.api.access")
+log = logging.getLogger("inertia.api")
 
 PROTECTED_PREFIX = "/v1/"
 
@@ -49,6 +50,41 @@ class AccessLog:
                 "elapsed_ms": round((time.perf_counter() - start) * 1e3, 3),
                 "client": client[0] if client else None,
             }))
+
+
+class LastResort:
+    """An exception that escapes the app (a bug) becomes the 500 envelope with ``Connection: close``.
+
+    Starlette's outermost handler answers too, but then re-raises, and the
+    server drops the connection without saying so: a keep-alive client sends
+    its next request into a closed socket. Here the exception stops, logged;
+    the response tells the client to reconnect, and the server closes the
+    connection after it. A response already under way cannot be replaced; it
+    is ended (the client sees a truncated body, never a hang).
+    """
+
+    def __init__(self, app: ASGIApp) -> None:
+        self.app = app
+
+    async def __call__(self, scope: Scope, receive: Receive, send: Send) -> None:
+        if scope["type"] != "http":
+            await self.app(scope, receive, send)
+            return
+        started = False
+
+        async def tracked_send(message: Message) -> None:
+            nonlocal started
+            if message["type"] == "http.response.start":
+                started = True
+            await send(message)
+
+        try:
+            await self.app(scope, receive, tracked_send)
+        except Exception as exc:
+            log.error("unexpected error on %s %s", scope.get("method"), scope.get("path"), exc_info=exc)
+            if started:
+                raise
+            await internal_error_response()(scope, receive, send)
 
 
 class Guard:

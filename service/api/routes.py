@@ -6,10 +6,13 @@ from typing import Annotated, Any
 
 from fastapi import APIRouter, Depends, File, Query, Request, UploadFile
 from fastapi.responses import StreamingResponse
+from starlette.background import BackgroundTask
+from starlette.concurrency import run_in_threadpool
 
-from ..load.sniff import POINT_FORMATS, SCENE_FORMATS, SURFACE_FORMATS, VOLUME_FORMATS
-from .compute import ComputePool
-from .jobs import MeshJob, PointsJob, PrecessionJob
+from ..load.sniff import CAD_FORMATS, POINT_FORMATS, SCENE_FORMATS, SURFACE_FORMATS, VOLUME_FORMATS
+from .compute import ComputePool, memory_limit
+from .formats import unavailable_formats
+from .jobs import Job, MeshJob, PointsJob, PrecessionJob, is_small, run_job
 from .ndjson import batch_lines
 from .schemas import (
     AnalysisOut,
@@ -21,9 +24,10 @@ from .schemas import (
     PointsRequest,
     PrecessionRequest,
     PrecessionResponse,
+    UnavailableFormatOut,
 )
 from .settings import Settings
-from .uploads import Upload, client_name, expand
+from .uploads import Upload, Workspace, client_name, expand, save
 
 __all__ = ["health", "v1"]
 
@@ -36,10 +40,17 @@ def _settings(request: Request) -> Settings:
     return request.app.state.settings  # type: ignore[no-any-return]
 
 
+def _workspace(request: Request) -> Workspace:
+    return request.app.state.workspace  # type: ignore[no-any-return]
+
+
 Pool = Annotated[ComputePool, Depends(_pool)]
 Config = Annotated[Settings, Depends(_settings)]
+Folders = Annotated[Workspace, Depends(_workspace)]
 Options = Annotated[MeshQuery, Query()]
-MeshFile = Annotated[UploadFile, File(description="the mesh file (any format of GET /v1/formats)")]
+MeshFile = Annotated[list[UploadFile], File(description="the mesh file (any format of GET /v1/formats); for a model "
+                                              "with companion files (.gltf + .bin, TetGen .ele + .node), one "
+                                              "'file' part each, or one .zip of them")]
 MeshFiles = Annotated[list[UploadFile], File(description="mesh files, or one .zip of them")]
 
 health = APIRouter()
@@ -58,41 +69,70 @@ async def healthz() -> dict[str, str]:
 
 @v1.get("/formats", response_model=FormatsOut, tags=["service"])
 async def formats() -> FormatsOut:
-    """The readable formats, and which hold surfaces, volume cells, or scenes of several parts."""
-    kinds = [(f, "surface") for f in SURFACE_FORMATS] + [(f, "volume") for f in VOLUME_FORMATS]
-    kinds += [(f, "points") for f in POINT_FORMATS]
+    """The formats this installation can read, and which hold surfaces, volume cells, or scenes of several parts.
+
+    A format whose reader needs a package that is not installed is left out of the lists and named under
+    ``unavailable`` with the extra that enables it."""
+    missing = unavailable_formats()
+    surface = [f for f in SURFACE_FORMATS if f not in missing]
+    volume = [f for f in VOLUME_FORMATS if f not in missing]
+    points = [f for f in POINT_FORMATS if f not in missing]
+    cad = [f for f in CAD_FORMATS if f not in missing]
+    kinds = [(f, "surface") for f in surface] + [(f, "volume") for f in volume] + [(f, "points") for f in points]
+    kinds += [(f, "cad") for f in cad]
     table = [FormatOut(format=f, kind=k, parts=f in SCENE_FORMATS)  # type: ignore[arg-type]
              for f, k in kinds]
-    return FormatsOut(formats=table, surface=list(SURFACE_FORMATS), volume=list(VOLUME_FORMATS), scene=list(SCENE_FORMATS),
-                      points=list(POINT_FORMATS))
+    return FormatsOut(formats=table, surface=surface, volume=volume,
+                      scene=[f for f in SCENE_FORMATS if f not in missing], points=points, cad=cad,
+                      unavailable=[UnavailableFormatOut(format=f, needs=n) for f, n in sorted(missing.items())])
 
 
 @v1.post("/analyze/mesh", response_model=AnalysisOut, response_model_exclude_none=True,
          responses=_UNSUPPORTED, tags=["analysis"], description=_CURL)
-async def analyze_mesh(file: MeshFile, query: Options, pool: Pool) -> dict[str, Any]:
+async def analyze_mesh(file: MeshFile, query: Options, pool: Pool, settings: Config,
+                       workspace: Folders) -> dict[str, Any]:
     """Mass properties, principal frame and class of one uploaded mesh (and its precession with omega)."""
     options = query.as_options()
-    return await pool.run(MeshJob(await file.read(), client_name(file.filename), options))
+    folder = workspace.folder()
+    try:  # the upload goes to private files in blocks; the compute process gets their paths
+        saved = [await run_in_threadpool(save, part.file, folder, i, settings.max_upload_bytes)
+                 for i, part in enumerate(file)]
+        names = [client_name(part.filename) for part in file]
+        size = sum(s for _, s in saved)
+        limit = memory_limit(size, names[0] if len(names) == 1 else ".zip", settings.max_job_memory_bytes)
+        source: str | tuple[tuple[str, str], ...] = saved[0][0] if len(saved) == 1 else \
+            tuple((name or f"file-{i}", path) for i, (name, (path, _)) in enumerate(zip(names, saved)))
+        return await pool.run(MeshJob(source, names[0] if len(saved) == 1 else None, options, folder, limit))
+    finally:  # after success, error, timeout or a killed process alike: the job's process has stopped using it
+        workspace.remove(folder)
+
+
+async def _small_or_pooled(job: Job, pool: ComputePool) -> dict[str, Any]:
+    # a small job (a few points, no trajectory) costs less than the round trip to a compute process
+    return run_job(job) if is_small(job) else await pool.run(job)
 
 
 @v1.post("/analyze/points", response_model=AnalysisOut, response_model_exclude_none=True, tags=["analysis"])
 async def analyze_points(body: PointsRequest, pool: Pool) -> dict[str, Any]:
     """Mass properties, principal frame and class of point masses."""
-    return await pool.run(PointsJob(body.records(), body.as_options()))
+    return await _small_or_pooled(PointsJob(body.records(), body.as_options()), pool)
 
 
 @v1.post("/precession", response_model=PrecessionResponse, response_model_exclude_none=True, tags=["analysis"])
 async def precession(body: PrecessionRequest, pool: Pool) -> dict[str, Any]:
     """Torque-free motion of a body of known inertia."""
-    return await pool.run(PrecessionJob(body.arguments()))
+    return await _small_or_pooled(PrecessionJob(body.arguments()), pool)
 
 
 @v1.post("/batch", tags=["analysis"], responses={200: {
     "description": "one line per file, in upload order: an analysis result or {source, error}",
     "content": {"application/x-ndjson": {"schema": {"type": "string"}}}}})
-async def batch(files: MeshFiles, query: Options, pool: Pool, settings: Config) -> StreamingResponse:
+async def batch(files: MeshFiles, query: Options, pool: Pool, settings: Config,
+                workspace: Folders) -> StreamingResponse:
     """Many meshes (or one .zip of them), streamed as NDJSON lines as each result is ready."""
     options = query.as_options()
-    items = expand([Upload(f.filename, f.file) for f in files], settings.max_upload_bytes)
-    return StreamingResponse(batch_lines(items, options, pool, window=pool.size + 1),
-                             media_type="application/x-ndjson")
+    folder = workspace.folder()  # removed by the stream when it ends, and by the task after the response
+    items = expand([Upload(f.filename, f.file) for f in files], folder, settings.max_upload_bytes)
+    lines = batch_lines(items, options, pool, pool.size + 1, folder, settings.max_job_memory_bytes)
+    return StreamingResponse(lines, media_type="application/x-ndjson",
+                             background=BackgroundTask(workspace.remove, folder))

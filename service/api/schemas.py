@@ -19,6 +19,7 @@ from ..pipeline import METHODS, AnalysisOptions
 __all__ = [
     "MeshQuery", "PointIn", "PointsRequest", "PrecessionRequest",
     "AnalysisOut", "PrecessionOut", "PrecessionResponse", "ErrorOut", "HealthOut", "FormatsOut",
+    "UnavailableFormatOut",
     "ERROR_RESPONSES",
 ]
 
@@ -84,6 +85,9 @@ def _densities(text: str | None) -> dict[str, float] | None:
     except ValueError as exc:
         raise InvalidParameterError(f"densities must be a JSON object of finite numbers: {exc}",
                                     parameter="densities") from None
+    except RecursionError:
+        raise InvalidParameterError('densities nests too deeply; send a flat JSON object {"part name": density}',
+                                    parameter="densities") from None
     if not isinstance(value, dict) or not all(
             isinstance(v, (int, float)) and not isinstance(v, bool) for v in value.values()):
         raise InvalidParameterError('densities must be a JSON object {"part name": density in kg/m^3}',
@@ -96,7 +100,8 @@ class MeshQuery(_Request):
 
     format: str | None = Field(None, description="file format (stl, obj, ply, off, glb, gltf, 3mf, vtu, vtk, msh, "
                                "...); inferred from the file name when absent", examples=["stl"])
-    units: str | None = Field(None, description="length unit of the file: m, cm, mm, um, in, ft (default m)",
+    units: str | None = Field(None, description="length unit of the file: m, cm, mm, um, in, ft, angstrom "
+                              "(default m; angstrom for xyz)",
                               examples=["m"])
     density: float | None = Field(None, gt=0, le=MAX_MAGNITUDE,
                                   description="density [kg/m^3] (default 1000); exclusive with mass")
@@ -115,6 +120,10 @@ class MeshQuery(_Request):
     method: Method = Field("exact", description="with omega: exact, dop853, rk45 or splitting")
     densities: str | None = Field(None, description="JSON object: part name -> density [kg/m^3]",
                                   examples=['{"bracket": 7850}'])
+    geometry: Literal["brep", "mesh"] = Field("brep", description="CAD files (STEP, IGES): integrate the exact "
+                                              "B-rep (brep) or its tessellation (mesh)")
+    deflection: float | None = Field(None, gt=0, lt=1, description="with geometry=mesh: chordal deflection "
+                                     "relative to the bounding-box diagonal [1] (default 1e-3)")
     export: ExportFormat | None = Field(None, description="urdf, sdf or mjcf: adds the format's inertial element")
     frame: str | None = Field(None, description="'w,x,y,z' unit quaternion carrying a named frame's axes into the "
                               "input frame: adds the frame section", examples=["1,0,0,0"])
@@ -127,7 +136,8 @@ class MeshQuery(_Request):
             thickness=self.thickness, tolerance=self.tolerance, reference=_triple("reference", self.reference),
             omega=_triple("omega", self.omega), duration=self.duration, samples=self.samples,
             method=self.method, densities=_densities(self.densities),
-            export=self.export, frame=_quaternion(self.frame), isotopes=self.isotopes)
+            export=self.export, frame=_quaternion(self.frame), isotopes=self.isotopes,
+            geometry=self.geometry, deflection=self.deflection)
 
 
 class PointIn(_Request):
@@ -222,7 +232,7 @@ class _Out(BaseModel):
 class SourceOut(_Out):
     filename: str | None = None
     format: str
-    kind: str = Field(description="mesh, volume or points")
+    kind: str = Field(description="mesh, volume, points or cad")
     units: str
     vertices: int | None = None
     triangles: int | None = None
@@ -311,6 +321,8 @@ class ExportOut(_Out):
 class DiagnosticsOut(_Out):
     elapsed_s: float
     relative_error_estimate: float
+    tessellation_error: float | None = Field(None, description="geometry=mesh: largest relative difference of "
+                                             "mass and principal moments to the exact B-rep [1]")
 
 
 class AnalysisOut(_Out):
@@ -359,8 +371,13 @@ class HealthOut(BaseModel):
 
 class FormatOut(BaseModel):
     format: str
-    kind: Literal["surface", "volume", "points"] = Field(description="what the file holds")
+    kind: Literal["surface", "volume", "points", "cad"] = Field(description="what the file holds")
     parts: bool = Field(description="whether a file can hold several bodies (scene or assembly)")
+
+
+class UnavailableFormatOut(BaseModel):
+    format: str
+    needs: str = Field(description="what to install to read it (an extra of this package, or a package)")
 
 
 class FormatsOut(BaseModel):
@@ -369,6 +386,9 @@ class FormatsOut(BaseModel):
     volume: list[str] = Field(description="formats of volume meshes (tetrahedra, hexahedra, ...)")
     scene: list[str] = Field(description="formats that can hold several parts")
     points: list[str] = Field(description="formats of point-mass tables")
+    cad: list[str] = Field(default_factory=list, description="CAD formats (B-rep solids; the 'cad' extra)")
+    unavailable: list[UnavailableFormatOut] = Field(
+        default_factory=list, description="formats known to the service that this installation cannot read")
 
 
 def _error(description: str) -> dict[str, Any]:

@@ -31,3 +31,7 @@ class Settings(BaseSettings):
     api_key: str | None = Field(None, description="when set, /v1/ needs the header X-API-Key with this value")
     compute_processes: int = Field(default_factory=_default_processes, gt=0,
                                    description="worker processes that run the analyses")
+    max_waiting: int = Field(64, ge=0, description="jobs that may wait for a busy compute pool before more get "
+                             "503 server_busy (each waits at most timeout_s; its upload is on disk meanwhile)")
+    max_job_memory_bytes: int = Field(8192 * MIB, gt=0, description="most memory one analysis may add to its "
+                                      "compute process, whatever the upload's size [bytes]")

@@ -46,8 +46,8 @@ __all__ = [
     "read_source",
 ]
 
-# mesh formats (points files are JSON/CSV, too generic to pick up from a folder)
-KNOWN_EXTENSIONS = frozenset(FORMATS) | {"stla", "stlb"}
+# mesh formats, CAD files and XYZ molecules (points files in JSON/CSV are too generic to pick up from a folder)
+KNOWN_EXTENSIONS = frozenset(FORMATS) | {"stla", "stlb", "xyz", "stp", "igs"}  # xyz: molecules, a specific enough name
 ZIP_EXTENSION = "zip"
 
 

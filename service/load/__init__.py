@@ -9,11 +9,11 @@ from dataclasses import dataclass, replace
 import numpy as np
 from numpy.typing import NDArray
 
-from ..body import Body, MeshBody, Part, PointBody, VolumeBody
+from ..body import Body, BrepBody, MeshBody, Part, PointBody, VolumeBody
 from ..conventions import length_scale
 from ..errors import EmptyGeometryError, UnreadableFileError
 from .guard import check_upload
-from .sniff import FORMATS, POINT_FORMATS, SCENE_FORMATS, SURFACE_FORMATS, VOLUME_FORMATS, sniff_format
+from .sniff import CAD_FORMATS, FORMATS, POINT_FORMATS, SCENE_FORMATS, SURFACE_FORMATS, VOLUME_FORMATS, sniff_format
 from .upload import pick_model_file, unpack_zip
 
 XYZ_UNIT = "angstrom"  # the XYZ format's length unit (coordinates in angstrom, as chemistry programs write them)
@@ -25,8 +25,9 @@ __all__ = ["Loaded", "load_body", "load_points", "FORMATS", "SURFACE_FORMATS", "
 class Loaded:
     """What was read: one or more parts and where they came from.
 
-    kind : "mesh" (surface), "volume" (volume cells) or "points".
+    kind : "mesh" (surface), "volume" (volume cells), "points" or "cad" (B-rep solids).
     units : the length unit used; units_from : "request", "file" or "default".
+    warnings : what the loader assumed (besides each body's own).
     """
 
     parts: tuple[Part, ...]
@@ -35,9 +36,10 @@ class Loaded:
     kind: str
     units: str
     units_from: str
+    warnings: tuple[str, ...] = ()
 
     @property
-    def body(self) -> Body:
+    def body(self) -> Body | BrepBody:
         """The single body (first part)."""
         return self.parts[0].body
 
@@ -124,6 +126,11 @@ def _load_bytes(data: bytes, filename: str | None, format: str | None, units: st
     fmt = sniff_format(filename, format, bytes(data[:512]))
     # includes, external references, inflation bounds: before any reader
     check_upload(data, fmt, companions=tuple(companions or ()))
+    if fmt in CAD_FORMATS:
+        from ..cad import read_cad_parts
+
+        cad_parts, unit, units_from, warnings = read_cad_parts(data, fmt, units)
+        return Loaded(tuple(cad_parts), filename, fmt, "cad", unit, units_from, warnings)
     xyz_default = fmt == "xyz" and units is None
     if xyz_default:
         units = XYZ_UNIT

@@ -305,7 +305,7 @@ def _b64(text: bytes) -> bytes | None:
 def _check_zip(data: bytes, ctx: _Context) -> None:
     try:
         archive = zipfile.ZipFile(io.BytesIO(data))
-    except (zipfile.BadZipFile, OSError, ValueError, EOFError) as exc:
+    except (zipfile.BadZipFile, OSError, ValueError, EOFError, NotImplementedError) as exc:
         raise UnreadableFileError(f"the {ctx.fmt.upper()} file is not a readable zip package ({exc})",
                                   format=ctx.fmt) from None
     with archive:

@@ -37,7 +37,7 @@ def read_surface_parts(data: bytes, fmt: str, length_scale: float,
     if fmt == "obj":
         from .obj import read_obj
 
-        groups = read_obj(data)
+        groups = guarded_read(lambda: read_obj(data), fmt)  # our reader; any slip still becomes a sentence
         parts = [mesh_part(name or "body", v, f, length_scale, "obj") for name, v, f in groups]
         if len(parts) == 1 and not groups[0][0]:
             parts = [mesh_part("body", groups[0][1], groups[0][2], length_scale, "obj")]
@@ -45,7 +45,7 @@ def read_surface_parts(data: bytes, fmt: str, length_scale: float,
     if fmt == "3mf":
         from .threemf import read_3mf
 
-        model = read_3mf(data)
+        model = guarded_read(lambda: read_3mf(data), fmt)
         parts = [mesh_part(name, v, f, length_scale, "3mf") for name, v, f in model.parts]
         return parts, model.unit, model.notes
     parts, unit = read_trimesh_parts(data, fmt, length_scale, companions)

@@ -48,50 +48,114 @@ def _lines(data: bytes) -> list[str]:
 
 
 def read_obj(data: bytes) -> list[tuple[str, NDArray[np.float64], NDArray[np.int64]]]:
-    """(name, vertices, triangles) of each named group, in order of first use; vertices shared (all of them)."""
-    coords: list[list[str]] = []
-    faces_by_part: dict[str, list[list[int]]] = {}
+    """(name, vertices, triangles) of each named group, in order of first use; vertices shared (all of them).
+
+    One pass sorts the lines by kind (and records, for each face line, its
+    group and how many vertices precede it); numbers are then converted by
+    numpy in bulk.  A line that breaks a rule is found again and named.
+    """
+    lines = _lines(data)
+    v_rows: list[list[str]] = []
+    v_line: list[int] = []
+    f_rows: list[list[str]] = []
+    f_line: list[int] = []
+    f_part: list[int] = []
+    f_seen: list[int] = []
+    names: dict[str, int] = {}
     obj_name, group_name = "", ""
-    current: list[list[int]] | None = None
-    for line_no, raw in enumerate(_lines(data), start=1):
-        line = raw.split("#", 1)[0].strip()
-        if not line:
+    part = -1
+    for line_no, raw in enumerate(lines, start=1):
+        if raw[:2] in ("vt", "vn", "vp"):  # texture coordinates, normals: not geometry (skipped unsplit: fast)
             continue
-        head, _, rest = line.partition(" ")
+        if "#" in raw:
+            raw = raw.split("#", 1)[0]
+        tokens = raw.split()
+        if not tokens:
+            continue
+        head = tokens[0]
         if head == "v":
-            values = rest.split()
-            if len(values) not in (3, 4, 6, 7):
-                raise _fail(line_no, line, f"gives {len(values)} numbers; a vertex needs x y z (and optionally w, "
-                            "or r g b)")
-            if len(values) in (4, 7) and _number(values[3], line_no, line) != 1.0:
-                raise _fail(line_no, line, "has a weight w other than 1, which only curves use")
-            coords.append(values[:3])
+            v_rows.append(tokens)
+            v_line.append(line_no)
         elif head == "f":
-            corners = rest.split()
-            if len(corners) < 3:
-                raise _fail(line_no, line, f"has {len(corners)} corners; a face needs at least 3")
-            idx = [_index(c, len(coords), line_no, line) for c in corners]
-            if current is None:
-                current = faces_by_part.setdefault(_part_name(obj_name, group_name), [])
-            current.extend([idx[0], idx[k], idx[k + 1]] for k in range(1, len(idx) - 1))
+            if part < 0:
+                part = names.setdefault(_part_name(obj_name, group_name), len(names))
+            f_rows.append(tokens)
+            f_line.append(line_no)
+            f_part.append(part)
+            f_seen.append(len(v_rows))
         elif head == "o":
-            obj_name, group_name, current = rest.strip(), "", None
+            obj_name, group_name, part = " ".join(tokens[1:]), "", -1
         elif head == "g":
-            group_name, current = rest.strip(), None
-    if not coords:
+            group_name, part = " ".join(tokens[1:]), -1
+    if not v_rows:
         raise EmptyGeometryError("the OBJ file has no vertices (v lines); send a mesh with geometry", format="obj")
-    try:
-        vertices = np.array(coords, dtype=np.float64)
-    except ValueError as exc:
-        bad = next(i for i, c in enumerate(coords) if not all(_is_number(x) for x in c))
-        raise UnreadableFileError(f"vertex {bad + 1} of the OBJ file has a coordinate that is not a number "
-                                  f"({' '.join(coords[bad])!r}); fix it or re-export the file", format="obj") from exc
-    parts = [(name, vertices, np.array(tris, dtype=np.int64).reshape(-1, 3)) for name, tris in faces_by_part.items()
-             if tris]
-    if not parts:
+    vertices = _vertices(v_rows, v_line, lines)
+    if not f_rows:
         raise EmptyGeometryError("the OBJ file has vertices but no faces (f lines); a solid needs triangles or "
                                  "polygons", format="obj")
+    triangles, owner = _faces(f_rows, f_line, f_part, f_seen, lines)
+    order = sorted(names, key=names.__getitem__)
+    parts = []
+    for index, name in enumerate(order):
+        tris = triangles[owner == index]
+        if len(tris):
+            parts.append((name, vertices, tris))
     return parts
+
+
+def _vertices(rows: list[list[str]], line_nos: list[int], lines: list[str]) -> NDArray[np.float64]:
+    counts = np.fromiter((len(r) - 1 for r in rows), dtype=np.int64, count=len(rows))
+    bad = np.flatnonzero(~np.isin(counts, (3, 4, 6, 7)))
+    if len(bad):
+        i = int(bad[0])
+        raise _fail(line_nos[i], lines[line_nos[i] - 1].strip(), f"gives {counts[i]} numbers; a vertex needs x y z "
+                    "(and optionally w, or r g b)")
+    try:
+        xyz = np.array([r[1:4] for r in rows], dtype=np.float64)
+        weighted = np.flatnonzero(np.isin(counts, (4, 7)))
+        w = np.array([rows[i][4] for i in weighted], dtype=np.float64)
+    except ValueError:
+        for i, r in enumerate(rows):
+            for text in r[1:5] if counts[i] in (4, 7) else r[1:4]:
+                _number(text, line_nos[i], lines[line_nos[i] - 1].strip())
+        raise  # unreachable: some number failed above
+    if np.any(w != 1.0):
+        i = int(weighted[np.flatnonzero(w != 1.0)[0]])
+        raise _fail(line_nos[i], lines[line_nos[i] - 1].strip(), "has a weight w other than 1, which only curves use")
+    return xyz
+
+
+def _faces(rows: list[list[str]], line_nos: list[int], part: list[int], seen: list[int],
+           lines: list[str]) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
+    """Triangles (0-based, polygons split into fans from their first corner) and the part of each."""
+    corners = np.fromiter((len(r) - 1 for r in rows), dtype=np.int64, count=len(rows))
+    short = np.flatnonzero(corners < 3)
+    if len(short):
+        i = int(short[0])
+        raise _fail(line_nos[i], lines[line_nos[i] - 1].strip(), f"has {corners[i]} corners; a face needs at least 3")
+    flat = [c.split("/", 1)[0] if "/" in c else c for r in rows for c in r[1:]]
+    try:
+        refs = np.array(flat, dtype=np.int64)
+    except (ValueError, OverflowError):
+        for i, r in enumerate(rows):
+            for c in r[1:]:
+                _index(c, seen[i], line_nos[i], lines[line_nos[i] - 1].strip())
+        raise
+    face_of = np.repeat(np.arange(len(rows)), corners)
+    before = np.asarray(seen, dtype=np.int64)[face_of]
+    idx = np.where(refs > 0, refs - 1, before + refs)
+    bad = np.flatnonzero((refs == 0) | (idx < 0) | (idx >= before))
+    if len(bad):
+        i = int(face_of[bad[0]])
+        raise _fail(line_nos[i], lines[line_nos[i] - 1].strip(),
+                    f"refers to vertex {int(refs[bad[0]])}, but only {seen[i]} vertices come before it")
+    starts = np.concatenate([[0], np.cumsum(corners)[:-1]])
+    fans = corners - 2  # triangles per face
+    tri_face = np.repeat(np.arange(len(rows)), fans)
+    k = np.arange(len(tri_face)) - np.repeat(np.cumsum(fans) - fans, fans)  # fan step within its face
+    first = starts[tri_face]
+    triangles = np.stack([idx[first], idx[first + 1 + k], idx[first + 2 + k]], axis=1)
+    return triangles, np.asarray(part, dtype=np.int64)[tri_face]
 
 
 def _part_name(obj_name: str, group_name: str) -> str:
@@ -100,19 +164,11 @@ def _part_name(obj_name: str, group_name: str) -> str:
     return group_name or obj_name or ""
 
 
-def _is_number(text: str) -> bool:
-    try:
-        float(text)
-    except ValueError:
-        return False
-    return True
-
-
 def _number(text: str, line_no: int, line: str) -> float:
     try:
         return float(text)
     except ValueError:
-        raise _fail(line_no, line, f"has {text!r} where a number belongs") from None
+        raise _fail(line_no, line, f"has {text!r}, which is not a number, where a coordinate belongs") from None
 
 
 def _index(corner: str, count: int, line_no: int, line: str) -> int:

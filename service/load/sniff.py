@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from ..errors import UnsupportedFormatError
 
-__all__ = ["SURFACE_FORMATS", "VOLUME_FORMATS", "SCENE_FORMATS", "POINT_FORMATS", "sniff_format", "FORMATS"]
+__all__ = ["SURFACE_FORMATS", "VOLUME_FORMATS", "SCENE_FORMATS", "POINT_FORMATS", "CAD_FORMATS", "sniff_format", "FORMATS"]
 
 # surface meshes read through our STL reader or trimesh
 SURFACE_FORMATS = ("stl", "obj", "ply", "off", "glb", "gltf", "3mf")
@@ -23,11 +23,13 @@ VOLUME_FORMATS = {
     "ele": "tetgen",
 }
 # formats that can hold several named bodies
-SCENE_FORMATS = ("glb", "gltf", "3mf", "obj", "vtu", "vtk", "msh", "mesh", "inp", "xdmf", "med")
+SCENE_FORMATS = ("glb", "gltf", "3mf", "obj", "vtu", "vtk", "msh", "mesh", "inp", "xdmf", "med", "step", "iges")
 POINT_FORMATS = ("json", "csv", "xyz")  # xyz: atoms by element, in angstrom
-FORMATS = SURFACE_FORMATS + tuple(VOLUME_FORMATS)
+# B-rep solids read through OpenCASCADE (the ``cad`` extra)
+CAD_FORMATS = ("step", "iges")
+FORMATS = SURFACE_FORMATS + tuple(VOLUME_FORMATS) + CAD_FORMATS
 
-_ALIASES = {"gmsh": "msh", "stla": "stl", "stlb": "stl", "ascii_stl": "stl"}
+_ALIASES = {"gmsh": "msh", "stla": "stl", "stlb": "stl", "ascii_stl": "stl", "stp": "step", "igs": "iges"}
 
 
 def sniff_format(filename: str | None, declared: str | None, head: bytes = b"") -> str:
@@ -71,4 +73,8 @@ def _from_content(head: bytes) -> str | None:
         return "stl"
     if b"<VTKFile" in head[:200]:
         return "vtu"
+    if head.lstrip().startswith(b"ISO-10303-21"):
+        return "step"
+    if len(head) >= 80 and head[72:73] == b"S" and head[73:80].strip().isdigit():  # IGES start section, column 73
+        return "iges"
     return None

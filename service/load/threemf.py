@@ -117,7 +117,7 @@ def read_3mf(data: bytes) -> ThreeMF:
     try:
         archive = zipfile.ZipFile(io.BytesIO(data))
         names = {"/" + n.lstrip("/").lower(): n for n in archive.namelist()}
-    except (zipfile.BadZipFile, OSError, ValueError, EOFError) as exc:
+    except (zipfile.BadZipFile, OSError, ValueError, EOFError, NotImplementedError) as exc:
         raise UnreadableFileError("the 3MF file is not a readable zip package (truncated or not a 3MF file); "
                                   "check the file or re-export it", format="3mf") from exc
     reader = _Reader(archive, names)

@@ -29,7 +29,7 @@ def unpack_zip(data: bytes) -> list[tuple[str, bytes]]:
     try:
         archive = zipfile.ZipFile(io.BytesIO(data))
         infos = [i for i in archive.infolist() if not i.is_dir()]
-    except (zipfile.BadZipFile, OSError, ValueError, EOFError) as exc:
+    except (zipfile.BadZipFile, OSError, ValueError, EOFError, NotImplementedError) as exc:
         raise UnreadableFileError("the upload is not a readable zip archive (truncated or corrupt); check the file",
                                   format="zip") from exc
     infos = [i for i in infos if not any(p.startswith((".", "__MACOSX")) for p in i.filename.split("/"))]

@@ -269,13 +269,14 @@ def _mesh_from_grid(grid: Any, to_numpy: Any, label: str) -> _Mesh:
     for t in np.unique(types):
         if int(t) not in VTK_CELL_TYPES:
             mesh.other[_VTK_2D_NAMES.get(int(t), f"VTK cell type {int(t)}")] = int(np.count_nonzero(types == t))
-    runs = np.flatnonzero(np.diff(types)) + 1
-    for start, stop in zip(np.r_[0, runs], np.r_[runs, len(types)]):
-        vtk_type = int(types[start])
+    # one block per cell type, in order of first appearance (as meshio groups a VTK file's cells; by type, not
+    # by consecutive runs, so a mesh whose types alternate does not become thousands of parts)
+    present, first = np.unique(types, return_index=True)
+    for vtk_type in (int(t) for t in present[np.argsort(first)]):
         if vtk_type not in VTK_CELL_TYPES:
             continue
         name = VTK_CELL_TYPES[vtk_type]
-        ids = np.arange(start, stop)
+        ids = np.flatnonzero(types == vtk_type)
         nodes = _fixed_width(conn, offsets, ids, _NODES[name], name, label, mesh.warnings)
         if name == "voxel":
             nodes, name = nodes[:, VOXEL_TO_HEXAHEDRON], "hexahedron"

@@ -198,6 +198,11 @@ async function analyze() {
   try {
     state.source = currentSource();
     motion = motionOptions();
+    for (const id of ['density', 'mass']) {
+      if (state.source.kind === 'points' && number(id) !== undefined) {
+        throw Object.assign(new Error(`point masses carry their own masses: leave ${id} empty`), { field: id });
+      }
+    }
   } catch (e) {
     showError(e.field || 'request', e.message);
     return;

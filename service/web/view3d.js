@@ -119,6 +119,14 @@ export class Viewer {
     this.controls = new OrbitControls(this.camera, this.renderer.domElement);
     this.controls.enableDamping = false;
     this.controls.addEventListener('change', () => this.render());
+    this.controls.listenToKeyEvents(container); // arrows pan, Shift+arrows rotate
+    container.addEventListener('keydown', (e) => {
+      const factor = { '+': 0.85, '=': 0.85, '-': 1 / 0.85, '−': 1 / 0.85 }[e.key];
+      if (!factor) return;
+      e.preventDefault();
+      this.camera.position.sub(this.controls.target).multiplyScalar(factor).add(this.controls.target);
+      this.controls.update();
+    });
     new ResizeObserver(() => this.resize()).observe(container);
     this.resize();
   }

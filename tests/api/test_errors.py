@@ -13,12 +13,13 @@ from typing import Any
 
 import numpy as np
 import pytest
+from fastapi.testclient import TestClient
+from pytest import LogCaptureFixture
 
 from inertia import errors as E
 from inertia.api import Settings, create_app
 from inertia.api.errors import STATUS
-
-from .meshes import box_stl, stl_bytes, torus_stl
+from tests.support.meshes import box_stl, stl_bytes, torus_stl
 
 with warnings.catch_warnings():
     warnings.filterwarnings("ignore", message="Using `httpx` with `starlette.testclient`")
@@ -53,6 +54,8 @@ CASES: list[tuple[type[E.ServiceError], str, int, Callable[[Any], Any]]] = [
     (E.UnsupportedFormatError, "unsupported_format", 415, mesh(BOX, "part.xyz123")),
     (E.UnsupportedFormatError, "unsupported_format", 415, mesh(BOX, format="dwg")),
     (E.UnreadableFileError, "unreadable_file", 422, mesh(TRUNCATED)),
+    (E.ExternalReferenceError, "external_reference", 422,
+     mesh(b"*NODE\n1, 0, 0, 0\n*INCLUDE, INPUT=/etc/passwd\n", "deck.inp")),
     (E.EmptyGeometryError, "empty_geometry", 422, mesh(b"")),
     (E.NotWatertightError, "not_watertight", 422, mesh(OPEN)),
     (E.ZeroVolumeError, "zero_volume", 422, mesh(FLAT)),
@@ -104,9 +107,25 @@ def assert_envelope(response: Any, code: str, status: int) -> dict[str, Any]:
 
 @pytest.mark.parametrize(("cls", "code", "status", "request_"), CASES,
                          ids=[f"{c[1]}-{i}" for i, c in enumerate(CASES)])
-def test_bad_request_gets_its_code_and_status(client, cls, code, status, request_) -> None:
+def test_bad_request_gets_its_code_and_status(client: TestClient, cls, code, status, request_) -> None:
     assert cls.code == code and STATUS[next(k for k in type.mro(cls) if k in STATUS)] == status
     assert_envelope(request_(client), code, status)
+
+
+def busy(c: Any) -> Any:
+    """A request while the only compute process is busy and no job may wait."""
+    import threading
+    import time
+
+    pool = c.app.state.pool
+    slow = threading.Thread(target=mesh(torus_stl(400, 400)), args=(c,))
+    slow.start()
+    deadline = time.monotonic() + 30
+    while not (pool._slots and pool._slots[1].locked()) and time.monotonic() < deadline:
+        time.sleep(0.01)
+    response = mesh(BOX)(c)
+    slow.join()
+    return response
 
 
 LIMITED = [
@@ -115,6 +134,7 @@ LIMITED = [
     (E.UnauthorizedError, "unauthorized", 401, Settings(api_key="s3cret", compute_processes=1), mesh(BOX)),
     (E.ComputeTimeoutError, "timeout", 503, Settings(timeout_s=0.05, compute_processes=1),
      mesh(torus_stl(500, 500))),
+    (E.ServerBusyError, "server_busy", 503, Settings(max_waiting=0, compute_processes=1), busy),
 ]
 
 
@@ -133,12 +153,12 @@ def test_every_mapped_error_class_is_provoked_by_a_test() -> None:
             assert any(issubclass(p, cls) for p in provoked), cls
 
 
-def test_unknown_path_and_method_use_the_envelope(client) -> None:
+def test_unknown_path_and_method_use_the_envelope(client: TestClient) -> None:
     assert_envelope(client.get("/v2/nothing"), "not_found", 404)
     assert_envelope(client.get("/v1/precession"), "method_not_allowed", 405)
 
 
-def test_unexpected_exception_is_500_envelope_with_logged_traceback(caplog) -> None:
+def test_unexpected_exception_is_500_envelope_with_logged_traceback(caplog: LogCaptureFixture) -> None:
     app = create_app(Settings(compute_processes=1))
 
     @app.get("/boom")
@@ -152,7 +172,7 @@ def test_unexpected_exception_is_500_envelope_with_logged_traceback(caplog) -> N
     assert any(r.exc_info and "secret internal detail" in str(r.exc_info[1]) for r in caplog.records)
 
 
-def test_validation_error_names_the_field(client) -> None:
+def test_validation_error_names_the_field(client: TestClient) -> None:
     error = assert_envelope(points({"points": [{"mass": 1, "position": [0, 0, "x"]}]})(client),
                             "invalid_parameter", 422)
     assert "points.0.position" in error["message"] and error["details"]["errors"][0]["loc"][0] == "body"

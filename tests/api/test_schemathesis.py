@@ -14,8 +14,8 @@ import os
 import warnings
 
 import schemathesis
-from schemathesis import checks
 from hypothesis import HealthCheck, settings
+from schemathesis import checks
 
 from inertia.api import Settings, create_app
 

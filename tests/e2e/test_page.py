@@ -281,6 +281,9 @@ def test_an_unreadable_file_and_bad_pasted_text_get_readable_messages(
     page.fill("#paste", '[{"mass": -1, "position": [0, 0, 0]}]')
     assert analyze(page) == "error"
     assert page.is_visible("#paste-error") and "mass" in page.inner_text("#paste-error")
+    page.fill("#paste", '[{"mass": 1, "position": [0, 0, 0]}, {"mass": 1, "position": [1, 0, 0]}]')
+    assert analyze(page, density="7850") == "error"
+    assert "leave density empty" in page.inner_text("#density-error")
 
 
 def test_download_buttons_give_the_json_and_the_offered_snippets(console_page: tuple[Any, Console], server: Server) -> None:
@@ -336,6 +339,13 @@ def test_controls_have_labels_and_are_keyboard_reachable(console_page: tuple[Any
     page.focus("#analyze")
     page.keyboard.press("Enter")
     page.wait_for_selector("body[data-state=ready]")
+    page.focus("#viewer")  # the view turns and zooms from the keyboard too
+    before = page.evaluate(PIXELS, [0, 0, 1, 1])["hash"]
+    page.keyboard.press("Shift+ArrowLeft")
+    turned = page.evaluate(PIXELS, [0, 0, 1, 1])["hash"]
+    page.keyboard.press("+")
+    zoomed = page.evaluate(PIXELS, [0, 0, 1, 1])["hash"]
+    assert len({before, turned, zoomed}) == 3
 
 
 @pytest.mark.parametrize(("path", "text"), [("/docs", "/v1/analyze/mesh"), ("/redoc", "/v1/analyze/mesh")])
@@ -405,3 +415,19 @@ def test_a_server_with_an_api_key_is_used_with_the_key(browser: Any, tmp_path: P
         assert all("401" in e for e in console.http_errors)  # the first look, before the key was given
     finally:
         server.stop()
+
+
+def test_an_export_the_api_refuses_disables_its_button_with_the_reason(console_page: tuple[Any, Console], server: Server) -> None:
+    page, console = console_page
+    console.expect_http_errors = True
+    open_page(page, server)
+    page.click("#paste-box summary")
+    page.fill("#paste", "1,0,0,0\n1,1,0,0\n")  # two points: a linear rotator, which simulators reject
+    assert analyze(page) == "ready"
+    if not page.locator("button[data-export=urdf]").is_visible():
+        pytest.skip("this service offers no export")
+    page.click("button[data-export=urdf]")
+    page.wait_for_selector("#export-error:not([hidden])")
+    assert "invalid_inertia" in page.inner_text("#export-error")
+    assert page.is_disabled("button[data-export=urdf]")
+    assert page.is_enabled("#dl-json")

@@ -11,6 +11,7 @@ from __future__ import annotations
 import time
 
 import pytest
+
 from inertia.errors import ExternalReferenceError, PayloadTooLargeError, ServiceError, UnreadableFileError
 from inertia.load import load_body
 from inertia.load.guard import check_upload, inflate_budget

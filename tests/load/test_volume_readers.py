@@ -25,7 +25,7 @@ from inertia.mass import assembly_properties, mass_properties
 from inertia.pipeline import AnalysisOptions, analyze
 
 vtk = pytest.importorskip("vtk")
-import volref  # noqa: E402  (needs vtk)
+from tests.load import volref
 
 HEX = [(0, 0, 0), (1, 0, 0), (1, 1, 0), (0, 1, 0), (0, 0, 1), (1, 0, 1), (1, 1, 1), (0, 1, 1)]
 
@@ -343,3 +343,56 @@ def test_analyze_options_still_apply_to_volume_cells(tmp_path: Path) -> None:
     data = write_vtu(grid(cells, pts), tmp_path / "m.vtu")
     doc = analyze(data, filename="m.vtu", options=AnalysisOptions(mass=2.0)).as_dict()
     assert doc["mass"] == pytest.approx(2.0, rel=1e-14)
+
+
+@pytest.mark.parametrize("kind", ["image", "rectilinear", "structured"])
+def test_structured_vtk_data_sets_are_their_voxels_and_hexahedra(tmp_path: Path, kind: str) -> None:
+    """Legacy STRUCTURED_POINTS, RECTILINEAR_GRID and STRUCTURED_GRID files: the cells VTK makes of them."""
+    xs, ys, zs = [0.0, 1.0, 3.0], [0.0, 2.0], [0.0, 0.5, 1.0, 4.0]
+    if kind == "image":
+        data_set = vtk.vtkImageData()
+        data_set.SetDimensions(3, 2, 4)
+        data_set.SetSpacing(1.5, 2.0, 0.5)
+        expected = (2 * 1.5) * 2.0 * (3 * 0.5)
+    elif kind == "rectilinear":
+        data_set = vtk.vtkRectilinearGrid()
+        data_set.SetDimensions(len(xs), len(ys), len(zs))
+        for setter, values in ((data_set.SetXCoordinates, xs), (data_set.SetYCoordinates, ys),
+                               (data_set.SetZCoordinates, zs)):
+            arr = vtk.vtkDoubleArray()
+            for v in values:
+                arr.InsertNextValue(v)
+            setter(arr)
+        expected = 3.0 * 2.0 * 4.0
+    else:
+        data_set = vtk.vtkStructuredGrid()
+        data_set.SetDimensions(len(xs), len(ys), len(zs))
+        pts = vtk.vtkPoints()
+        pts.SetDataTypeToDouble()
+        for z in zs:
+            for y in ys:
+                for x in xs:
+                    pts.InsertNextPoint(x, y, z + 0.25 * x * y)  # sheared: hexahedra with warped faces
+        data_set.SetPoints(pts)
+        expected = 3.0 * 2.0 * 4.0  # the shear moves top and bottom alike: volume unchanged
+    writer = vtk.vtkDataSetWriter()
+    writer.SetFileName(str(tmp_path / "grid.vtk"))
+    writer.SetInputData(data_set)
+    assert writer.Write() == 1
+    assert volume_of((tmp_path / "grid.vtk").read_bytes(), "grid.vtk") == pytest.approx(expected, rel=1e-14)
+
+
+def test_alternating_cell_types_make_one_part_per_type(tmp_path: Path) -> None:
+    """Cells of two types interleaved: two parts (one per type), each cell keeping its own density."""
+    pts = np.array([*HEX, *[(x + 1.0, y, z) for x, y, z in HEX]], dtype=float)
+    cells = []
+    density = []
+    for k in range(6):
+        offset = 8 * (k % 2)
+        cells.append((12, [i + offset for i in range(8)]) if k % 3 else (10, [offset, offset + 1, offset + 3, offset + 4]))
+        density.append(1000.0 + k)
+    data = write_vtu(grid(cells, pts, density=density), tmp_path / "mixed.vtu")
+    loaded = load_body(data, filename="mixed.vtu")
+    assert [p.name for p in loaded.parts] == ["tetra_0", "hexahedron_1"]
+    expected = sum(rho * (1.0 if ctype == 12 else 1 / 6) for (ctype, _), rho in zip(cells, density))
+    assert assembly_properties([(p.body, None) for p in loaded.parts]).mass == pytest.approx(expected, rel=1e-14)

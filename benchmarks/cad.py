@@ -1,0 +1,233 @@
+"""Work-precision of CAD tessellation: error and run time against the deflection, B-rep included.
+
+    python -m benchmarks.cad                   # writes docs/cad.md
+    python -m benchmarks.cad --doc /tmp/cad.md # elsewhere
+
+Each solid is built with OpenCASCADE (the binding of the ``cad`` extra), written
+to a STEP file in millimetres, and analysed through ``inertia.pipeline.analyze``
+from the file's bytes, as a user's upload would be: with ``geometry=brep``, and
+with ``geometry=mesh`` at deflections 1e-1 ... 1e-5 of the bounding-box diagonal.
+Errors are relative, against closed forms:
+
+- cylinder r, h: V = pi r^2 h, I_z = m r^2 / 2, I_x = m (3 r^2 + h^2) / 12;
+- sphere r: V = 4/3 pi r^3, I = 2/5 m r^2;
+- torus R, r (ring about z): V = 2 pi^2 R r^2, I_z = m (R^2 + 3/4 r^2),
+  I_x = m (R^2 / 2 + 5/8 r^2) (e.g. Weisstein, MathWorld "Torus", moment of inertia);
+- the same cylinder with every face converted to NURBS (its geometry is still
+  exact; only the integration is harder);
+- a filleted L-bracket: no closed form, so against its own B-rep result.
+
+"mass" is the relative error of the mass; "moments" the largest relative error
+of the three principal moments (sorted); "estimate" is what the result reports
+(``relative_error_estimate`` for the B-rep, ``tessellation_error`` for a mesh).
+Times are wall-clock of one ``analyze`` call (reading the STEP file included),
+best of ``--repeat``, on whatever else the machine was running.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import os
+import platform
+import sys
+import tempfile
+import time
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+ROOT = Path(__file__).resolve().parents[1]
+DOC = ROOT / "docs" / "cad.md"
+DEFLECTIONS = (1e-1, 1e-2, 1e-3, 1e-4, 1e-5)
+MM3 = 1e-9  # m^3 per mm^3
+RHO = 1000.0  # the default density [kg/m^3]
+
+
+def _quiet() -> None:
+    from OCP.Message import Message
+
+    messenger = Message.DefaultMessenger_s()
+    for printer in list(messenger.Printers()):
+        messenger.RemovePrinter(printer)
+
+
+def cylinder(r: float = 10.0, h: float = 30.0) -> Any:
+    from OCP.BRepPrimAPI import BRepPrimAPI_MakeCylinder
+
+    return BRepPrimAPI_MakeCylinder(r, h).Shape()
+
+
+def sphere(r: float = 20.0) -> Any:
+    from OCP.BRepPrimAPI import BRepPrimAPI_MakeSphere
+
+    return BRepPrimAPI_MakeSphere(r).Shape()
+
+
+def torus(R: float = 30.0, r: float = 10.0) -> Any:
+    from OCP.BRepPrimAPI import BRepPrimAPI_MakeTorus
+
+    return BRepPrimAPI_MakeTorus(R, r).Shape()
+
+
+def nurbs(shape: Any) -> Any:
+    from OCP.BRepBuilderAPI import BRepBuilderAPI_NurbsConvert
+
+    return BRepBuilderAPI_NurbsConvert(shape, True).Shape()
+
+
+def bracket() -> Any:
+    """An L-bracket 60 x 40 x 50 mm, 8 mm thick, every edge filleted at 2 mm, with a 10 mm hole."""
+    from OCP.BRepAlgoAPI import BRepAlgoAPI_Cut, BRepAlgoAPI_Fuse
+    from OCP.BRepFilletAPI import BRepFilletAPI_MakeFillet
+    from OCP.BRepPrimAPI import BRepPrimAPI_MakeBox, BRepPrimAPI_MakeCylinder
+    from OCP.gp import gp_Ax2, gp_Dir, gp_Pnt
+    from OCP.TopAbs import TopAbs_EDGE
+    from OCP.TopExp import TopExp_Explorer
+    from OCP.TopoDS import TopoDS
+
+    base = BRepPrimAPI_MakeBox(60.0, 40.0, 8.0).Shape()
+    wall = BRepPrimAPI_MakeBox(gp_Pnt(0, 0, 0), 8.0, 40.0, 50.0).Shape()
+    body = BRepAlgoAPI_Fuse(base, wall).Shape()
+    fillet = BRepFilletAPI_MakeFillet(body)
+    explorer = TopExp_Explorer(body, TopAbs_EDGE)
+    while explorer.More():
+        fillet.Add(2.0, TopoDS.Edge(explorer.Current()))
+        explorer.Next()
+    rounded = fillet.Shape()
+    hole = BRepPrimAPI_MakeCylinder(gp_Ax2(gp_Pnt(40.0, 20.0, -1.0), gp_Dir(0, 0, 1)), 5.0, 10.0).Shape()
+    return BRepAlgoAPI_Cut(rounded, hole).Shape()
+
+
+def cylinder_reference(r: float = 10.0, h: float = 30.0) -> tuple[float, list[float]]:
+    m = RHO * math.pi * r * r * h * MM3
+    r, h = r * 1e-3, h * 1e-3
+    ix, iz = m * (3 * r * r + h * h) / 12, m * r * r / 2
+    return m, sorted([ix, ix, iz])
+
+
+def sphere_reference(r: float = 20.0) -> tuple[float, list[float]]:
+    m = RHO * 4 / 3 * math.pi * r**3 * MM3
+    i = 0.4 * m * (r * 1e-3) ** 2
+    return m, [i, i, i]
+
+
+def torus_reference(R: float = 30.0, r: float = 10.0) -> tuple[float, list[float]]:
+    m = RHO * 2 * math.pi**2 * R * r * r * MM3
+    R, r = R * 1e-3, r * 1e-3
+    iz, ix = m * (R * R + 0.75 * r * r), m * (R * R / 2 + 5 / 8 * r * r)
+    return m, sorted([ix, ix, iz])
+
+
+def write_step(shape: Any) -> bytes:
+    from OCP.Interface import Interface_Static
+    from OCP.STEPControl import STEPControl_AsIs, STEPControl_Writer
+
+    Interface_Static.SetCVal_s("write.step.unit", "MM")
+    writer = STEPControl_Writer()
+    writer.Transfer(shape, STEPControl_AsIs)
+    with tempfile.TemporaryDirectory() as tmp:
+        path = os.path.join(tmp, "part.step")
+        writer.Write(path)
+        return Path(path).read_bytes()
+
+
+def _errors(doc: dict[str, Any], mass: float, moments: list[float]) -> tuple[float, float]:
+    got = sorted(doc["principal"]["moments"])
+    return abs(doc["mass"] - mass) / mass, max(abs(a - b) / b for a, b in zip(got, moments))
+
+
+def _timed(call: Callable[[], Any], repeat: int) -> tuple[Any, float]:
+    best, out = math.inf, None
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        out = call()
+        best = min(best, time.perf_counter() - t0)
+    return out, best
+
+
+def rows_for(name: str, shape: Any, reference: tuple[float, list[float]] | None, repeat: int) -> list[str]:
+    from inertia.pipeline import AnalysisOptions, analyze
+
+    data = write_step(shape)
+    brep, t_brep = _timed(lambda: analyze(data, filename=f"{name}.step").as_dict(), repeat)
+    mass, moments = reference if reference else (brep["mass"], sorted(brep["principal"]["moments"]))
+    em, ei = _errors(brep, mass, moments)
+    est = brep["diagnostics"]["relative_error_estimate"]
+    rows = [f"| {name} | B-rep | {brep['source']['solids']} solid | {em:.1e} | {ei:.1e} | {est:.1e} | {t_brep * 1e3:.0f} |"]
+    for deflection in DEFLECTIONS:
+        options = AnalysisOptions(geometry="mesh", deflection=deflection)
+        doc, t = _timed(lambda o=options: analyze(data, filename=f"{name}.step", options=o).as_dict(), repeat)
+        em, ei = _errors(doc, mass, moments)
+        rows.append(f"| {name} | {deflection:g} | {doc['source']['triangles']:,} | {em:.1e} | {ei:.1e} | "
+                    f"{doc['diagnostics']['tessellation_error']:.1e} | {t * 1e3:.0f} |")
+        print(rows[-1], flush=True)
+    return rows
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--doc", type=Path, default=DOC)
+    parser.add_argument("--repeat", type=int, default=1, help="runs per row, best kept (the 1e-5 rows take minutes)")
+    args = parser.parse_args(argv)
+    _quiet()
+    from OCP import __file__ as ocp_file
+
+    cases: list[tuple[str, Any, tuple[float, list[float]] | None]] = [
+        ("cylinder r10 h30", cylinder(), cylinder_reference()),
+        ("sphere r20", sphere(), sphere_reference()),
+        ("torus R30 r10", torus(), torus_reference()),
+        ("cylinder, NURBS faces", nurbs(cylinder()), cylinder_reference()),
+        ("filleted L-bracket", bracket(), None),
+    ]
+    rows: list[str] = []
+    for name, shape, ref in cases:
+        rows.extend(rows_for(name, shape, ref, args.repeat))
+    text = _document(rows, Path(ocp_file).parent.name, args.repeat)
+    args.doc.write_text(text, encoding="utf-8")
+    print(f"wrote {args.doc}")
+    return 0
+
+
+def _document(rows: list[str], binding: str, repeat: int) -> str:
+    import importlib.metadata as md
+
+    version = md.version("cadquery-ocp-novtk")
+    return f"""# CAD files: tessellation work-precision
+
+Generated by `python -m benchmarks.cad` (cadquery-ocp-novtk {version}, Python
+{platform.python_version()}, {platform.machine()}; best of {repeat} runs of one
+`analyze` call on the STEP file's bytes, reading included; the machine was shared
+with other work, so times are indicative).
+
+`geometry=brep` (the default) integrates the exact faces; `geometry=mesh`
+tessellates them with a chordal deflection of `deflection` times the part's
+bounding-box diagonal (angular deflection 0.5 rad, OpenCASCADE's default, which
+governs the coarsest setting) and integrates the polyhedron exactly. Errors are
+relative, against closed forms (cylinder, sphere, torus) or, for the bracket,
+against its B-rep result. *estimate* is what the result itself reports:
+`relative_error_estimate` on the B-rep rows, `tessellation_error` (difference to the
+B-rep) on the mesh rows.
+
+| solid | deflection | triangles | mass error | moments error | estimate | time [ms] |
+|---|---|---:|---:|---:|---:|---:|
+{chr(10).join(rows)}
+
+Reading the table: the tessellation's error falls in proportion to the deflection
+once the linear deflection governs (below about 1e-2), roughly 5 x deflection in the
+moments for these curved solids; planar faces cost nothing. To reach 1e-6 a mesh
+needs a deflection near 1e-7 and millions of triangles, where the B-rep gives
+1e-8 or better in milliseconds: use `geometry=mesh` only to see what a tessellated
+export (STL, a simulator's collision mesh) of the part would weigh.
+
+The B-rep rows integrate each solid twice with OpenCASCADE's adaptive Gauss rule
+(`BRepGProp.VolumeProperties_s` with eps 1e-12 and 1e-14) and report the difference
+as the estimate. Analytic faces (planes, cylinders, spheres, tori) are integrated
+to rounding; the NURBS cylinder shows the case the estimate exists for: the rule
+converges slowly on rational B-spline faces, and the default, non-adaptive rule
+(what gmsh's `getMass` calls) is off by about 1 % on that same cylinder.
+"""
+
+
+if __name__ == "__main__":
+    sys.exit(main())

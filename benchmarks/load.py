@@ -1,0 +1,350 @@
+"""Load on the running HTTP server, on loopback only, with a bare FastAPI route as the peer in the same run.
+
+    python -m benchmarks.load                     # writes docs/load.md (about 3 minutes)
+    python -m benchmarks.load --seconds 4 --doc /tmp/load.md   # shorter
+
+Starts one server (``create_app`` under uvicorn on 127.0.0.1, a free port, default settings, two compute
+processes) with one extra route, ``POST /bench/bare``, an ``async def`` that returns a constant dict:
+what FastAPI and the same middleware cost without our work. Then, with a bounded number of concurrent
+clients (asyncio + httpx, keep-alive) and a bounded duration per phase, it measures:
+
+- ``bare`` and ``points`` (3 point masses, ``/v1/analyze/points``) in interleaved rounds: requests/s,
+  p50/p99 latency, and the ratio points/bare of each round;
+- ``small meshes``: the 12-triangle box of ``sample_meshes/`` on ``/v1/analyze/mesh``;
+- ``mix``: clients sending points and small meshes while two more send 1,000,000-triangle binary STLs
+  (48 MB each), with ``/healthz`` latency.
+
+Every reply is checked (status 200 and a ``mass``, or ``status: ok``); any other status counts as an error.
+The server's resident memory and that of its compute processes are sampled every 0.5 s throughout.
+The machine may be shared: absolute numbers are noisy, the ratio within a round is what counts.
+"""
+
+from __future__ import annotations
+
+import argparse
+import asyncio
+import contextlib
+import os
+import socket
+import statistics
+import subprocess
+import sys
+import tempfile
+import threading
+import time
+from collections.abc import Awaitable, Callable, Iterator
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import httpx
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+HOST = "127.0.0.1"  # loopback only
+POINTS = {"points": [{"mass": 1.0, "position": [0, 0, 0]}, {"mass": 2.0, "position": [1, 0, 0]},
+                     {"mass": 1.0, "position": [0, 1, 0]}]}
+SERVER = """
+import sys, uvicorn
+from inertia.api import Settings, create_app
+app = create_app(Settings())
+
+@app.post("/bench/bare")
+async def bare() -> dict[str, str]:
+    return {"status": "ok"}
+
+uvicorn.run(app, host=sys.argv[1], port=int(sys.argv[2]), log_level="warning", access_log=False)
+"""
+
+
+@dataclass
+class Phase:
+    name: str
+    latencies: list[float] = field(default_factory=list)
+    errors: int = 0
+    seconds: float = 0.0
+    cpu_s: float = 0.0  # CPU time the server process used during the phase
+
+    @property
+    def cpu_ms_per_request(self) -> float:
+        return 1e3 * self.cpu_s / len(self.latencies) if self.latencies else float("nan")
+
+    @property
+    def rate(self) -> float:
+        return len(self.latencies) / self.seconds if self.seconds else 0.0
+
+    def quantile(self, q: float) -> float:
+        if not self.latencies:
+            return float("nan")
+        ordered = sorted(self.latencies)
+        return ordered[min(len(ordered) - 1, int(q * len(ordered)))] * 1e3
+
+
+def _free_port() -> int:
+    with socket.socket() as s:
+        s.bind((HOST, 0))
+        return int(s.getsockname()[1])
+
+
+@contextlib.contextmanager
+def running_server() -> Iterator[tuple[str, subprocess.Popen[bytes]]]:
+    port = _free_port()
+    env = {k: v for k, v in os.environ.items() if not k.startswith("INERTIA_")}
+    proc = subprocess.Popen([sys.executable, "-c", SERVER, HOST, str(port)], cwd=ROOT, env=env,
+                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    url = f"http://{HOST}:{port}"
+    try:
+        deadline = time.monotonic() + 60
+        while time.monotonic() < deadline:
+            try:
+                if httpx.get(f"{url}/healthz", timeout=1).status_code == 200:
+                    break
+            except httpx.TransportError:
+                time.sleep(0.2)
+        else:
+            raise RuntimeError("the server did not start")
+        yield url, proc
+    finally:
+        proc.terminate()
+        try:
+            proc.wait(15)
+        except subprocess.TimeoutExpired:
+            proc.kill()
+
+
+def _rss_mib(pid: int) -> float:
+    try:
+        for line in Path(f"/proc/{pid}/status").read_text().splitlines():
+            if line.startswith("VmRSS"):
+                return int(line.split()[1]) / 1024
+    except OSError:
+        pass
+    return 0.0
+
+
+def _cpu_s(pid: int) -> float:
+    """User + system CPU time of one process [s]."""
+    try:
+        fields = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
+    except OSError:
+        return 0.0
+    return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
+
+
+def _descendants(pid: int) -> list[int]:
+    parents = {}
+    for entry in Path("/proc").iterdir():
+        if entry.name.isdigit():
+            with contextlib.suppress(OSError, IndexError, ValueError):
+                parents[int(entry.name)] = int((entry / "stat").read_text().rsplit(")", 1)[1].split()[1])
+    found, frontier = [], [pid]
+    while frontier:
+        frontier = [p for p, parent in parents.items() if parent in frontier]
+        found += frontier
+    return found
+
+
+class MemorySampler(threading.Thread):
+    """(seconds since start, phase, server MiB, compute processes MiB) every 0.5 s."""
+
+    def __init__(self, pid: int) -> None:
+        super().__init__(daemon=True)
+        self.pid, self.phase, self.samples = pid, "start", []
+        self.done = threading.Event()
+        self.start_time = time.monotonic()
+
+    def run(self) -> None:
+        while not self.done.wait(0.5):
+            workers = sum(_rss_mib(p) for p in _descendants(self.pid))
+            self.samples.append((time.monotonic() - self.start_time, self.phase, _rss_mib(self.pid), workers))
+
+
+Request = Callable[[httpx.AsyncClient], Awaitable[bool]]
+
+
+async def _drive(url: str, phase: Phase, request: Request, clients: int, seconds: float) -> None:
+    stop = time.monotonic() + seconds
+
+    async def client() -> None:
+        async with httpx.AsyncClient(base_url=url, timeout=120) as c:
+            while time.monotonic() < stop:
+                start = time.perf_counter()
+                try:
+                    ok = await request(c)
+                except httpx.HTTPError:
+                    ok = False
+                if ok:
+                    phase.latencies.append(time.perf_counter() - start)
+                else:
+                    phase.errors += 1
+
+    start = time.monotonic()
+    await asyncio.gather(*(client() for _ in range(clients)))
+    phase.seconds = time.monotonic() - start
+
+
+async def _bare(c: httpx.AsyncClient) -> bool:
+    r = await c.post("/bench/bare", json=POINTS)
+    return r.status_code == 200 and r.json()["status"] == "ok"
+
+
+async def _points(c: httpx.AsyncClient) -> bool:
+    r = await c.post("/v1/analyze/points", json=POINTS)
+    return r.status_code == 200 and r.json()["mass"] == 4.0
+
+
+BOX = (ROOT / "sample_meshes" / "box.stl").read_bytes()
+
+
+async def _box(c: httpx.AsyncClient) -> bool:
+    r = await c.post("/v1/analyze/mesh", files={"file": ("box.stl", BOX)})
+    return r.status_code == 200 and "mass" in r.json()
+
+
+def _torus_stl(n: int, m: int) -> bytes:
+    u = np.linspace(0, 2 * np.pi, n, endpoint=False)[:, None]
+    v = np.linspace(0, 2 * np.pi, m, endpoint=False)[None, :]
+    ring = 2.0 + 0.5 * np.cos(v)
+    pts = np.stack([ring * np.cos(u), ring * np.sin(u), 0.5 * np.sin(v) + 0 * u], axis=-1).reshape(-1, 3)
+    i, j = np.meshgrid(np.arange(n), np.arange(m), indexing="ij")
+    a, b = i * m + j, ((i + 1) % n) * m + j
+    c, d = ((i + 1) % n) * m + (j + 1) % m, i * m + (j + 1) % m
+    faces = np.concatenate([np.stack([a, b, c], -1).reshape(-1, 3), np.stack([a, c, d], -1).reshape(-1, 3)])
+    records = np.zeros(len(faces), dtype=[("normal", "<f4", 3), ("v", "<f4", (3, 3)), ("attr", "<u2")])
+    records["v"] = pts[faces]
+    return b"\0" * 80 + len(faces).to_bytes(4, "little") + records.tobytes()
+
+
+def _row(p: Phase) -> str:
+    return f"| {p.name} | {len(p.latencies)} | {p.rate:.0f} | {p.quantile(0.5):.1f} | {p.quantile(0.99):.1f} | {p.errors} |"
+
+
+async def measure(url: str, sampler: MemorySampler, seconds: float, rounds: int, clients: int,
+                  big: bytes) -> dict[str, object]:
+    pid = sampler.pid
+    pairs = []
+    for k in range(rounds):  # interleaved, order alternating, so drift of the shared machine hits both
+        order = [("bare", _bare), ("points", _points)]
+        if k % 2:
+            order.reverse()
+        got = {}
+        for name, fn in order:
+            sampler.phase = name
+            got[name] = Phase(f"{name} (round {k + 1})")
+            cpu = _cpu_s(pid)
+            await _drive(url, got[name], fn, clients, seconds)
+            got[name].cpu_s = _cpu_s(pid) - cpu
+        pairs.append((got["bare"], got["points"]))
+    sampler.phase = "small meshes"
+    small = Phase("small meshes (box.stl)")
+    await _drive(url, small, _box, clients, seconds)
+
+    sampler.phase = "mix"
+    mix_points, mix_small, mix_big, health = (Phase("mix: points"), Phase("mix: small meshes"),
+                                              Phase("mix: 1e6-triangle meshes"), Phase("mix: /healthz"))
+
+    async def _big(c: httpx.AsyncClient) -> bool:
+        r = await c.post("/v1/analyze/mesh", files={"file": ("torus.stl", big)})
+        return r.status_code == 200 and "mass" in r.json()
+
+    async def _health(c: httpx.AsyncClient) -> bool:
+        await asyncio.sleep(0.2)
+        return (await c.get("/healthz")).status_code == 200
+
+    mix_seconds = max(3 * seconds, 20.0)
+    await asyncio.gather(_drive(url, mix_points, _points, max(1, clients // 2), mix_seconds),
+                         _drive(url, mix_small, _box, max(1, clients // 2), mix_seconds),
+                         _drive(url, mix_big, _big, 2, mix_seconds),
+                         _drive(url, health, _health, 1, mix_seconds))
+    sampler.phase = "end"
+    return {"pairs": pairs, "small": small, "mix": [mix_points, mix_small, mix_big, health]}
+
+
+def report(result: dict[str, object], sampler: MemorySampler, args: argparse.Namespace, wall: float) -> str:
+    pairs = result["pairs"]
+    assert isinstance(pairs, list)
+    ratios = [p.rate / b.rate for b, p in pairs]
+    cpu_ratios = [b.cpu_ms_per_request / p.cpu_ms_per_request for b, p in pairs]
+    lines = [
+        "# Load on the HTTP server",
+        "",
+        "Generated by `python -m benchmarks.load"
+        + (f" --seconds {args.seconds:g}" if args.seconds != 8 else "")
+        + (f" --rounds {args.rounds}" if args.rounds != 3 else "") + "` "
+        f"({time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}, {wall:.0f} s). One server on 127.0.0.1 with "
+        f"default settings ({os.cpu_count()} cores, two compute processes) and an extra `POST /bench/bare` route "
+        f"(an `async def` returning a constant, behind the same middleware): the peer in the same run. "
+        f"{args.clients} concurrent keep-alive clients (asyncio + httpx in one process on the same machine), "
+        f"{args.seconds:g} s per phase. The machine is shared with other work: absolute rates are noisy and the "
+        "client itself takes CPU from the server; the ratio within each round is the figure that counts.",
+        "",
+        "## Small requests against the bare route",
+        "",
+        "| phase | requests | requests/s | p50 [ms] | p99 [ms] | errors | server CPU per request [ms] |",
+        "|---|---|---|---|---|---|---|",
+    ]
+    for b, p in pairs:
+        lines += [_row(b) + f" {b.cpu_ms_per_request:.2f} |", _row(p) + f" {p.cpu_ms_per_request:.2f} |"]
+    lines += ["", "Points/bare throughput per round: " + ", ".join(f"{r:.2f}" for r in ratios)
+              + f"; median **{statistics.median(ratios):.2f}** (goal: at least 0.70).", "",
+              "The same comparison by the server's own CPU time per request (bare / points: the throughput "
+              "ratio one server core would reach, independent of the client's share of the machine): "
+              + ", ".join(f"{r:.2f}" for r in cpu_ratios) + f"; median **{statistics.median(cpu_ratios):.2f}**.", "",
+              "Read both: the throughput ratio is what clients on this machine saw (the load generator shares the "
+              "cores, which narrows the gap); the CPU ratio is what the server spends. The transport part of a "
+              "small request is now the bare route's (no process round trip, no pickling); what remains is the "
+              "analysis itself, mass properties with their error estimate, about 1-3 ms of CPU for three points "
+              "on this machine.", "",
+              "Requests of at most "
+              "1,000 point masses without a trajectory (and precession without samples) run in the server process; "
+              "every other job goes to a compute process.", "",
+              "## Small meshes, and a mix with 1,000,000-triangle meshes", "",
+              "| phase | requests | requests/s | p50 [ms] | p99 [ms] | errors |", "|---|---|---|---|---|---|"]
+    small = result["small"]
+    mix = result["mix"]
+    assert isinstance(small, Phase) and isinstance(mix, list)
+    lines += [_row(small)] + [_row(p) for p in mix]
+    errors = sum(p.errors for b, q in pairs for p in (b, q)) + small.errors + sum(p.errors for p in mix)
+    lines += ["", f"Errors in the whole run: **{errors}**.", "",
+              "In the mix, two clients upload 48 MB binary STLs (1,000,000 triangles) back to back while the others "
+              "send points and small meshes; `/healthz` is polled every 0.2 s. Small meshes share the two compute "
+              "processes with the large ones, so their latency in the mix is bounded by the large jobs' turns.",
+              "", "## Memory over time", "",
+              "Resident memory of the server process and of its compute processes together, every 2 s.", "",
+              "| t [s] | phase | server [MiB] | compute processes [MiB] |", "|---|---|---|---|"]
+    last = -10.0
+    for t, phase, server, workers in sampler.samples:
+        if t - last >= 2.0:
+            lines.append(f"| {t:.0f} | {phase} | {server:.0f} | {workers:.0f} |")
+            last = t
+    peak_server = max((s[2] for s in sampler.samples), default=0.0)
+    peak_workers = max((s[3] for s in sampler.samples), default=0.0)
+    lines += ["", f"Peaks: server {peak_server:.0f} MiB, compute processes together {peak_workers:.0f} MiB.", ""]
+    return "\n".join(lines)
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--seconds", type=float, default=8.0, help="duration of each phase [s]")
+    parser.add_argument("--rounds", type=int, default=3, help="interleaved bare/points rounds")
+    parser.add_argument("--clients", type=int, default=8, help="concurrent clients (at most 64)")
+    parser.add_argument("--doc", type=Path, default=ROOT / "docs" / "load.md")
+    args = parser.parse_args()
+    args.clients = max(1, min(64, args.clients))
+    big = _torus_stl(707, 707)  # 999,698 triangles
+    start = time.monotonic()
+    with running_server() as (url, proc):
+        sampler = MemorySampler(proc.pid)
+        sampler.start()
+        try:
+            result = asyncio.run(measure(url, sampler, args.seconds, args.rounds, args.clients, big))
+        finally:
+            sampler.done.set()
+            sampler.join()
+    text = report(result, sampler, args, time.monotonic() - start)
+    args.doc.write_text(text)
+    print(text)
+
+
+if __name__ == "__main__":
+    with tempfile.TemporaryDirectory():
+        main()

@@ -1,0 +1,256 @@
+"""Molecules (API.md 1.1, "Molecules"): atoms by element, XYZ files, rotational constants.
+
+Expected values come from outside the code under test:
+
+* atomic masses typed here from their sources: IUPAC/CIAAW abridged standard
+  atomic weights 2021 (Prohaska et al., Pure Appl. Chem. 94, 573, 2022) and
+  AME2020 isotope masses (Wang et al., Chinese Phys. C 45, 030003, 2021);
+* the moments of inertia and constants recomputed here with numpy from those
+  masses and the CODATA h and c (scipy.constants), A = h / (8 pi^2 I);
+* the geometries and published constants of NIST CCCBDB (Computational
+  Chemistry Comparison and Benchmark DataBase, release 22, "Listing of
+  experimental geometry data", cccbdb.nist.gov/expgeom2x.asp?casno=...),
+  each cited at its molecule.
+
+The published ground-state constants (B0) are not those of a rigid
+equilibrium geometry: vibration-rotation interaction and the inertial defect
+separate them by up to a few per cent (water's re geometry gives A = 27.38
+cm^-1 against A0 = 27.877).  The comparison with those tables is therefore a
+consistency check at the size of that effect, stated per molecule; the
+precision checks are against the independent recomputation.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import subprocess
+import sys
+import warnings
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+from scipy.constants import c as SPEED_OF_LIGHT
+from scipy.constants import h as PLANCK
+from scipy.constants import physical_constants
+
+with warnings.catch_warnings():
+    warnings.simplefilter("ignore")
+    from fastapi.testclient import TestClient
+
+ROOT = Path(__file__).resolve().parents[1]
+DALTON = physical_constants["atomic mass constant"][0]
+
+# IUPAC 2021 abridged standard atomic weights [u]
+STANDARD = {"H": 1.008, "C": 12.011, "N": 14.007, "O": 15.999}
+# AME2020 atomic masses of the most abundant isotopes [u] (12C is 12 by definition)
+ABUNDANT = {"H": 1.00782503224, "C": 12.0, "N": 14.00307400425, "O": 15.99491461926}
+DEUTERIUM, CARBON13 = 2.01410177784, 13.00335483534  # AME2020 [u]
+REL_MASS = 1e-9  # isotope masses as tabulated agree to this (rounding of the published digits)
+
+
+@pytest.fixture(scope="module")
+def client() -> Any:
+    from inertia.app import app
+
+    with TestClient(app) as c:
+        yield c
+
+
+def _deg(a: float) -> float:
+    return math.radians(a)
+
+
+def water(r: float = 0.958, angle: float = 104.4776) -> list[tuple[str, list[float]]]:
+    """H2O, C2v, from rOH and aHOH (CCCBDB: re 0.958 A, 104.4776 deg, Hoy & Bunker 1979)."""
+    y, z = r * math.sin(_deg(angle) / 2), r * math.cos(_deg(angle) / 2)
+    return [("O", [0, 0, 0]), ("H", [0, y, z]), ("H", [0, -y, z])]
+
+
+def ammonia(r: float = 1.012, angle: float = 106.67) -> list[tuple[str, list[float]]]:
+    """NH3, C3v, from rNH and aHNH (CCCBDB: 1.012 A, 106.67 deg, Herzberg 1966)."""
+    hh = 2 * r * math.sin(_deg(angle) / 2)
+    rho = hh / math.sqrt(3)
+    h = math.sqrt(r * r - rho * rho)
+    return [("N", [0, 0, 0])] + [("H", [rho * math.cos(k * 2 * math.pi / 3), rho * math.sin(k * 2 * math.pi / 3), -h])
+                                 for k in range(3)]
+
+
+def methane(r: float = 1.087) -> list[tuple[str, list[float]]]:
+    """CH4, Td: hydrogens on alternate corners of a cube (rCH 1.087 A)."""
+    s = r / math.sqrt(3)
+    return [("C", [0, 0, 0])] + [("H", [s * a, s * b, s * a * b]) for a in (1, -1) for b in (1, -1)]
+
+
+def formaldehyde(rch: float = 1.111, rco: float = 1.205, hch: float = 116.133) -> list[tuple[str, list[float]]]:
+    """H2CO, C2v (CCCBDB: rCH 1.111, rCO 1.205 A, aHCH 116.133 deg, Gurvich)."""
+    y, z = rch * math.sin(_deg(hch) / 2), -rch * math.cos(_deg(hch) / 2)
+    return [("O", [0, 0, rco]), ("C", [0, 0, 0]), ("H", [0, y, z]), ("H", [0, -y, z])]
+
+
+def carbon_dioxide(r: float = 1.162) -> list[tuple[str, list[float]]]:
+    """CO2, linear, D-inf-h (rCO 1.162 A, the commonly quoted ground-state r0 distance)."""
+    return [("O", [0, 0, -r]), ("C", [0, 0, 0]), ("O", [0, 0, r])]
+
+
+def benzene(rcc: float = 1.3914, rch: float = 1.0802) -> list[tuple[str, list[float]]]:
+    """C6H6, D6h (re(CC) 1.3914, re(CH) 1.0802 A: Gauss & Stanton, J. Phys. Chem. A 104, 2865, 2000)."""
+    ring = [(math.cos(k * math.pi / 3), math.sin(k * math.pi / 3)) for k in range(6)]
+    return ([("C", [rcc * x, rcc * y, 0.0]) for x, y in ring]
+            + [("H", [(rcc + rch) * x, (rcc + rch) * y, 0.0]) for x, y in ring])
+
+
+def _points(atoms: list[tuple[str, list[float]]]) -> list[dict[str, Any]]:
+    return [{"element": e, "position": p} for e, p in atoms]
+
+
+def _constants(atoms: list[tuple[str, list[float]]], masses: dict[str, float]) -> tuple[np.ndarray, np.ndarray]:
+    """Independent recomputation: principal moments [kg m^2] and A >= B >= C [MHz]."""
+    m = np.array([masses[e] for e, _ in atoms]) * DALTON
+    x = np.array([p for _, p in atoms], dtype=float) * 1e-10
+    x = x - (m[:, None] * x).sum(axis=0) / m.sum()
+    tensor = sum(mi * (np.dot(xi, xi) * np.eye(3) - np.outer(xi, xi)) for mi, xi in zip(m, x))
+    moments = np.sort(np.linalg.eigvalsh(tensor))
+    with np.errstate(divide="ignore"):
+        mhz = PLANCK / (8 * math.pi**2 * moments) * 1e-6
+    return moments, mhz
+
+
+MOLECULES = {
+    # name: (geometry, expected kind, shape, published ground-state constants [cm^-1], relative gap to them)
+    # CCCBDB casno=7732185: A0 B0 C0 27.877 14.512 9.285; the re geometry differs from B0 by ~2.5 %
+    "water": (water(), "asymmetric_top", None, [27.877, 14.512, 9.285], 0.03),
+    # CCCBDB casno=50000 (Herzberg 1966): 9.4053 1.2953 1.1342; the inertial defect moves C by ~0.4 %
+    "formaldehyde": (formaldehyde(), "asymmetric_top", None, [9.4053, 1.2953, 1.1342], 0.005),
+    # CCCBDB casno=124389: B0 0.39021 (Herzberg 1966)
+    "carbon dioxide": (carbon_dioxide(), "linear_rotator", None, [0.39021], 0.001),
+    "ammonia": (ammonia(), "symmetric_top", "oblate", None, None),
+    "methane": (methane(), "spherical_top", None, None, None),
+    "benzene": (benzene(), "symmetric_top", "oblate", None, None),
+}
+
+
+@pytest.mark.parametrize("name", list(MOLECULES))
+def test_molecule_rotor_type_and_constants(client: Any, name: str) -> None:
+    atoms, kind, shape, published, gap = MOLECULES[name]
+    r = client.post("/v1/analyze/points", json={"points": _points(atoms), "units": "angstrom", "isotopes": "abundant"})
+    assert r.status_code == 200, r.text
+    doc = r.json()
+    assert doc["classification"]["kind"] == kind
+    assert doc["classification"].get("shape") == shape
+    moments, mhz = _constants(atoms, ABUNDANT)
+    # REL_MASS: the package's isotope table rounds AME2020 masses at ~1e-10 relative (1H: 1.0078250319)
+    np.testing.assert_allclose(doc["principal"]["moments"], moments, rtol=REL_MASS, atol=REL_MASS * moments[2])
+    got = doc["rotational_constants"]
+    if kind == "linear_rotator":
+        expected_mhz = [PLANCK / (8 * math.pi**2 * moments[2]) * 1e-6]
+    else:
+        expected_mhz = list(mhz)
+        assert got["MHz"] == sorted(got["MHz"], reverse=True)
+    np.testing.assert_allclose(got["MHz"], expected_mhz, rtol=REL_MASS)
+    np.testing.assert_allclose(got["cm-1"], np.array(expected_mhz) * 1e6 / SPEED_OF_LIGHT / 100, rtol=REL_MASS)
+    if published is not None:
+        np.testing.assert_allclose(got["cm-1"], published, rtol=gap)
+
+
+def test_symmetric_and_spherical_tops_have_their_equal_constants(client: Any) -> None:
+    for atoms, equal in ((ammonia(), (0, 1)), (methane(), (0, 2)), (benzene(), (0, 1))):
+        doc = client.post("/v1/analyze/points", json={"points": _points(atoms), "units": "angstrom"}).json()
+        values = doc["rotational_constants"]["MHz"]
+        assert values[equal[0]] == pytest.approx(values[equal[1]], rel=1e-12)
+
+
+def test_standard_weights_are_the_default_and_abundant_isotopes_on_request(client: Any) -> None:
+    atoms = water()
+    for isotopes, table in (("standard", STANDARD), ("abundant", ABUNDANT)):
+        body = {"points": _points(atoms), "units": "angstrom", "isotopes": isotopes}
+        doc = client.post("/v1/analyze/points", json=body).json()
+        expected = (table["O"] + 2 * table["H"]) * DALTON
+        assert doc["mass"] == pytest.approx(expected, rel=1e-12)
+    default = client.post("/v1/analyze/points", json={"points": _points(atoms), "units": "angstrom"}).json()
+    assert default["mass"] == pytest.approx((STANDARD["O"] + 2 * STANDARD["H"]) * DALTON, rel=1e-12)
+
+
+@pytest.mark.parametrize("symbol, mass", [("D", DEUTERIUM), ("2H", DEUTERIUM), ("13C", CARBON13), ("12C", 12.0)])
+def test_mass_numbers_and_deuterium(client: Any, symbol: str, mass: float) -> None:
+    body = {"points": [{"element": symbol, "position": [0, 0, 0]}, {"mass": 1.0, "position": [1, 0, 0]}],
+            "mass_unit": "u"}
+    doc = client.post("/v1/analyze/points", json=body).json()
+    assert doc["mass"] == pytest.approx((mass + 1.0) * DALTON, rel=1e-9)
+
+
+def test_mass_wins_over_element_and_mass_unit_u(client: Any) -> None:
+    body = {"points": [{"element": "O", "mass": 2.0, "position": [0, 0, 0]}, {"mass": 3.0, "position": [1, 0, 0]}],
+            "mass_unit": "u"}
+    doc = client.post("/v1/analyze/points", json=body).json()
+    assert doc["mass"] == pytest.approx(5.0 * DALTON, rel=1e-12)
+    kg = client.post("/v1/analyze/points", json={**body, "mass_unit": "kg"}).json()
+    assert kg["mass"] == 5.0
+
+
+@pytest.mark.parametrize("symbol, reason", [("Xx", "not an element"), ("99C", "mass numbers of C"),
+                                            ("Tc", "no standard atomic weight"), ("14D", "already names")])
+def test_unknown_elements_are_refused_with_advice(client: Any, symbol: str, reason: str) -> None:
+    body = {"points": [{"element": symbol, "position": [0, 0, 0]}, {"element": "H", "position": [1, 0, 0]}]}
+    r = client.post("/v1/analyze/points", json=body)
+    assert r.status_code == 422
+    assert r.json()["error"]["code"] == "invalid_parameter" and reason in r.json()["error"]["message"]
+
+
+def test_a_point_needs_a_mass_or_an_element(client: Any) -> None:
+    r = client.post("/v1/analyze/points", json={"points": [{"position": [0, 0, 0]}]})
+    assert r.status_code == 422 and r.json()["error"]["code"] == "invalid_parameter"
+
+
+def test_points_with_masses_only_have_no_rotational_constants(client: Any) -> None:
+    doc = client.post("/v1/analyze/points", json={"points": [{"mass": 1, "position": [0, 0, 0]},
+                                                              {"mass": 1, "position": [1, 0, 0]},
+                                                              {"mass": 1, "position": [0, 1, 0]}]}).json()
+    assert "rotational_constants" not in doc
+
+
+def _xyz(atoms: list[tuple[str, list[float]]], comment: str = "from a test") -> str:
+    lines = [str(len(atoms)), comment] + [f"{e} {p[0]!r} {p[1]!r} {p[2]!r}" for e, p in atoms]
+    return "\n".join(lines) + "\n"
+
+
+def test_xyz_upload_is_read_in_angstrom_with_the_isotopes_parameter(client: Any) -> None:
+    atoms = formaldehyde()
+    files = {"file": ("h2co.xyz", _xyz(atoms).encode(), "chemical/x-xyz")}
+    doc = client.post("/v1/analyze/mesh", params={"isotopes": "abundant"}, files=files).json()
+    assert doc["source"]["format"] == "xyz" and doc["source"]["units"] == "angstrom"
+    _, mhz = _constants(atoms, ABUNDANT)
+    np.testing.assert_allclose(doc["rotational_constants"]["MHz"], mhz, rtol=REL_MASS)
+    nm = client.post("/v1/analyze/mesh", params={"units": "m"}, files=files).json()
+    assert nm["source"]["units"] == "m"
+    assert nm["principal"]["moments"][0] == pytest.approx(doc["principal"]["moments"][0] * 1e20, rel=1e-6)
+
+
+def test_xyz_atomic_numbers_and_trajectories(client: Any) -> None:
+    text = "3\nwater by atomic number\n8 0 0 0\n1 0 0.757 0.586\n1 0 -0.757 0.586\n3\nsecond frame\nO 0 0 0\nH 0 1 0\nH 0 -1 0\n"
+    doc = client.post("/v1/analyze/mesh", files={"file": ("traj.xyz", text.encode())}).json()
+    assert doc["source"]["points"] == 3
+    assert any("first frame" in w for w in doc["warnings"])
+
+
+@pytest.mark.parametrize("text, message", [("x\n\nO 0 0 0\n", "number of atoms"), ("3\n\nO 0 0 0\n", "announces 3"),
+                                           ("1\n\nO 0 zero 0\n", "element x y z")])
+def test_broken_xyz_is_unreadable_file(client: Any, text: str, message: str) -> None:
+    r = client.post("/v1/analyze/mesh", files={"file": ("bad.xyz", text.encode())})
+    assert r.status_code == 422
+    assert r.json()["error"]["code"] == "unreadable_file" and message in r.json()["error"]["message"]
+
+
+def test_cli_analyze_water_xyz(tmp_path: Path) -> None:
+    path = tmp_path / "water.xyz"
+    path.write_text(_xyz(water()))
+    table = subprocess.run([sys.executable, "-m", "inertia", "analyze", str(path)], capture_output=True, text=True,
+                           check=True, cwd=ROOT).stdout
+    assert "rotational A, B, C" in table and "cm^-1" in table and "asymmetric_top" in table
+    doc = json.loads(subprocess.run([sys.executable, "-m", "inertia", "analyze", str(path), "--json",
+                                     "--isotopes", "abundant"],
+                                    capture_output=True, text=True, check=True, cwd=ROOT).stdout)
+    _, mhz = _constants(water(), ABUNDANT)
+    np.testing.assert_allclose(doc["rotational_constants"]["MHz"], mhz, rtol=REL_MASS)
