@@ -31,10 +31,9 @@ import pytest
 
 pytest.importorskip("OCP")
 
-from cadlib import box, cylinder, nurbs, open_shell, write_iges, write_step
-
 from inertia.errors import NotWatertightError, UnsupportedFormatError
 from inertia.pipeline import AnalysisOptions, analyze
+from tests.cad.cadlib import box, cylinder, nurbs, open_shell, write_iges, write_step
 
 RHO = 1000.0  # the default density, kg/m^3
 REL = 1e-9
