@@ -36,10 +36,10 @@ from pathlib import Path
 import mpmath as mp
 import numpy as np
 
+from inertia.motion import quaternions as quat
 from inertia.motion.integrators import integrate_scipy, integrate_splitting
 from inertia.motion.invariants import RigidProblem, invariant_drifts
 from inertia.motion.jacobi import AsymmetricTop
-from inertia.motion import quaternions as quat
 
 ROOT = Path(__file__).resolve().parents[1]
 DOC = ROOT / "docs" / "error-vs-runtime.md"

@@ -34,7 +34,6 @@ from __future__ import annotations
 import argparse
 import io
 import json
-import sys
 import time
 from dataclasses import dataclass
 from pathlib import Path
@@ -132,8 +131,7 @@ def reference(path: Path, rel: str, companions: tuple[str, ...]) -> tuple[float,
     """Volume and inertia tensor about the centre (unit density) of the file as trimesh reads it, exactly."""
     import trimesh
 
-    sys.path.insert(0, str(ROOT / "tests"))
-    from exact import exact_solid
+    from benchmarks.exact import exact_solid
 
     kwargs: dict[str, Any] = {}
     if companions:

@@ -24,10 +24,10 @@ import argparse
 import math
 import sys
 import time
+from collections.abc import Callable, Sequence
 from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Callable, Sequence
 
 import mpmath
 import numpy as np
@@ -35,16 +35,14 @@ from numpy.typing import NDArray
 from scipy.spatial.transform import Rotation
 
 ROOT = Path(__file__).resolve().parents[1]
-if str(ROOT) not in sys.path:
-    sys.path.insert(0, str(ROOT))
 
-from inertia.body import MeshBody, PointBody, VolumeBody  # noqa: E402
-from inertia.classification import RotorClass, classify  # noqa: E402
-from inertia.mass import mass_properties  # noqa: E402
-from inertia.motion import ideal_moments, motion_rotor  # noqa: E402
-from inertia.principal import principal_frame  # noqa: E402
-from tests.exact import (exact_eigenvalues, exact_points, exact_solid, exact_tetrahedra,  # noqa: E402
-                         relative_error)
+from benchmarks.cases import BOX_FACES
+from benchmarks.exact import exact_eigenvalues, exact_points, exact_solid, exact_tetrahedra, relative_error
+from inertia.body import MeshBody, PointBody, VolumeBody
+from inertia.classification import RotorClass, classify
+from inertia.mass import mass_properties
+from inertia.motion import ideal_moments, motion_rotor
+from inertia.principal import principal_frame
 
 __all__ = ["GENERIC", "BOUND_EXACT", "BOUND_THIN", "BOUND_INVARIANT", "box", "uv_sphere", "prism",
            "two_material_boxes", "log_uniform_points", "MeshCase", "geometry_cases", "measure_mesh",
@@ -67,8 +65,6 @@ SCIPY_MAX_ANGLE = 1e6
 """scipy runs the full horizon only when |Omega| T is at most this many radians;
 beyond, it runs 1e5 rad and the cell says so (1e11 rad would need ~1e10 steps)."""
 
-BOX_FACES = np.array([[0, 2, 1], [1, 2, 3], [4, 5, 6], [5, 7, 6], [0, 1, 4], [1, 5, 4],
-                      [2, 6, 3], [3, 6, 7], [0, 4, 2], [2, 4, 6], [1, 3, 5], [3, 7, 5]])
 HEX_TETS = np.array([[0, 1, 3, 7], [0, 1, 7, 5], [0, 5, 7, 4], [0, 3, 2, 7], [0, 2, 6, 7], [0, 6, 4, 7]])
 """Kuhn split of a hexahedron (vertex k has bits x, y, z) into six tetrahedra along 0-7."""
 
@@ -574,7 +570,7 @@ def _elliptic_reference(I: list[mpmath.mpf], w: list[mpmath.mpf], t: Array) -> A
     E2 = sum(i * x * x for i, x in zip(I, w))  # 2E
     M2 = sum((i * x) ** 2 for i, x in zip(I, w))
     # above the separatrix Omega_3 keeps its sign (dn), below Omega_1 does
-    d, c = (2, 0) if M2 > E2 * I[1] else (0, 2)
+    d, c = (2, 0) if E2 * I[1] < M2 else (0, 2)
     i1, i2, i3 = I
     if d == 2:
         amp = [mpmath.sqrt((E2 * i3 - M2) / (i1 * (i3 - i1))), mpmath.sqrt((E2 * i3 - M2) / (i2 * (i3 - i2))),

@@ -1,6 +1,6 @@
 """Regenerate the sample meshes and the table of their exact values.
 
-    python sample_meshes/generate.py
+    python -m sample_meshes.generate
 
 Every expected value in README.md here comes from a closed formula or from
 exact rational integration (``fractions.Fraction``) of the vertices as
@@ -10,110 +10,14 @@ written, never from the service itself.
 from __future__ import annotations
 
 import json
-import struct
-from fractions import Fraction
 from pathlib import Path
 
 import numpy as np
 
+from benchmarks.cases import box, icosahedron, l_bracket, prism, write_obj, write_stl
+from benchmarks.exact import exact_solid
+
 HERE = Path(__file__).resolve().parent
-
-BOX_FACES = [[0, 2, 1], [1, 2, 3], [4, 5, 6], [5, 7, 6], [0, 1, 4], [1, 5, 4],
-             [2, 6, 3], [3, 6, 7], [0, 4, 2], [2, 4, 6], [1, 3, 5], [3, 7, 5]]
-
-
-def box(a: float, b: float, c: float, origin=(0.0, 0.0, 0.0)) -> tuple[np.ndarray, np.ndarray]:
-    """Axis-aligned box with outward winding; vertex k has bits (x, y, z) = (k&1, k&2, k&4)."""
-    o = np.asarray(origin, dtype=float)
-    v = np.array([[(k & 1) * a, ((k >> 1) & 1) * b, ((k >> 2) & 1) * c] for k in range(8)]) + o
-    return v, np.array(BOX_FACES)
-
-
-def prism(n: int, radius: float, height: float) -> tuple[np.ndarray, np.ndarray]:
-    ang = 2 * np.pi * np.arange(n) / n
-    ring = np.stack([radius * np.cos(ang), radius * np.sin(ang)], axis=1)
-    v = np.vstack([np.c_[ring, np.zeros(n)], np.c_[ring, np.full(n, height)], [[0, 0, 0], [0, 0, height]]])
-    faces = []
-    for i in range(n):
-        j = (i + 1) % n
-        faces += [[i, j, n + j], [i, n + j, n + i], [2 * n, j, i], [2 * n + 1, n + i, n + j]]
-    return v, np.array(faces)
-
-
-def icosahedron(edge: float) -> tuple[np.ndarray, np.ndarray]:
-    phi = (1 + 5**0.5) / 2
-    s = edge / 2
-    v = []
-    for a in (-1, 1):
-        for b in (-1, 1):
-            v += [[0, a * s, b * s * phi], [a * s, b * s * phi, 0], [b * s * phi, 0, a * s]]
-    v = np.array(v)
-    faces = []
-    n = len(v)
-    for i in range(n):
-        for j in range(i + 1, n):
-            for k in range(j + 1, n):
-                d = [np.linalg.norm(v[p] - v[q]) for p, q in ((i, j), (j, k), (i, k))]
-                if all(abs(x - edge) < 1e-9 * edge for x in d):
-                    tri = [i, j, k]
-                    if np.dot(np.cross(v[j] - v[i], v[k] - v[i]), v[i]) < 0:
-                        tri = [i, k, j]
-                    faces.append(tri)
-    return v, np.array(faces)
-
-
-def l_bracket(depth: float) -> tuple[np.ndarray, np.ndarray]:
-    """L profile (0,0),(4,0),(4,1),(1,1),(1,3),(0,3) extruded by ``depth`` along z."""
-    prof = [(0, 0), (4, 0), (4, 1), (1, 1), (1, 3), (0, 3)]
-    n = len(prof)
-    v = np.array([[x, y, 0.0] for x, y in prof] + [[x, y, depth] for x, y in prof])
-    faces = []
-    for i in range(1, n - 1):  # fan from vertex 0 covers the L exactly
-        faces += [[0, i + 1, i], [n, n + i, n + i + 1]]
-    for i in range(n):
-        j = (i + 1) % n
-        faces += [[i, j, n + j], [i, n + j, n + i]]
-    return v, np.array(faces)
-
-
-def write_stl(path: Path, v: np.ndarray, f: np.ndarray) -> None:
-    rec = np.zeros(len(f), dtype=[("n", "<f4", (3,)), ("v", "<f4", (3, 3)), ("a", "<u2")])
-    rec["v"] = v[f].astype("<f4")
-    path.write_bytes(b"sample mesh".ljust(80, b" ") + struct.pack("<I", len(f)) + rec.tobytes())
-
-
-def write_obj(path: Path, v: np.ndarray, f: np.ndarray) -> None:
-    lines = [f"v {x!r} {y!r} {z!r}" for x, y, z in v.tolist()]
-    lines += [f"f {a + 1} {b + 1} {c + 1}" for a, b, c in f.tolist()]
-    path.write_text("\n".join(lines) + "\n")
-
-
-def exact_solid(v: np.ndarray, f: np.ndarray) -> tuple[Fraction, list[Fraction], list[list[Fraction]]]:
-    """Volume, centre and inertia tensor (unit density) of the polyhedron, in rationals.
-
-    Signed tetrahedra from the origin (Tonon 2004): int x_i x_j = V/20 (sum p p + S S).
-    """
-    V = [[Fraction(float(x)) for x in row] for row in v]
-    m0 = Fraction(0)
-    m1 = [Fraction(0)] * 3
-    m2 = [[Fraction(0)] * 3 for _ in range(3)]
-    for t in f.tolist():
-        a, b, c = V[t[0]], V[t[1]], V[t[2]]
-        det = (a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0])
-               + a[2] * (b[0] * c[1] - b[1] * c[0]))
-        vol = det / 6
-        s = [a[i] + b[i] + c[i] for i in range(3)]
-        m0 += vol
-        for i in range(3):
-            m1[i] += vol * s[i] / 4
-            for j in range(3):
-                m2[i][j] += vol / 20 * (a[i] * a[j] + b[i] * b[j] + c[i] * c[j] + s[i] * s[j])
-    com = [x / m0 for x in m1]
-    cov = [[m2[i][j] - m0 * com[i] * com[j] for j in range(3)] for i in range(3)]
-    tr = sum(cov[i][i] for i in range(3))
-    tensor = [[(tr if i == j else 0) - cov[i][j] for j in range(3)] for i in range(3)]
-    return m0, com, tensor
-
 
 def write_two_density_vtu(path: Path) -> dict[str, float]:
     """A 2x1x1 box of tetrahedra, density 1000 for x < 1 and 8000 for x > 1."""
@@ -193,7 +97,7 @@ def _write_readme(rows: list) -> None:
         "# Sample meshes",
         "",
         "Small bodies with known answers, used by the tests and the README examples.",
-        "Regenerate with `python sample_meshes/generate.py`. Values are SI at the default",
+        "Regenerate with `python -m sample_meshes.generate`. Values are SI at the default",
         "density 1000 kg/m³ and units m, computed by exact rational integration of the",
         "vertices as written (float32 for binary STL) or from closed formulas; moments",
         "are ascending principal moments about the centre of mass.",

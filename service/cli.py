@@ -89,10 +89,11 @@ def add_analysis_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("--reference", type=_triple, metavar="X,Y,Z",
                    help="point (file units): also report the tensor about it; negative values as written: -1,0,0")
     p.add_argument("--densities", help="JSON file: part name -> density (kg/m^3) for files of several parts")
-    p.add_argument("--geometry", choices=("brep", "mesh"), default="brep",
+    p.add_argument("--geometry", choices=("brep", "mesh"),
                    help="CAD files: integrate the exact B-rep (default) or a tessellation of it")
     p.add_argument("--deflection", type=float,
-                   help="with --geometry mesh: chordal deflection relative to the bounding-box diagonal (default 1e-3)")
+                   help="CAD files: tessellate (implies --geometry mesh) with this chordal deflection relative to "
+                   "the bounding-box diagonal (default 1e-3)")
     p.add_argument("--frame", type=_quaternion, metavar="W,X,Y,Z",
                    help="unit quaternion carrying a named frame's axes into the file's: also report the centre of "
                    "mass and tensors along that frame's axes")
@@ -126,7 +127,7 @@ def options_from_args(args: argparse.Namespace) -> Any:
         samples=getattr(args, "samples", None),
         method=getattr(args, "method", "exact"),
         densities=densities,
-        geometry=getattr(args, "geometry", "brep"),
+        geometry=getattr(args, "geometry", None) or ("mesh" if getattr(args, "deflection", None) else "brep"),
         deflection=getattr(args, "deflection", None),
         export=getattr(args, "export", None),
         frame=getattr(args, "frame", None),
@@ -208,9 +209,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         if args.command == "analyze":
             return _analyze(args)
         if args.command == "batch":
-            from .batch import run_batch_cli
-
-            return run_batch_cli(args)
+            return _batch(args)
         return _serve(args)
     except ServiceError as exc:
         if as_json:
@@ -245,6 +244,31 @@ def _analyze(args: argparse.Namespace) -> int:
         print(text)
     else:
         print(render_table(doc, args.output_units))
+    return 0
+
+
+def _batch(args: argparse.Namespace) -> int:
+    """``inertia batch``: run, print a one-line summary to stderr, exit 0.
+
+    Files that fail are rows of the output, not a failure of the run; a bad
+    option or a missing extra raises ``InvalidParameterError`` (exit 2).
+    """
+    if args.scheduler is None:  # a local cluster: its workers' imports start now, beside this process's
+        from .batch.workers import start_forkserver
+
+        start_forkserver()
+    from .batch import run_batch
+
+    summary = run_batch(
+        args.paths,
+        args.out,
+        options_from_args(args),
+        resume=args.resume,
+        workers=args.workers,
+        scheduler=args.scheduler,
+        progress=not args.no_progress,
+    )
+    print(summary.as_text(), file=sys.stderr)
     return 0
 
 
@@ -362,6 +386,9 @@ def render_table(doc: dict[str, Any], output_units: str = "si") -> str:
                          f"moments {_vec(moments)} {inertia_unit}"))
     diag = doc["diagnostics"]
     rows.append(("relative error", f"{diag['relative_error_estimate']:.2g}"))
+    if "tessellation_error" in diag:
+        rows.append(("tessellation error", f"{diag['tessellation_error']:.2g} vs the exact B-rep "
+                     f"(deflection {doc['source'].get('deflection')})"))
     rows.append(("elapsed", f"{diag['elapsed_s'] * 1e3:.2f} ms"))
     width = max(len(k) for k, _ in rows)
     lines += [f"  {k:<{width}}  {v}" for k, v in rows]

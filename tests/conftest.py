@@ -1,16 +1,12 @@
-"""Shared fixtures: the sample-mesh generator doubles as the exact reference."""
+"""Shared fixtures; shared helpers live in ``tests.support`` and ``benchmarks`` (imported, not put on a path)."""
 
 from __future__ import annotations
 
-import sys
 from pathlib import Path
 
 import pytest
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-from paths import SAMPLES  # noqa: E402
-
-sys.path.insert(0, str(SAMPLES))
+from tests.support.paths import SAMPLES
 
 
 @pytest.fixture

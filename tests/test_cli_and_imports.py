@@ -8,7 +8,7 @@ import sys
 
 import pytest
 
-from paths import ROOT, SAMPLES
+from tests.support.paths import ROOT, SAMPLES
 
 
 def run(*args: str) -> subprocess.CompletedProcess[str]:

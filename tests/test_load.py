@@ -3,13 +3,14 @@
 from __future__ import annotations
 
 import json
+from pathlib import Path
 
 import meshio
 import numpy as np
 import pytest
 import trimesh
 
-from generate import box
+from benchmarks.cases import box
 from inertia.errors import EmptyGeometryError, UnreadableFileError, UnsupportedFormatError
 from inertia.mass import parallel_axis
 from inertia.pipeline import AnalysisOptions, analyze
@@ -128,7 +129,7 @@ def hex_wedge_pyramid_mesh() -> meshio.Mesh:
 
 
 @pytest.mark.parametrize("ext,fmt", [("vtu", "vtu"), ("vtk", "vtk"), ("msh", "gmsh22")])
-def test_volume_cells_of_every_kind_integrate_exactly(tmp_path, ext: str, fmt: str) -> None:  # noqa: ANN001
+def test_volume_cells_of_every_kind_integrate_exactly(tmp_path: Path, ext: str, fmt: str) -> None:
     path = tmp_path / f"cells.{ext}"
     meshio.write(path, hex_wedge_pyramid_mesh(), file_format=fmt, **({"binary": False} if fmt.startswith("gmsh") else {}))
     doc = analyze(path, options=AnalysisOptions(density=1.0)).as_dict()
@@ -141,7 +142,7 @@ def test_volume_cells_of_every_kind_integrate_exactly(tmp_path, ext: str, fmt: s
     np.testing.assert_allclose(doc["center_of_mass"], com, rtol=1e-14)
 
 
-def test_points_files_json_and_csv(tmp_path) -> None:  # noqa: ANN001
+def test_points_files_json_and_csv(tmp_path: Path) -> None:
     pts = [{"mass": 1.0, "position": [0, 0, 0]}, {"mass": 3.0, "position": [2, 0, 0]}]
     (tmp_path / "p.json").write_text(json.dumps(pts))
     (tmp_path / "p.csv").write_text("mass,x,y,z\n1,0,0,0\n3,2,0,0\n")
@@ -214,12 +215,7 @@ def test_gltf_with_its_bin_in_one_upload_is_read() -> None:
 
 
 def test_assembly_far_from_the_origin_keeps_every_moment() -> None:
-    import sys
-
-    from paths import ROOT
-
-    sys.path.insert(0, str(ROOT / "tests"))
-    from exact import exact_eigenvalues, exact_solid
+    from benchmarks.exact import exact_eigenvalues, exact_solid
 
     offset = np.array([1e6, -6e5, 3e5])  # OBJ text keeps float64 coordinates
     left = trimesh.Trimesh(*box(1.0, 1.0, 1.0), process=False)

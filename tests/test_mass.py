@@ -2,12 +2,15 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import mpmath
 import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from generate import box, exact_solid, l_bracket, prism  # sample_meshes/generate.py
+from benchmarks.cases import box, l_bracket, prism
+from benchmarks.exact import exact_solid
 from inertia.body import MeshBody, PointBody, VolumeBody
 from inertia.errors import InvalidParameterError, NotWatertightError, ZeroVolumeError
 from inertia.mass import mass_properties
@@ -27,7 +30,7 @@ def rel(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return np.abs(np.asarray(a) - np.asarray(b)) / np.abs(np.asarray(b))
 
 
-def moments(props) -> np.ndarray:  # noqa: ANN001
+def moments(props) -> np.ndarray:
     return np.sort(props.principal_moments)
 
 
@@ -206,9 +209,8 @@ def test_reference_tensor_follows_parallel_axis_theorem() -> None:
 
 
 def test_two_material_volume_mesh_matches_composite_box() -> None:
-    from generate import write_two_density_vtu  # noqa: F401  (same geometry as the sample)
     from inertia.load import load_body
-    from paths import SAMPLES
+    from tests.support.paths import SAMPLES
 
     loaded = load_body(SAMPLES / "two_density.vtu")
     props = mass_properties(loaded.body)
@@ -279,19 +281,18 @@ def test_tetratomic_with_equal_masses_and_regular_shape_is_spherical() -> None:
     np.testing.assert_allclose(moments(props), [m * a * a] * 3, rtol=1e-13)
 
 
-def test_results_are_bit_identical_across_processes(tmp_path) -> None:  # noqa: ANN001
+def test_results_are_bit_identical_across_processes(tmp_path: Path) -> None:
     import subprocess
     import sys
 
     code = (
-        "import sys; sys.path.insert(0, 'sample_meshes');"
-        "from generate import l_bracket; import numpy as np;"
+        "from benchmarks.cases import l_bracket; import numpy as np;"
         "from scipy.spatial.transform import Rotation as R;"
         "from inertia.body import MeshBody; from inertia.mass import mass_properties;"
         "v, f = l_bracket(2.0); v = v @ R.from_euler('xyz', [.1, .2, .3]).as_matrix().T + 1e5;"
         "p = mass_properties(MeshBody(v, f)); print(p.inertia.matrix.tobytes().hex(), p.center_of_mass.tobytes().hex())"
     )
-    from paths import ROOT
+    from tests.support.paths import ROOT
 
     outs = {subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT, check=True).stdout
             for _ in range(2)}

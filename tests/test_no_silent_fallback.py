@@ -8,7 +8,6 @@ from their volumes, the unit cube's surface area 6.
 from __future__ import annotations
 
 import io
-import struct
 import subprocess
 import sys
 from pathlib import Path
@@ -17,6 +16,7 @@ import numpy as np
 import pytest
 
 import inertia
+from benchmarks.cases import stl_bytes
 from inertia import AnalysisOptions, analyze
 from inertia.errors import InvalidParameterError
 
@@ -43,12 +43,6 @@ def obj_two_boxes() -> bytes:
         out.writelines(f"f {a + 1 + base} {b + 1 + base} {c + 1 + base}\n" for a, b, c in f)
         base += len(v)
     return out.getvalue().encode()
-
-
-def stl_bytes(v: np.ndarray, f: np.ndarray) -> bytes:
-    tris = v[f].astype("<f4")
-    body = b"".join(struct.pack("<3f", 0, 0, 0) + t.tobytes() + b"\0\0" for t in tris)
-    return b"\0" * 80 + struct.pack("<I", len(f)) + body
 
 
 def test_a_densities_typo_is_an_error_naming_the_parts() -> None:

@@ -17,11 +17,10 @@ import pytest
 import inertia.integrals as integrals
 import inertia.mass as mass
 import inertia.topology as topology
+from benchmarks.exact import exact_moments, exact_solid, relative_error
 from inertia.body import MeshBody
-from inertia.tolerances import EPS
 from inertia.load.stl import read_stl
-
-from exact import exact_moments, exact_solid, relative_error
+from inertia.tolerances import EPS
 
 
 def _binary_stl(triangles: np.ndarray) -> bytes:

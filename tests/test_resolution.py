@@ -20,16 +20,18 @@ import subprocess
 import sys
 import warnings
 from collections.abc import Iterator
+from pathlib import Path
 
 import numpy as np
 import pytest
-from exact import exact_moments, relative_error
-from paths import ROOT
+from fastapi.testclient import TestClient
 from scipy.spatial.transform import Rotation
 
+from benchmarks.exact import exact_moments, relative_error
 from inertia import analyze, analyze_points
 from inertia.errors import DegenerateBodyError, InsufficientPrecisionError
 from inertia.pipeline import AnalysisOptions
+from tests.support.paths import ROOT
 
 # a 1 x 0.5 x 0.2 box, turned so that no coordinate lies on a float32 grid line
 ROT = Rotation.from_euler("zyx", [0.3, 0.5, -0.7]).as_matrix()
@@ -65,7 +67,7 @@ def obj_text(vertices: np.ndarray, faces: np.ndarray) -> bytes:
 
 
 @pytest.mark.parametrize("exponent", range(9))
-def test_float32_part_at_growing_offsets_is_exact_or_refused(exponent):
+def test_float32_part_at_growing_offsets_is_exact_or_refused(exponent) -> None:
     offset = 10.0**exponent * np.array([1.0, 0.7, 0.4])
     vertices = CORNERS @ ROT.T + offset
     data = binary_stl(vertices, FACES)
@@ -92,7 +94,7 @@ def test_float32_part_at_growing_offsets_is_exact_or_refused(exponent):
         assert any("float32" in w for w in result.warnings)
 
 
-def test_the_part_collapses_within_the_range():
+def test_the_part_collapses_within_the_range() -> None:
     refused = []
     for exponent in range(9):
         vertices = CORNERS @ ROT.T + 10.0**exponent * np.array([1.0, 0.7, 0.4])
@@ -103,13 +105,13 @@ def test_the_part_collapses_within_the_range():
     assert refused and refused == list(range(refused[0], refused[-1] + 1)) and refused[0] <= 7
 
 
-def test_zero_volume_float32_shells_are_refused_not_flipped_into_a_body():
+def test_zero_volume_float32_shells_are_refused_not_flipped_into_a_body() -> None:
     vertices, faces = flat_shells(1e4)
     with pytest.raises(InsufficientPrecisionError, match="float32"):
         analyze(binary_stl(vertices, faces), filename="shells.stl")
 
 
-def test_zero_volume_float64_shells_are_refused_not_flipped_into_a_body():
+def test_zero_volume_float64_shells_are_refused_not_flipped_into_a_body() -> None:
     vertices, faces = flat_shells(1e6)
     with pytest.raises(InsufficientPrecisionError, match="degenerate shells"):
         analyze(obj_text(vertices, faces), filename="shells.obj")
@@ -127,7 +129,7 @@ def _collinear(seed: int) -> list[dict[str, object]]:
 
 
 @pytest.mark.parametrize("points", [COLLINEAR] + [_collinear(s) for s in range(20)])
-def test_collinear_points_with_omega_are_a_rotator(points):
+def test_collinear_points_with_omega_are_a_rotator(points) -> None:
     result = analyze_points(points, AnalysisOptions(omega=(0.1, 1.0, 0.3)))
     assert result.classification.kind == "linear_rotator"
     assert result.motion is not None and result.motion.regime.value == "rotator"
@@ -155,7 +157,7 @@ def client() -> Iterator[object]:
         yield c
 
 
-def test_http_collinear_points_with_omega(client):
+def test_http_collinear_points_with_omega(client: TestClient) -> None:
     res = client.post("/v1/analyze/points", json={"points": COLLINEAR, "omega": [0.1, 1, 0.3]})
     assert res.status_code == 200, res.text
     doc = res.json()
@@ -163,7 +165,7 @@ def test_http_collinear_points_with_omega(client):
     assert "Infinity" not in res.text and "NaN" not in res.text
 
 
-def test_http_float32_collapse_is_a_422_naming_the_cause(client):
+def test_http_float32_collapse_is_a_422_naming_the_cause(client: TestClient) -> None:
     vertices = CORNERS @ ROT.T + 1e7 * np.array([1.0, 0.7, 0.4])
     res = client.post("/v1/analyze/mesh", files={"file": ("part.stl", binary_stl(vertices, FACES))})
     assert res.status_code == 422
@@ -171,7 +173,7 @@ def test_http_float32_collapse_is_a_422_naming_the_cause(client):
     assert err["code"] == "insufficient_precision" and "float32" in err["message"]
 
 
-def test_cli_json_never_prints_infinity(tmp_path):
+def test_cli_json_never_prints_infinity(tmp_path: Path) -> None:
     path = tmp_path / "line.json"
     path.write_text(json.dumps({"points": COLLINEAR}))
     out = subprocess.run([sys.executable, "-m", "inertia", "analyze", str(path), "--json", "--omega", "0.1,1,0.3"],

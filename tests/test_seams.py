@@ -4,9 +4,9 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from exact import exact_solid
-from generate import box, icosahedron
 
+from benchmarks.cases import box, icosahedron
+from benchmarks.exact import exact_solid
 from inertia.body import MeshBody, Part
 from inertia.errors import NotWatertightError, ZeroVolumeError
 from inertia.mass import mass_properties

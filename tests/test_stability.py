@@ -12,24 +12,37 @@ invariants of the exact motion to 1e-12 over 1e5 time units.
 from __future__ import annotations
 
 import math
-import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # benchmarks/ is not installed
-
-from benchmarks.stability import (BOUND_EXACT, BOUND_INVARIANT, BOUND_THIN, BOX_FACES, HORIZON, MeshCase,  # noqa: E402
-                                  geometry_cases, measure_motion, moment_errors, motion_cases,
-                                  near_symmetric_flip, placed, point_case, prism, smallest_true_tolerance,
-                                  sphere_with_triangles, two_material_case, box, DIRECTION)
-from exact import exact_eigenvalues, exact_solid  # noqa: E402
-from inertia.body import MeshBody  # noqa: E402
-from inertia.classification import RotorClass, classify  # noqa: E402
-from inertia.mass import mass_properties  # noqa: E402
-from inertia.principal import PrincipalFrame, principal_frame  # noqa: E402
-from inertia.tolerances import EPS  # noqa: E402
+from benchmarks.exact import exact_eigenvalues, exact_solid
+from benchmarks.stability import (
+    BOUND_EXACT,
+    BOUND_INVARIANT,
+    BOUND_THIN,
+    BOX_FACES,
+    DIRECTION,
+    HORIZON,
+    MeshCase,
+    box,
+    geometry_cases,
+    measure_motion,
+    moment_errors,
+    motion_cases,
+    near_symmetric_flip,
+    placed,
+    point_case,
+    prism,
+    smallest_true_tolerance,
+    sphere_with_triangles,
+    two_material_case,
+)
+from inertia.body import MeshBody
+from inertia.classification import RotorClass, classify
+from inertia.mass import mass_properties
+from inertia.principal import PrincipalFrame, principal_frame
+from inertia.tolerances import EPS
 
 GEOMETRY = {c.name: c for c in geometry_cases(quick=True)}
 
@@ -126,7 +139,7 @@ def test_smallest_true_tolerance_finds_the_gap() -> None:
 
 
 @pytest.mark.parametrize("case", motion_cases(), ids=lambda c: c.name)
-def test_exact_motion_keeps_invariants_over_1e5_time_units(case) -> None:  # noqa: ANN001
+def test_exact_motion_keeps_invariants_over_1e5_time_units(case) -> None:
     row = measure_motion(case, samples=2001, reference_samples=9, run_scipy=False)
     assert row["finite"]
     assert row["energy_drift"] <= BOUND_INVARIANT, row

@@ -10,8 +10,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 import trimesh
-from generate import box
 
+from benchmarks.cases import box
 from inertia.errors import (
     EmptyGeometryError,
     NotWatertightError,

@@ -27,7 +27,7 @@ def _reference(tensor: np.ndarray) -> list[mp.mpf]:
 
 
 @pytest.mark.parametrize("exponent", np.linspace(0.0, -12.0, 13))
-def test_rotated_tensor_estimate_is_never_below_the_error(exponent):
+def test_rotated_tensor_estimate_is_never_below_the_error(exponent) -> None:
     rng = np.random.default_rng(int(-exponent * 10) + 1)
     worst = 0.0
     for _ in range(20):
@@ -55,7 +55,7 @@ def test_rotated_tensor_estimate_is_never_below_the_error(exponent):
     assert worst < 1.0
 
 
-def test_the_estimate_scales_with_the_conditioning():
+def test_the_estimate_scales_with_the_conditioning() -> None:
     r = special_ortho_group.rvs(3, random_state=5)
     estimates = []
     for ratio in (1.0, 1e-4, 1e-8, 1e-12):
@@ -65,12 +65,12 @@ def test_the_estimate_scales_with_the_conditioning():
     assert all(a < b for a, b in itertools.pairwise(estimates))
 
 
-def test_principal_moments_as_given_keep_a_rounding_estimate():
+def test_principal_moments_as_given_keep_a_rounding_estimate() -> None:
     res = precession([0.1, 0.2, 0.3], principal_moments=[1e-12, 1.0, 1.0])
     assert res.relative_error_estimate <= 1e-14
 
 
-def test_a_rod_tensor_reports_zero_not_a_negative_moment():
+def test_a_rod_tensor_reports_zero_not_a_negative_moment() -> None:
     r = special_ortho_group.rvs(3, random_state=9)
     tensor = r @ np.diag([0.0, 1.0, 1.0]) @ r.T
     res = precession([0.3, -0.2, 1.0], inertia_tensor=0.5 * (tensor + tensor.T), duration=1.0, samples=3)
@@ -80,6 +80,6 @@ def test_a_rod_tensor_reports_zero_not_a_negative_moment():
     assert np.isfinite(res.relative_error_estimate)
 
 
-def test_a_negative_moment_beyond_rounding_is_refused():
+def test_a_negative_moment_beyond_rounding_is_refused() -> None:
     with pytest.raises(InvalidParameterError, match="negative principal moment"):
         precession([0, 0, 1.0], inertia_tensor=np.diag([-1e-9, 1.0, 1.0]))

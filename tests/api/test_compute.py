@@ -12,8 +12,7 @@ from inertia.api.compute import ComputePool
 from inertia.api.jobs import MeshJob
 from inertia.errors import ComputeTimeoutError, NotWatertightError
 from inertia.pipeline import AnalysisOptions
-
-from .meshes import box_stl, torus_stl
+from tests.support.meshes import box_stl, torus_stl
 
 
 def open_box() -> bytes:

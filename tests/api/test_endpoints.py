@@ -9,8 +9,9 @@ import zipfile
 
 import numpy as np
 import pytest
+from fastapi.testclient import TestClient
 
-from .meshes import box_stl
+from tests.support.meshes import box_stl
 
 REL = 1e-12  # float32 box corners are exact; what is left is summation rounding
 
@@ -25,16 +26,16 @@ def box_tensor(m: float, a: float, b: float, c: float) -> np.ndarray:
     return np.diag([m * (b * b + c * c) / 12, m * (a * a + c * c) / 12, m * (a * a + b * b) / 12])
 
 
-def upload(client, data: bytes, name: str = "box.stl", **params: object):
+def upload(client: TestClient, data: bytes, name: str = "box.stl", **params: object):
     return client.post("/v1/analyze/mesh", files={"file": (name, data)}, params=params)
 
 
-def test_healthz_is_ok(client) -> None:
+def test_healthz_is_ok(client: TestClient) -> None:
     r = client.get("/healthz")
     assert r.status_code == 200 and r.json() == {"status": "ok"}
 
 
-def test_box_mass_centre_and_tensor_match_closed_form(client) -> None:
+def test_box_mass_centre_and_tensor_match_closed_form(client: TestClient) -> None:
     r = upload(client, box_stl(1, 2, 3))
     assert r.status_code == 200, r.text
     doc = r.json()
@@ -49,7 +50,7 @@ def test_box_mass_centre_and_tensor_match_closed_form(client) -> None:
                              "vertices": 8, "triangles": 12, "watertight": True}
 
 
-def test_response_holds_only_sections_asked_for(client) -> None:
+def test_response_holds_only_sections_asked_for(client: TestClient) -> None:
     doc = upload(client, box_stl(1, 2, 3)).json()
     for absent in ("reference_inertia", "precession", "parts"):
         assert absent not in doc
@@ -58,7 +59,7 @@ def test_response_holds_only_sections_asked_for(client) -> None:
     assert "precession" in with_omega and "trajectory" not in with_omega["precession"]
 
 
-def test_reference_tensor_follows_parallel_axis_theorem(client) -> None:
+def test_reference_tensor_follows_parallel_axis_theorem(client: TestClient) -> None:
     doc = upload(client, box_stl(1, 2, 3), reference="0,0,0").json()
     d = np.array([0.5, 1.0, 1.5])
     # Steiner: I_O = I_G + m (|d|^2 E - d d^T)
@@ -67,7 +68,7 @@ def test_reference_tensor_follows_parallel_axis_theorem(client) -> None:
     assert close(doc["reference_inertia"]["tensor"], expected)
 
 
-def test_units_density_and_mass_options_scale_as_expected(client) -> None:
+def test_units_density_and_mass_options_scale_as_expected(client: TestClient) -> None:
     mm = upload(client, box_stl(10, 20, 30), units="mm", density=7850).json()
     m = 7850 * 6e-6
     assert mm["source"]["units"] == "mm" and mm["mass"] == pytest.approx(m, rel=1e-12)
@@ -76,24 +77,24 @@ def test_units_density_and_mass_options_scale_as_expected(client) -> None:
     assert by_mass["mass"] == pytest.approx(12, rel=REL) and by_mass["density"] == pytest.approx(2, rel=REL)
 
 
-def test_format_parameter_overrides_the_file_name(client) -> None:
+def test_format_parameter_overrides_the_file_name(client: TestClient) -> None:
     r = upload(client, box_stl(1, 2, 3), name="upload.bin", format="stl")
     assert r.status_code == 200 and r.json()["source"]["format"] == "stl"
 
 
-def test_client_paths_are_never_followed(client) -> None:
+def test_client_paths_are_never_followed(client: TestClient) -> None:
     doc = upload(client, box_stl(1, 2, 3), name="../../etc/box.stl").json()
     assert doc["source"]["filename"] == "box.stl"
 
 
-def test_omega_with_duration_and_samples_adds_a_trajectory(client) -> None:
+def test_omega_with_duration_and_samples_adds_a_trajectory(client: TestClient) -> None:
     doc = upload(client, box_stl(1, 2, 3), omega="0.01,1,0.01", duration=2, samples=5, method="dop853").json()
     traj = doc["precession"]["trajectory"]
     assert len(traj["t"]) == 5 and traj["t"][0] == 0 and traj["t"][-1] == pytest.approx(2)
     assert close(traj["quaternion"][0], [1, 0, 0, 0])
 
 
-def test_points_dumbbell_is_a_linear_rotator(client) -> None:
+def test_points_dumbbell_is_a_linear_rotator(client: TestClient) -> None:
     r = client.post("/v1/analyze/points", json={"points": [
         {"mass": 1.0, "position": [0, 0, 0]}, {"mass": 1.0, "position": [1, 0, 0]}]})
     assert r.status_code == 200, r.text
@@ -105,7 +106,7 @@ def test_points_dumbbell_is_a_linear_rotator(client) -> None:
     assert "volume" not in doc and "density" not in doc
 
 
-def test_points_example_of_the_contract_works(client) -> None:
+def test_points_example_of_the_contract_works(client: TestClient) -> None:
     body = {"points": [{"mass": 1.0, "position": [0, 0, 0]}, {"mass": 2.0, "position": [1, 0, 0]}],
             "units": "m", "tolerance": 1e-6, "reference": [0, 0, 0], "omega": [0, 0, 1],
             "duration": 10.0, "samples": 100, "method": "exact"}
@@ -116,7 +117,7 @@ def test_points_example_of_the_contract_works(client) -> None:
     assert len(doc["precession"]["trajectory"]["t"]) == 100
 
 
-def test_precession_of_symmetric_top_matches_landau_lifshitz(client) -> None:
+def test_precession_of_symmetric_top_matches_landau_lifshitz(client: TestClient) -> None:
     I1, I3, w = 1.0, 2.0, np.array([0.1, 0.0, 1.0])
     r = client.post("/v1/precession", json={"principal_moments": [I1, I1, I3], "omega": w.tolist()})
     assert r.status_code == 200, r.text
@@ -134,7 +135,7 @@ def test_precession_of_symmetric_top_matches_landau_lifshitz(client) -> None:
     assert set(doc) == {"principal", "classification", "precession", "warnings", "diagnostics"}
 
 
-def test_precession_from_a_tensor_rotates_into_the_input_frame(client) -> None:
+def test_precession_from_a_tensor_rotates_into_the_input_frame(client: TestClient) -> None:
     r = client.post("/v1/precession", json={"inertia_tensor": [[3, 0, 0], [0, 2, 0], [0, 0, 4]],
                                             "omega": [0, 0, 1], "duration": 1, "samples": 3})
     doc = r.json()
@@ -143,7 +144,7 @@ def test_precession_from_a_tensor_rotates_into_the_input_frame(client) -> None:
     assert close(doc["precession"]["trajectory"]["omega"], [[0, 0, 1]] * 3, rel=1e-9)
 
 
-def test_formats_lists_surfaces_volumes_and_scenes(client) -> None:
+def test_formats_lists_surfaces_volumes_and_scenes(client: TestClient) -> None:
     doc = client.get("/v1/formats").json()
     names = {f["format"]: f for f in doc["formats"]}
     assert {"stl", "obj", "ply", "off", "glb", "gltf", "3mf", "vtu", "vtk", "msh"} <= set(names)
@@ -158,7 +159,7 @@ def _lines(response) -> list[dict]:
     return [json.loads(line) for line in response.text.splitlines()]
 
 
-def test_batch_streams_one_line_per_file_in_upload_order(client) -> None:
+def test_batch_streams_one_line_per_file_in_upload_order(client: TestClient) -> None:
     files = [("files", ("a.stl", box_stl(1, 2, 3))), ("files", ("notes.txt", b"hello")),
              ("files", ("empty.stl", b"")), ("files", ("b.stl", box_stl(2, 2, 2)))]
     lines = _lines(client.post("/v1/batch", files=files, params={"density": 500}))
@@ -168,7 +169,7 @@ def test_batch_streams_one_line_per_file_in_upload_order(client) -> None:
     assert lines[2]["error"]["code"] == "empty_geometry"
 
 
-def test_batch_of_a_zip_expands_members_in_archive_order(client) -> None:
+def test_batch_of_a_zip_expands_members_in_archive_order(client: TestClient) -> None:
     buf = io.BytesIO()
     with zipfile.ZipFile(buf, "w", zipfile.ZIP_DEFLATED) as zf:
         zf.writestr("parts/", b"")
@@ -185,7 +186,7 @@ def test_batch_of_a_zip_expands_members_in_archive_order(client) -> None:
     assert lines[3]["error"]["code"] == "unreadable_file"
 
 
-def test_openapi_documents_every_endpoint_with_an_example(client) -> None:
+def test_openapi_documents_every_endpoint_with_an_example(client: TestClient) -> None:
     spec = client.get("/openapi.json").json()
     paths = spec["paths"]
     for path in ("/v1/analyze/mesh", "/v1/analyze/points", "/v1/precession", "/v1/batch"):

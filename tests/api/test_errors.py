@@ -13,12 +13,13 @@ from typing import Any
 
 import numpy as np
 import pytest
+from fastapi.testclient import TestClient
+from pytest import LogCaptureFixture
 
 from inertia import errors as E
 from inertia.api import Settings, create_app
 from inertia.api.errors import STATUS
-
-from .meshes import box_stl, stl_bytes, torus_stl
+from tests.support.meshes import box_stl, stl_bytes, torus_stl
 
 with warnings.catch_warnings():
     warnings.filterwarnings("ignore", message="Using `httpx` with `starlette.testclient`")
@@ -106,7 +107,7 @@ def assert_envelope(response: Any, code: str, status: int) -> dict[str, Any]:
 
 @pytest.mark.parametrize(("cls", "code", "status", "request_"), CASES,
                          ids=[f"{c[1]}-{i}" for i, c in enumerate(CASES)])
-def test_bad_request_gets_its_code_and_status(client, cls, code, status, request_) -> None:
+def test_bad_request_gets_its_code_and_status(client: TestClient, cls, code, status, request_) -> None:
     assert cls.code == code and STATUS[next(k for k in type.mro(cls) if k in STATUS)] == status
     assert_envelope(request_(client), code, status)
 
@@ -152,12 +153,12 @@ def test_every_mapped_error_class_is_provoked_by_a_test() -> None:
             assert any(issubclass(p, cls) for p in provoked), cls
 
 
-def test_unknown_path_and_method_use_the_envelope(client) -> None:
+def test_unknown_path_and_method_use_the_envelope(client: TestClient) -> None:
     assert_envelope(client.get("/v2/nothing"), "not_found", 404)
     assert_envelope(client.get("/v1/precession"), "method_not_allowed", 405)
 
 
-def test_unexpected_exception_is_500_envelope_with_logged_traceback(caplog) -> None:
+def test_unexpected_exception_is_500_envelope_with_logged_traceback(caplog: LogCaptureFixture) -> None:
     app = create_app(Settings(compute_processes=1))
 
     @app.get("/boom")
@@ -171,7 +172,7 @@ def test_unexpected_exception_is_500_envelope_with_logged_traceback(caplog) -> N
     assert any(r.exc_info and "secret internal detail" in str(r.exc_info[1]) for r in caplog.records)
 
 
-def test_validation_error_names_the_field(client) -> None:
+def test_validation_error_names_the_field(client: TestClient) -> None:
     error = assert_envelope(points({"points": [{"mass": 1, "position": [0, 0, "x"]}]})(client),
                             "invalid_parameter", 422)
     assert "points.0.position" in error["message"] and error["details"]["errors"][0]["loc"][0] == "body"

@@ -21,11 +21,10 @@ from typing import Any
 import httpx
 import numpy as np
 import pytest
-from fuzz import hostile as H
 
 from inertia.api import Settings, create_app
-
-from .meshes import box_stl, torus_stl
+from tests.fuzz import hostile as H
+from tests.support.meshes import box_stl, torus_stl
 
 with warnings.catch_warnings():
     warnings.filterwarnings("ignore", message="Using `httpx` with `starlette.testclient`")

@@ -12,7 +12,7 @@ from typing import Any
 import httpx
 import pytest
 
-from .meshes import box_stl, torus_stl
+from tests.support.meshes import box_stl, torus_stl
 
 BOX = box_stl(1, 2, 3)
 

@@ -3,15 +3,13 @@
 from __future__ import annotations
 
 import json
-import struct
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-# Outward-wound box; vertex k has bits (x, y, z) = (k&1, k&2, k&4).
-BOX_FACES = np.array([[0, 2, 1], [1, 2, 3], [4, 5, 6], [5, 7, 6], [0, 1, 4], [1, 5, 4],
-                      [2, 6, 3], [3, 6, 7], [0, 4, 2], [2, 4, 6], [1, 3, 5], [3, 7, 5]])
+from benchmarks import cases
+
 N_FILES = 50
 BROKEN = {"broken/truncated.stl": "unreadable_file", "broken/open_box.stl": "not_watertight",
           "broken/garbage.stl": "unreadable_file"}
@@ -19,18 +17,15 @@ BROKEN = {"broken/truncated.stl": "unreadable_file", "broken/open_box.stl": "not
 
 def box(size: tuple[float, float, float], angle: float, offset: tuple[float, float, float]) -> np.ndarray:
     """Triangles (n, 3, 3) of a box rotated by ``angle`` about (1, 1, 1) and moved by ``offset``."""
-    a, b, c = size
-    v = np.array([[(k & 1) * a, ((k >> 1) & 1) * b, ((k >> 2) & 1) * c] for k in range(8)])
+    v, faces = cases.box(*size)
     axis = np.ones(3) / np.sqrt(3.0)
     k = np.array([[0, -axis[2], axis[1]], [axis[2], 0, -axis[0]], [-axis[1], axis[0], 0]])
     rot = np.eye(3) + np.sin(angle) * k + (1 - np.cos(angle)) * k @ k  # Rodrigues
-    return (v @ rot.T + np.asarray(offset))[BOX_FACES]
+    return (v @ rot.T + np.asarray(offset))[faces]
 
 
 def stl_bytes(tri: np.ndarray) -> bytes:
-    rec = np.zeros(len(tri), dtype=[("n", "<f4", (3,)), ("v", "<f4", (3, 3)), ("a", "<u2")])
-    rec["v"] = tri.astype("<f4")
-    return b"batch test".ljust(80, b" ") + struct.pack("<I", len(tri)) + rec.tobytes()
+    return cases.triangles_stl_bytes(tri, b"batch test".ljust(80, b" "))
 
 
 def obj_text(tri: np.ndarray) -> str:

@@ -9,7 +9,8 @@ from pathlib import Path
 from typing import Any
 
 import pytest
-from batchlib import make_library
+
+from tests.batch.batchlib import make_library
 
 
 @pytest.fixture(scope="session")

@@ -13,7 +13,6 @@ from pathlib import Path
 from typing import Any
 
 import pytest
-from batchlib import N_FILES, box, cli_error, stl_bytes, without_timing
 
 from inertia.batch import runner, workers
 from inertia.batch.sources import Source, iter_inputs, iter_zip_bytes, list_sources, read_source
@@ -21,6 +20,7 @@ from inertia.batch.tasks import analyze_source, analyze_sources
 from inertia.cli import main
 from inertia.errors import UnreadableFileError
 from inertia.pipeline import AnalysisOptions
+from tests.batch.batchlib import N_FILES, box, cli_error, stl_bytes, without_timing
 
 Library = tuple[Path, dict[str, "str | None"]]
 

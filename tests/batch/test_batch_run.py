@@ -11,12 +11,12 @@ from pathlib import Path
 from typing import Any
 
 import pytest
-from batchlib import BROKEN, N_FILES, box, by_name, cli_error, read_jsonl, stl_bytes, without_timing
 
 from inertia.batch.rows import COLUMNS, FLOAT_COLUMNS, flat_row
 from inertia.cli import main
 from inertia.errors import ServiceError
 from inertia.pipeline import AnalysisOptions, analyze
+from tests.batch.batchlib import BROKEN, N_FILES, box, by_name, cli_error, read_jsonl, stl_bytes, without_timing
 
 Library = tuple[Path, dict[str, "str | None"]]
 
@@ -297,11 +297,10 @@ def test_workers_and_scheduler_together_are_refused(library: Library, tmp_path: 
 
 def test_a_file_that_kills_its_worker_is_one_error_row_and_the_rest_complete(library: Library,
                                                                               tmp_path: Path) -> None:
-    from batchlib import crashing_task
-
     from inertia.batch import runner
     from inertia.batch.pool import run_pool
     from inertia.batch.sources import list_sources
+    from tests.batch.batchlib import crashing_task
 
     folder = tmp_path / "lib"
     shutil.copytree(library[0], folder)

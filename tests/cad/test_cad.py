@@ -31,10 +31,9 @@ import pytest
 
 pytest.importorskip("OCP")
 
-from cadlib import box, cylinder, nurbs, open_shell, write_iges, write_step
-
 from inertia.errors import NotWatertightError, UnsupportedFormatError
 from inertia.pipeline import AnalysisOptions, analyze
+from tests.cad.cadlib import box, cylinder, nurbs, open_shell, write_iges, write_step
 
 RHO = 1000.0  # the default density, kg/m^3
 REL = 1e-9
@@ -222,6 +221,15 @@ def test_garbage_step_is_unreadable() -> None:
         analyze(b"ISO-10303-21;\nHEADER;\nthis is not STEP\n", filename="junk.step")
 
 
+def test_step_naming_another_file_is_refused(step_assembly: bytes) -> None:
+    """An assembly whose parts live in other files: the server never opens a file an upload names."""
+    from inertia.errors import ExternalReferenceError
+
+    text = step_assembly.replace(b"DATA;", b"DATA;\n#999999=DOCUMENT_FILE('/etc/part.stp','',$,#1,'',$);", 1)
+    with pytest.raises(ExternalReferenceError):
+        analyze(text, filename="bracket.step")
+
+
 def test_step_is_recognised_by_content() -> None:
     doc = analyze(write_step([("plate", box(*BOX, CORNER))])).as_dict()
     assert doc["source"]["format"] == "step"
@@ -258,3 +266,14 @@ def test_missing_extra_error_in_the_library(monkeypatch: pytest.MonkeyPatch) -> 
     monkeypatch.setattr(occ, "available", lambda: False)
     with pytest.raises(UnsupportedFormatError, match=r"inertia-service\[cad\]"):
         analyze(write_step([("plate", box(*BOX, CORNER))]), filename="plate.step")
+
+
+def test_cli_reads_step_and_deflection_implies_mesh(tmp_path: Path, step_assembly: bytes) -> None:
+    path = tmp_path / "bracket.step"
+    path.write_bytes(step_assembly)
+    out = subprocess.run([sys.executable, "-m", "inertia", "analyze", str(path), "--deflection", "1e-3", "--json"],
+                         capture_output=True, timeout=120, check=True)
+    doc = json.loads(out.stdout)
+    assert doc["source"]["kind"] == "cad" and doc["source"]["geometry"] == "mesh"
+    assert [p["name"] for p in doc["parts"]] == ["plate", "rod"]
+    assert doc["diagnostics"]["tessellation_error"] > 0

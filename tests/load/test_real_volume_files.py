@@ -38,7 +38,7 @@ def test_quadratic_sphere_is_not_flattened_to_its_corners() -> None:
 
 @pytest.mark.parametrize("name", sorted(REFERENCE))
 def test_gmsh_meshes_agree_with_vtk_shape_functions(name: str) -> None:
-    volref = pytest.importorskip("volref")
+    volref = pytest.importorskip("tests.load.volref")
     from inertia.body import CellBlock
 
     body = load_body(QUADRATIC / name).body

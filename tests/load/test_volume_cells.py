@@ -15,7 +15,7 @@ from inertia.body import CellBlock, VolumeBody
 from inertia.cells import CELL_NODES, cell_rule, shape_functions
 from inertia.mass import assembly_properties, mass_properties
 
-volref = pytest.importorskip("volref")  # needs vtk (the 'vtk' extra, in 'test')
+volref = pytest.importorskip("tests.load.volref")  # needs vtk (the 'vtk' extra, in 'test')
 
 QUADRATIC = ("tetra10", "hexahedron20", "hexahedron27", "wedge15", "wedge18", "pyramid13")
 ALL_TYPES = tuple(CELL_NODES)

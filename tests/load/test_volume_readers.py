@@ -25,7 +25,7 @@ from inertia.mass import assembly_properties, mass_properties
 from inertia.pipeline import AnalysisOptions, analyze
 
 vtk = pytest.importorskip("vtk")
-import volref  # noqa: E402  (needs vtk)
+from tests.load import volref
 
 HEX = [(0, 0, 0), (1, 0, 0), (1, 1, 0), (0, 1, 0), (0, 0, 1), (1, 0, 1), (1, 1, 1), (0, 1, 1)]
 

@@ -6,9 +6,9 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from motion_reference import body, euler_reference, ll_period, quaternion_matrix
 from inertia.conventions import orient_axes
 from inertia.motion import Regime, predict_motion
+from tests.support.motion import body, euler_reference, ll_period, quaternion_matrix
 
 # principal axes as rows in the input frame, signs already by the convention's rule
 ROT = orient_axes(Rotation.from_euler("zyx", [0.3, 0.5, -0.7]).as_matrix())
@@ -24,13 +24,13 @@ GENERIC = [
 ]
 
 
-def _predict(moments, omega_body, rotation=ROT, tolerance=1e-6, **kw):
+def _predict(moments, omega_body, rotation=ROT, tolerance: float=1e-6, **kw):
     frame, cls = body(moments, rotation, tolerance)
     return predict_motion(frame, cls, np.asarray(rotation).T @ np.asarray(omega_body, dtype=float), **kw)
 
 
 @pytest.mark.parametrize("moments, omega", GENERIC)
-def test_period_is_4K_over_rate(moments, omega):
+def test_period_is_4K_over_rate(moments, omega) -> None:
     motion = _predict(moments, omega)
     assert motion.regime is Regime.ASYMMETRIC
     expected = ll_period(moments, omega)
@@ -38,7 +38,7 @@ def test_period_is_4K_over_rate(moments, omega):
 
 
 @pytest.mark.parametrize("moments, omega", GENERIC)
-def test_omega_and_attitude_match_dop853(moments, omega):
+def test_omega_and_attitude_match_dop853(moments, omega) -> None:
     t = np.linspace(0.0, 25.0, 201)
     motion = _predict(moments, omega, duration=25.0, samples=201)
     w_ref, r_ref = euler_reference(moments, omega, t)
@@ -54,7 +54,7 @@ def test_omega_and_attitude_match_dop853(moments, omega):
 
 
 @pytest.mark.parametrize("moments, omega", GENERIC[:3])
-def test_momentum_in_input_frame_is_constant(moments, omega):
+def test_momentum_in_input_frame_is_constant(moments, omega) -> None:
     motion = _predict(moments, omega, duration=1e3, samples=2001)
     traj = motion.trajectory
     m_body = traj.omega_body * np.asarray(moments)
@@ -65,7 +65,7 @@ def test_momentum_in_input_frame_is_constant(moments, omega):
     assert motion.diagnostics.energy_drift <= 1e-13
 
 
-def test_quaternions_are_unit_and_identity_at_zero():
+def test_quaternions_are_unit_and_identity_at_zero() -> None:
     motion = _predict((1.0, 2.0, 3.0), (0.3, 0.2, 1.0), duration=50.0, samples=501)
     q = motion.trajectory.quaternion
     assert np.max(np.abs(np.linalg.norm(q, axis=1) - 1.0)) <= 4e-16
@@ -73,7 +73,7 @@ def test_quaternions_are_unit_and_identity_at_zero():
     assert np.all(q[:, 0] >= 0.0)
 
 
-def test_flip_near_intermediate_axis():
+def test_flip_near_intermediate_axis() -> None:
     """Started 1e-3 off x2, Omega2 reverses every half period (the tennis-racket flip)."""
     moments, omega = (1.0, 2.0, 3.0), (1e-3, 1.0, 1e-3)
     motion = _predict(moments, omega, duration=300.0, samples=30001)
@@ -88,12 +88,12 @@ def test_flip_near_intermediate_axis():
     assert np.max(np.abs(w2)) == pytest.approx(1.0, rel=1e-5)
 
 
-def test_stable_when_nearest_an_extreme_axis():
+def test_stable_when_nearest_an_extreme_axis() -> None:
     motion = _predict((1.0, 2.0, 3.0), (0.3, 0.2, 1.0))
     assert motion.stable is True and motion.flip_interval is None
 
 
-def test_separatrix_has_no_period_and_follows_the_hyperbolic_limit():
+def test_separatrix_has_no_period_and_follows_the_hyperbolic_limit() -> None:
     # I = (3, 5, 6), Omega = (1, W2, 1): I3 (I3 - I2) W3^2 = I1 (I2 - I1) W1^2 = 6 exactly, so 2 E I2 = M^2.
     moments, omega = (3.0, 5.0, 6.0), (1.0, 0.3, 1.0)
     motion = _predict(moments, omega, rotation=np.eye(3), duration=40.0, samples=401)
@@ -113,7 +113,7 @@ def test_separatrix_has_no_period_and_follows_the_hyperbolic_limit():
 
 
 @pytest.mark.parametrize("side", [+1.0, -1.0])
-def test_within_1e_12_of_the_separatrix(side):
+def test_within_1e_12_of_the_separatrix(side) -> None:
     """2E I2 / M^2 - 1 ~ 1e-12 on either side: k'^2 ~ 1e-12, m rounds to 1 if formed as 1 - k'^2."""
     moments = (1.0, 2.0, 3.0)
     omega = (1.0, 0.4, np.sqrt((1.0 + side * 1e-12) / 3.0))  # I3 (I3 - I2) W3^2 - I1 (I2 - I1) W1^2 = +-1e-12
@@ -130,7 +130,7 @@ def test_within_1e_12_of_the_separatrix(side):
     assert np.max(np.abs(short.trajectory.omega_body - w_ref)) <= 1e-8
 
 
-def test_started_1e_9_off_the_intermediate_axis():
+def test_started_1e_9_off_the_intermediate_axis() -> None:
     moments, omega = (1.0, 2.0, 3.0), (1e-9, 1.0, 1e-9)
     motion = _predict(moments, omega, rotation=np.eye(3), duration=1e5, samples=20001)  # see above: conditioning
     assert motion.regime is Regime.ASYMMETRIC and motion.stable is False
@@ -143,7 +143,7 @@ def test_started_1e_9_off_the_intermediate_axis():
     assert np.max(np.abs(short.trajectory.omega_body - w_ref)) <= 1e-9
 
 
-def test_fast_spin_with_slow_asymmetry():
+def test_fast_spin_with_slow_asymmetry() -> None:
     """|Omega| = 1e6 rad/s, I2 - I1 = 1e-3 I1: the Jacobi phase stays accurate over ~1e4 periods."""
     moments = (1.0, 1.001, 2.0)
     omega = (6e5, 3e5, 7e5)
@@ -160,7 +160,7 @@ def test_fast_spin_with_slow_asymmetry():
 
 
 @pytest.mark.parametrize("scale", [1e-30, 1e30])
-def test_extreme_moment_scales_give_the_same_omega(scale):
+def test_extreme_moment_scales_give_the_same_omega(scale) -> None:
     moments, omega = np.array([1.0, 2.0, 3.0]), (0.3, 0.2, 1.0)
     unit = _predict(moments, omega, duration=1e5, samples=2001)
     scaled = _predict(moments * scale, omega, duration=1e5, samples=2001)
@@ -171,7 +171,7 @@ def test_extreme_moment_scales_give_the_same_omega(scale):
     assert scaled.diagnostics.energy_drift <= 1e-12 and scaled.diagnostics.momentum_drift <= 1e-12
 
 
-def test_nearly_linear_asymmetric_body_matches_dop853():
+def test_nearly_linear_asymmetric_body_matches_dop853() -> None:
     """I1 = 1e-9 I3: Omega1 swings at ~1e3 rad/s while the rest turns at ~1 rad/s."""
     moments, omega = (1e-9, 1.0, 1.001), (0.3, 0.2, 1.0)
     t = np.linspace(0.0, 0.05, 101)

@@ -8,7 +8,6 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from motion_reference import body, euler_reference
 from inertia.motion import MotionMethod, Regime, predict_motion
 from inertia.motion.elliptic import (
     complete_third_kind_rj,
@@ -20,6 +19,7 @@ from inertia.motion.elliptic import (
 from inertia.motion.integrators import SPLITTING_ORDER, integrate_splitting
 from inertia.motion.invariants import RigidProblem
 from inertia.tolerances import Tolerances
+from tests.support.motion import body, euler_reference
 
 MOMENTS, OMEGA = (1.0, 2.0, 3.0), (0.3, 0.2, 1.0)
 
@@ -31,7 +31,7 @@ def _exact(moments, omega, duration, samples, **kw):
 
 @pytest.mark.parametrize("method, tol", [("dop853", 1e-8), ("rk45", 1e-7), ("splitting", 1e-5)])
 @pytest.mark.parametrize("moments, omega", [(MOMENTS, OMEGA), ((1.0, 2.0, 3.0), (1.0, 0.4, 0.1)), ((2.0, 2.0, 3.0), (0.3, -0.4, 1.2))])
-def test_numerical_methods_agree_with_exact(method, tol, moments, omega):
+def test_numerical_methods_agree_with_exact(method, tol, moments, omega) -> None:
     frame, cls = body(moments)
     numeric = predict_motion(frame, cls, omega, duration=20.0, samples=41, method=method)
     exact = _exact(moments, omega, 20.0, 41)
@@ -44,14 +44,14 @@ def test_numerical_methods_agree_with_exact(method, tol, moments, omega):
     assert np.max(dq) <= tol
 
 
-def test_splitting_keeps_momentum_exactly_and_energy_without_drift():
+def test_splitting_keeps_momentum_exactly_and_energy_without_drift() -> None:
     frame, cls = body(MOMENTS)
     motion = predict_motion(frame, cls, OMEGA, duration=100.0, samples=11, method="splitting")
     assert motion.diagnostics.momentum_drift <= 1e-12  # rounding only, over ~4e5 sub-rotations
     assert motion.diagnostics.energy_drift <= 1e-6  # O((h Omega)^2), bounded, not growing
 
 
-def test_splitting_converges_at_its_declared_order():
+def test_splitting_converges_at_its_declared_order() -> None:
     problem = RigidProblem(np.array(MOMENTS), np.array(OMEGA), np.eye(3), np.array([1.0, 0, 0, 0]))
     t = np.array([0.0, 5.0])
     exact = _exact(MOMENTS, OMEGA, 5.0, 2).trajectory.omega_body[-1]
@@ -61,7 +61,7 @@ def test_splitting_converges_at_its_declared_order():
     assert abs(order - SPLITTING_ORDER) <= 0.1
 
 
-def test_integrator_tolerance_is_taken_from_tolerances():
+def test_integrator_tolerance_is_taken_from_tolerances() -> None:
     frame, cls = body(MOMENTS)
     loose = predict_motion(frame, cls, OMEGA, duration=20.0, samples=5, method="rk45", tolerances=Tolerances(integrator_rtol=1e-4))
     exact = _exact(MOMENTS, OMEGA, 20.0, 5)
@@ -70,7 +70,7 @@ def test_integrator_tolerance_is_taken_from_tolerances():
 
 
 @pytest.mark.parametrize("m1", [0.9, 0.5, 1e-3, 1e-9, 2e-18])
-def test_jacobi_functions_match_mpmath(m1):
+def test_jacobi_functions_match_mpmath(m1) -> None:
     K = quarter_period(m1)
     u = np.linspace(-K, K, 17)
     sn, cn, dn = jacobi_sncndn(u, m1)
@@ -85,7 +85,7 @@ def test_jacobi_functions_match_mpmath(m1):
 
 
 @pytest.mark.parametrize("m1, b", [(0.5, 0.3), (1e-12, 0.9), (0.99, 1e-3)])
-def test_elliptic_integrals_match_mpmath(m1, b):
+def test_elliptic_integrals_match_mpmath(m1, b) -> None:
     phi = 1.1
     s, c = np.sin(phi), np.cos(phi)
     d = np.sqrt(c * c + m1 * s * s)
@@ -110,7 +110,7 @@ omega_st = st.tuples(st.floats(-5.0, 5.0), st.floats(-5.0, 5.0), st.floats(-5.0,
 
 @settings(max_examples=40, deadline=None)
 @given(moments_st, omega_st, st.floats(1.0, 1e5))
-def test_exact_path_keeps_energy_and_momentum(moments, omega, duration):
+def test_exact_path_keeps_energy_and_momentum(moments, omega, duration) -> None:
     motion = _exact(moments, omega, duration, 257)
     assert motion.regime is Regime.ASYMMETRIC
     assert motion.diagnostics.energy_drift <= 1e-12
@@ -120,7 +120,7 @@ def test_exact_path_keeps_energy_and_momentum(moments, omega, duration):
 
 @settings(max_examples=15, deadline=None)
 @given(moments_st, omega_st)
-def test_exact_path_agrees_with_dop853(moments, omega):
+def test_exact_path_agrees_with_dop853(moments, omega) -> None:
     rate = np.linalg.norm(omega)
     duration = 10.0 / rate  # ~10 radians: beyond, DOP853's own error grows near separatrices
     motion = _exact(moments, omega, duration, 21)

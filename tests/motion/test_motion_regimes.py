@@ -9,11 +9,12 @@ import sys
 import mpmath as mp
 import numpy as np
 import pytest
+from scipy.spatial.transform import Rotation
+
 from inertia.conventions import orient_axes
 from inertia.errors import InvalidParameterError, MotionError
 from inertia.motion import MAX_SAMPLES, MotionMethod, Regime, predict_motion
-from motion_reference import body, euler_reference, quaternion_matrix
-from scipy.spatial.transform import Rotation
+from tests.support.motion import body, euler_reference, quaternion_matrix
 
 # principal axes as rows in the input frame, signs already by the convention's rule
 ROT = orient_axes(Rotation.from_euler("xyz", [0.4, -0.2, 1.1]).as_matrix())
@@ -22,7 +23,7 @@ BASE_KEYS = {"regime", "angular_momentum", "angular_momentum_magnitude", "kineti
 SYMMETRIC_KEYS = BASE_KEYS | {"body_precession_rate", "space_precession_rate", "spin_rate", "nutation_angle", "period", "stable"}
 
 
-def _predict(moments, omega_body, rotation=ROT, tolerance=1e-6, **kw):
+def _predict(moments, omega_body, rotation=ROT, tolerance: float=1e-6, **kw):
     frame, cls = body(moments, rotation, tolerance)
     return predict_motion(frame, cls, np.asarray(rotation).T @ np.asarray(omega_body, dtype=float), **kw)
 
@@ -31,7 +32,7 @@ def _predict(moments, omega_body, rotation=ROT, tolerance=1e-6, **kw):
     "moments, omega, unique",
     [((2.0, 2.0, 3.0), (0.3, -0.4, 1.2), 2), ((1.0, 2.5, 2.5), (0.8, 0.3, -0.4), 0), ((2.0, 2.0, 3.0), (0.3, 0.1, -2.0), 2)],
 )
-def test_symmetric_top_rates_match_landau_lifshitz(moments, omega, unique):
+def test_symmetric_top_rates_match_landau_lifshitz(moments, omega, unique) -> None:
     motion = _predict(moments, omega)
     assert motion.regime is Regime.REGULAR_PRECESSION and set(motion.as_dict()) == SYMMETRIC_KEYS
     i_perp = moments[1] if unique == 0 else moments[0]
@@ -46,7 +47,7 @@ def test_symmetric_top_rates_match_landau_lifshitz(moments, omega, unique):
     assert motion.period == pytest.approx(2 * np.pi / abs(omega_rate), rel=1e-14)
 
 
-def test_symmetric_trajectory_is_a_regular_precession():
+def test_symmetric_trajectory_is_a_regular_precession() -> None:
     moments, omega = (2.0, 2.0, 3.0), (0.3, -0.4, 1.2)
     motion = _predict(moments, omega, duration=40.0, samples=401)
     traj = motion.trajectory
@@ -61,7 +62,7 @@ def test_symmetric_trajectory_is_a_regular_precession():
     assert np.allclose(np.arccos(np.clip(axis_t @ m_hat, -1, 1)), motion.nutation_angle, atol=1e-7)
 
 
-def test_nearly_symmetric_gap_keeps_its_digits():
+def test_nearly_symmetric_gap_keeps_its_digits() -> None:
     """I3 - I1 = 1e-12: the rates come from the gap itself, not from 1/I3 - 1/I1."""
     moments, omega = (1.0, 1.0, 1.0 + 1e-12), (0.3, 0.2, 1.0)
     motion = _predict(moments, omega, rotation=np.eye(3), tolerance=1e-15, duration=1e5, samples=1001)
@@ -82,14 +83,14 @@ def test_nearly_symmetric_gap_keeps_its_digits():
     assert np.array_equal(default.trajectory.omega_body, motion.trajectory.omega_body)
 
 
-def test_spherical_top_keeps_omega_constant():
+def test_spherical_top_keeps_omega_constant() -> None:
     motion = _predict((2.0, 2.0, 2.0), (0.3, -0.4, 1.2), duration=10.0, samples=11)
     assert motion.regime is Regime.SPHERICAL and set(motion.as_dict()) == BASE_KEYS | {"stable", "trajectory"}
     assert np.allclose(motion.trajectory.omega, motion.trajectory.omega[0], atol=1e-15)
     assert np.allclose(motion.trajectory.omega[0], ROT.T @ np.array([0.3, -0.4, 1.2]), atol=1e-15)
 
 
-def test_linear_rotator_drops_the_axial_component():
+def test_linear_rotator_drops_the_axial_component() -> None:
     motion = _predict((0.0, 1.0, 1.0), (0.5, 0.3, -0.4), duration=10.0, samples=101)
     assert motion.regime is Regime.ROTATOR
     assert any("rotator axis" in w for w in motion.warnings)
@@ -102,7 +103,7 @@ def test_linear_rotator_drops_the_axial_component():
     assert np.max(np.abs(rod @ motion.angular_momentum)) <= 1e-14  # the rod stays perpendicular to M
 
 
-def test_nearly_linear_body_both_ways():
+def test_nearly_linear_body_both_ways() -> None:
     """I = (1e-9, 1, 1): labelled a rotator at the default tolerance, a prolate symmetric top at 1e-12;
     both move as the prolate top the moments make (issue 12: the tolerance labels, it does not idealise)."""
     moments, omega = (1e-9, 1.0, 1.0), (0.3, 0.2, 1.0)
@@ -120,7 +121,7 @@ def test_nearly_linear_body_both_ways():
     assert np.max(np.abs(quaternion_matrix(short.trajectory.quaternion) - r_ref)) <= 1e-10
 
 
-def test_rest():
+def test_rest() -> None:
     motion = _predict((1.0, 2.0, 3.0), (0.0, 0.0, 0.0), duration=5.0, samples=3)
     d = motion.as_dict()
     assert d["regime"] == "rest" and d["angular_momentum"] == [0.0, 0.0, 0.0] and d["kinetic_energy"] == 0.0
@@ -129,7 +130,7 @@ def test_rest():
 
 
 @pytest.mark.parametrize("axis, stable", [(0, True), (1, False), (2, True)])
-def test_permanent_rotation_stability_per_axis(axis, stable):
+def test_permanent_rotation_stability_per_axis(axis, stable) -> None:
     omega = np.zeros(3)
     omega[axis] = 2.0
     motion = _predict((1.0, 2.0, 3.0), omega, duration=100.0, samples=101)
@@ -138,14 +139,14 @@ def test_permanent_rotation_stability_per_axis(axis, stable):
     assert np.max(np.abs(motion.trajectory.omega_body - omega)) <= 1e-15 * 2.0
 
 
-def test_symmetric_top_spun_about_its_axis_or_across_it_is_permanent():
+def test_symmetric_top_spun_about_its_axis_or_across_it_is_permanent() -> None:
     assert _predict((2.0, 2.0, 3.0), (0.0, 0.0, 1.0)).regime is Regime.PERMANENT_ROTATION
     across = _predict((2.0, 2.0, 3.0), (0.6, 0.8, 0.0), duration=10.0, samples=11)
     assert across.regime is Regime.PERMANENT_ROTATION and across.stable is True
     assert np.allclose(across.trajectory.omega_body, [0.6, 0.8, 0.0], atol=1e-15)
 
 
-def test_as_dict_is_json_and_has_a_trajectory_only_when_asked():
+def test_as_dict_is_json_and_has_a_trajectory_only_when_asked() -> None:
     with_traj = _predict((1.0, 2.0, 3.0), (0.3, 0.2, 1.0), duration=10.0, samples=5).as_dict()
     text = json.dumps(with_traj, allow_nan=False)
     assert set(json.loads(text)["trajectory"]) == {"t", "omega_body", "omega", "quaternion"}
@@ -171,7 +172,7 @@ def test_as_dict_is_json_and_has_a_trajectory_only_when_asked():
         ({"method": "euler"}, (1.0, 0.0, 0.0), "method"),
     ],
 )
-def test_invalid_input_is_refused_with_the_parameter_named(kwargs, omega, parameter):
+def test_invalid_input_is_refused_with_the_parameter_named(kwargs, omega, parameter) -> None:
     with pytest.raises(InvalidParameterError) as info:
         frame, cls = body((1.0, 2.0, 3.0))
         predict_motion(frame, cls, omega, **kwargs)
@@ -180,19 +181,19 @@ def test_invalid_input_is_refused_with_the_parameter_named(kwargs, omega, parame
 
 
 @pytest.mark.parametrize("method", ["dop853", "rk45", "splitting"])
-def test_numerical_methods_refuse_a_linear_rotator(method):
+def test_numerical_methods_refuse_a_linear_rotator(method) -> None:
     frame, cls = body((0.0, 1.0, 1.0))
     with pytest.raises(MotionError, match="method='exact'"):
         predict_motion(frame, cls, (0.0, 1.0, 0.0), method=method)
 
 
-def test_splitting_refuses_a_horizon_beyond_its_step_budget():
+def test_splitting_refuses_a_horizon_beyond_its_step_budget() -> None:
     frame, cls = body((1.0, 2.0, 3.0))
     with pytest.raises(MotionError, match="method='exact'"):
         predict_motion(frame, cls, (0.3, 0.2, 1.0), duration=1e7, samples=10, method=MotionMethod.SPLITTING)
 
 
-def test_importing_motion_does_not_import_scipy_integrate():
+def test_importing_motion_does_not_import_scipy_integrate() -> None:
     code = "import sys, inertia.motion; print('scipy.integrate' in sys.modules)"
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.strip() == "False"

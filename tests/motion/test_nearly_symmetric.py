@@ -10,9 +10,9 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from motion_reference import elliptic_reference, euler_taylor_reference
 
 from inertia import precession
+from tests.support.motion import elliptic_reference, euler_taylor_reference
 
 EPS = np.finfo(float).eps
 
@@ -29,7 +29,7 @@ def _tops(seed: int, count: int):
         yield moments, rng.normal(size=3)
 
 
-def test_the_elliptic_reference_solves_eulers_equations():
+def test_the_elliptic_reference_solves_eulers_equations() -> None:
     t = np.linspace(0.0, 10.0, 6)
     for moments, omega in _tops(7, 3):
         assert np.max(np.abs(elliptic_reference(moments, omega, t) - euler_taylor_reference(moments, omega, t))) \
@@ -37,7 +37,7 @@ def test_the_elliptic_reference_solves_eulers_equations():
 
 
 @pytest.mark.parametrize("duration", [10.0, 1000.0])
-def test_nearly_symmetric_tops_move_as_given_at_the_default_tolerance(duration):
+def test_nearly_symmetric_tops_move_as_given_at_the_default_tolerance(duration) -> None:
     t = np.linspace(0.0, duration, 6)
     labelled_symmetric = 0
     for moments, omega in _tops(12, 60):
@@ -52,7 +52,7 @@ def test_nearly_symmetric_tops_move_as_given_at_the_default_tolerance(duration):
     assert labelled_symmetric == 60
 
 
-def test_tensor_input_of_a_nearly_symmetric_top_keeps_its_moments():
+def test_tensor_input_of_a_nearly_symmetric_top_keeps_its_moments() -> None:
     moments, omega = (1.0, 1.0 + 3e-8, 2.0), np.array([0.4, 0.9, 0.3])
     t = np.linspace(0.0, 10.0, 5)
     res = precession(omega, inertia_tensor=np.diag(moments), duration=10.0, samples=5)

@@ -19,8 +19,8 @@ Eigenvalues of the exact tensor are taken with ``mpmath.eigsy`` at 50 digits.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from fractions import Fraction
-from typing import Sequence
 
 import mpmath
 import numpy as np

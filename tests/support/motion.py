@@ -16,7 +16,7 @@ from inertia.classification import Classification, classify
 from inertia.principal import PrincipalFrame
 
 
-def body(moments, rotation=None, tolerance=1e-6) -> tuple[PrincipalFrame, Classification]:
+def body(moments, rotation=None, tolerance: float=1e-6) -> tuple[PrincipalFrame, Classification]:
     """Principal frame and classification of a body with these principal moments,
     its principal axes the rows of ``rotation`` (identity by default)."""
     axes = np.eye(3) if rotation is None else np.asarray(rotation, dtype=float)
@@ -25,7 +25,7 @@ def body(moments, rotation=None, tolerance=1e-6) -> tuple[PrincipalFrame, Classi
     return frame, classify(frame)
 
 
-def euler_reference(moments, omega_body, t, rtol=1e-12):
+def euler_reference(moments, omega_body, t, rtol: float=1e-12):
     """Omega(t) (N, 3) in the body and R(t) (N, 3, 3), the rotation since t = 0 in the body frame at 0."""
     I1, I2, I3 = (float(x) for x in moments)
 
@@ -71,7 +71,7 @@ def quaternion_matrix(q):
     )
 
 
-def elliptic_reference(moments, omega_body, t, dps=50):
+def elliptic_reference(moments, omega_body, t, dps: int=50):
     """Omega(t) (N, 3) in the body frame of an asymmetric top (I1 < I2 < I3), from the
     closed form of L&L §37 (eqs. 37.10-37.12) evaluated with mpmath's Jacobi
     functions at ``dps`` digits, for the moments exactly as given.
@@ -84,7 +84,7 @@ def elliptic_reference(moments, omega_body, t, dps=50):
     (the relabelling 1 <-> 3 reverses the sense of rotation).
     """
     with mp.workdps(dps):
-        I = [mp.mpf(float(x)) for x in moments]  # noqa: E741 (the textbook's name)
+        I = [mp.mpf(float(x)) for x in moments]
         W = [mp.mpf(float(x)) for x in omega_body]
         E2 = sum(I[i] * W[i] ** 2 for i in range(3))
         M2 = sum((I[i] * W[i]) ** 2 for i in range(3))
@@ -125,7 +125,7 @@ def elliptic_reference(moments, omega_body, t, dps=50):
         return out
 
 
-def euler_taylor_reference(moments, omega_body, t, dps=30):
+def euler_taylor_reference(moments, omega_body, t, dps: int=30):
     """Omega(t) (N, 3) from Euler's equations integrated by mpmath's Taylor-series solver
     (``mpmath.odefun``) at ``dps`` digits: slow, for short horizons."""
     with mp.workdps(dps):

@@ -1,32 +1,18 @@
-"""Meshes written by the tests themselves, as binary STL bytes."""
+"""Meshes written by the tests themselves, as binary STL bytes (the shapes and writers are ``benchmarks.cases``)."""
 
 from __future__ import annotations
 
-import struct
-
 import numpy as np
 
-__all__ = ["box_stl", "torus_stl", "stl_bytes"]
+from benchmarks.cases import BOX_FACES, box, icosahedron, l_bracket, prism, stl_bytes, triangles_stl_bytes, write_obj, write_stl
 
-
-def stl_bytes(vertices: np.ndarray, faces: np.ndarray) -> bytes:
-    """Binary STL of triangles ``vertices[faces]`` (float32, zero normals)."""
-    tri = np.asarray(vertices, dtype=np.float64)[np.asarray(faces)]
-    records = np.zeros(len(tri), dtype=[("normal", "<f4", 3), ("v", "<f4", (3, 3)), ("attr", "<u2")])
-    records["v"] = tri
-    return b"\0" * 80 + struct.pack("<I", len(tri)) + records.tobytes()
+__all__ = ["BOX_FACES", "box", "box_stl", "icosahedron", "l_bracket", "prism", "stl_bytes", "torus_stl",
+           "triangles_stl_bytes", "write_obj", "write_stl"]
 
 
 def box_stl(a: float, b: float, c: float, origin: tuple[float, float, float] = (0.0, 0.0, 0.0)) -> bytes:
     """A closed a x b x c box, outward winding, corner at ``origin``."""
-    corners = np.array([[x, y, z] for x in (0, a) for y in (0, b) for z in (0, c)], dtype=np.float64)
-    corners += np.asarray(origin)
-    faces = np.array([
-        [0, 1, 3], [0, 3, 2], [4, 6, 7], [4, 7, 5],  # x = 0, x = a
-        [0, 4, 5], [0, 5, 1], [2, 3, 7], [2, 7, 6],  # y = 0, y = b
-        [0, 2, 6], [0, 6, 4], [1, 5, 7], [1, 7, 3],  # z = 0, z = c
-    ])
-    return stl_bytes(corners, faces)
+    return stl_bytes(*box(a, b, c, origin))
 
 
 def torus_stl(n: int, m: int, major: float = 2.0, minor: float = 0.5) -> bytes:
