@@ -34,8 +34,6 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.spatial.transform import Rotation
 
-ROOT = Path(__file__).resolve().parents[1]
-
 from benchmarks.cases import BOX_FACES
 from benchmarks.exact import exact_eigenvalues, exact_points, exact_solid, exact_tetrahedra, relative_error
 from inertia.body import MeshBody, PointBody, VolumeBody
@@ -43,6 +41,8 @@ from inertia.classification import RotorClass, classify
 from inertia.mass import mass_properties
 from inertia.motion import ideal_moments, motion_rotor
 from inertia.principal import principal_frame
+
+ROOT = Path(__file__).resolve().parents[1]
 
 __all__ = ["GENERIC", "BOUND_EXACT", "BOUND_THIN", "BOUND_INVARIANT", "box", "uv_sphere", "prism",
            "two_material_boxes", "log_uniform_points", "MeshCase", "geometry_cases", "measure_mesh",
@@ -99,7 +99,7 @@ def uv_sphere(n_lat: int, n_lon: int, radius: float = 1.0) -> tuple[Array, NDArr
 
 def sphere_with_triangles(n: int) -> tuple[Array, NDArray[np.int64]]:
     """A UV sphere of about ``n`` triangles (n_lon = 2 n_lat)."""
-    k = max(3, int(round(math.sqrt(n / 4))))
+    k = max(3, round(math.sqrt(n / 4)))
     return uv_sphere(k, 2 * k)
 
 
@@ -331,7 +331,7 @@ def two_material_case(ratio: float = 1e6, offset: float = 1e3) -> Row:
     start = time.perf_counter()
     pts, tets, rho = two_material_boxes(ratio)
     pts = placed(pts, offset=offset * 2.0 * DIRECTION)
-    mass, _, tensor = exact_tetrahedra(pts, tets, rho)
+    _mass, _, tensor = exact_tetrahedra(pts, tets, rho)
     exact = exact_eigenvalues(tensor)
     props = mass_properties(VolumeBody(pts, tets, cell_density=rho))
     errors = moment_errors(props.principal_moments, exact)
@@ -735,7 +735,8 @@ def render(geometry: list[Row], growth: list[Row], flip: dict[str, object], tess
         + "Peers on the largest mesh they ran: "
         + ", ".join(f"{k} {v:.1f} s" for r in growth[-2:-1]
                     for k, v in r.extra.get("peer_s", {}).items())  # type: ignore[union-attr]
-        + f" ({growth[-2].case.split(',')[0] if len(growth) > 1 else '-'}). numpy-stl and MuJoCo are not run at 1e7 triangles: at ten times those times "
+        + f" ({growth[-2].case.split(',')[0] if len(growth) > 1 else '-'}). "
+        "numpy-stl and MuJoCo are not run at 1e7 triangles: at ten times those times "
         "the report would no longer regenerate in a few minutes; trimesh and ours are.",
         "",
         "Notes:",
@@ -831,7 +832,8 @@ def _motion_lines(motion: list[dict[str, object]]) -> list[str]:
         "frame, recomputed here from the trajectory (Omega_body and the attitude quaternion), not taken from the "
         "service's diagnostics. Omega err is max |Omega(t) - Omega_ref(t)| / |Omega| at 41 times against the "
         "mpmath closed form at 40 digits; for the exact method it is the phase error of rounding the "
-        "frequency (~ t x rate x 1e-16: ~1e-11 at 1e5 rad, 9e-6 at the 1e11 rad of the ‖Ω‖ = 1e6 row; near the separatrix the phase is "
+        "frequency (~ t x rate x 1e-16: ~1e-11 at 1e5 rad, 9e-6 at the 1e11 rad of the ‖Ω‖ = 1e6 row; "
+        "near the separatrix the phase is "
         "exponentially sensitive and any float64 method loses it). No bound is claimed on Omega err.",
         "",
         "scipy runs the full 1e5 time units except where that is more than 1e6 rad (the ‖Ω‖ = 1e6 row: "
@@ -1001,7 +1003,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     geometry.append(point_case(100_000 if args.quick else 1_000_000))
     growth: list[Row] = []
     timings: dict[str, tuple[float, float]] = {}
-    for n, case in summation_cases(args.quick):
+    for _n, case in summation_cases(args.quick):
         t0 = time.perf_counter()
         growth.append(measure_mesh(case))
         timings[f"{len(case.faces):.1e} triangles"] = (growth[-1].extra["ours_s"], time.perf_counter() - t0)

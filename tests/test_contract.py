@@ -491,7 +491,7 @@ def test_rotated_box_tensor_axes_and_quaternion_are_in_the_input_frame(client: T
     v, f = rotated_box(1.0, 2.0, 3.0, R, [0.3, -0.2, 0.1])
     data = obj_bytes([(None, v, f)])
     res = analyze(client, "rotated.obj", data)
-    mass, com, inertia, _ = exact_mass_properties(v[f])
+    _mass, _com, inertia, _ = exact_mass_properties(v[f])
     want = np.array([[float(x) for x in r] for r in inertia])
     np.testing.assert_allclose(res["inertia_tensor"], want, rtol=0, atol=1e-12 * 6500)
     np.testing.assert_allclose(want, R @ box_inertia(6000, 1, 2, 3) @ R.T, rtol=0, atol=1e-9)
@@ -510,7 +510,7 @@ def test_far_from_origin_rotated_box_keeps_every_moment_within_the_estimate(clie
     v, f = rotated_box(1.0, 2.0, 3.0, R, [1e8, 5e7, -7e7])
     data = obj_bytes([(None, v, f)])
     res = analyze(client, "far.obj", data)
-    mass, com, inertia, _ = exact_mass_properties(v[f])
+    _mass, com, inertia, _ = exact_mass_properties(v[f])
     est = res["diagnostics"]["relative_error_estimate"]
     assert est <= 1e-12
     for got, want in zip(res["principal"]["moments"], exact_moments(inertia)):
@@ -523,7 +523,7 @@ def test_far_from_origin_binary_stl_uses_its_float32_coordinates(client: TestCli
     v, f = rotated_box(1.0, 2.0, 3.0, R, [1e4, -2e4, 3e3])
     data = stl_bytes(v, f)
     res = analyze(client, "far32.stl", data)
-    mass, com, inertia, _ = exact_of("far32.stl", data)
+    mass, _com, inertia, _ = exact_of("far32.stl", data)
     est = res["diagnostics"]["relative_error_estimate"]
     assert est <= 1e-12
     assert res["mass"] == pytest.approx(float(mass), rel=1e-13)
@@ -641,7 +641,7 @@ def test_shell_model_integrates_a_thin_wall_of_given_thickness(client: TestClien
 
 def test_shell_thickness_is_in_file_units(client: TestClient) -> None:
     res = analyze(client, "box.stl", model="shell", thickness=0.1, units="mm")
-    M, com, I = thin_box_shell_inertia(1e-3, 2e-3, 3e-3, RHO * 1e-4)
+    M, _com, I = thin_box_shell_inertia(1e-3, 2e-3, 3e-3, RHO * 1e-4)
     assert res["mass"] == pytest.approx(M, rel=1e-3)
     np.testing.assert_allclose(res["inertia_tensor"], I, rtol=0, atol=1e-3 * np.trace(I))
 
@@ -705,7 +705,7 @@ def test_volume_mesh_cell_density_takes_precedence_and_mass_scales_it(client: Te
 
 def two_cube_obj() -> bytes:
     cube = box_corners(1, 1, 1)
-    return obj_bytes([("left", cube, BOX_FACES), ("right", cube + [2, 0, 0], BOX_FACES)])
+    return obj_bytes([("left", cube, BOX_FACES), ("right", cube + np.array([2, 0, 0]), BOX_FACES)])
 
 
 def test_parts_of_a_scene_with_densities_per_part(client: TestClient) -> None:
@@ -1475,7 +1475,7 @@ def off_ascii(v: np.ndarray, f: np.ndarray) -> bytes:
 
 @pytest.mark.parametrize("fmt", ["ply", "off", "obj", "stl"])
 def test_surface_formats_give_the_same_box(client: TestClient, fmt) -> None:
-    v = box_corners(1, 2, 3) + [1, -1, 2]
+    v = box_corners(1, 2, 3) + np.array([1, -1, 2])
     writer = {"ply": ply_ascii, "off": off_ascii, "obj": lambda a, b: obj_bytes([(None, a, b)]),
               "stl": stl_bytes}[fmt]
     res = analyze(client, f"box.{fmt}", writer(v, BOX_FACES))
@@ -1723,7 +1723,7 @@ def test_random_convex_body_far_from_the_origin_within_the_estimate(client: Test
     v = local @ rotation([3, 1, -2], 2.0).T + [3e7, -4e7, 5e7]
     data = obj_bytes([(None, v, faces)])
     res = analyze(client, "hull.obj", data)
-    mass, com, inertia, _ = exact_mass_properties(v[faces])
+    mass, _com, inertia, _ = exact_mass_properties(v[faces])
     est = res["diagnostics"]["relative_error_estimate"]
     assert est <= 1e-12
     assert res["mass"] == pytest.approx(float(mass), rel=1e-13)
@@ -1910,7 +1910,7 @@ def test_cavity_is_subtracted_not_mistaken_for_inverted_winding(client: TestClie
 
 
 def test_a_separate_inverted_shell_is_corrected_with_a_warning(client: TestClient) -> None:
-    v = np.vstack([box_corners(1, 1, 1), box_corners(1, 1, 1) + [3, 0, 0]])
+    v = np.vstack([box_corners(1, 1, 1), box_corners(1, 1, 1) + np.array([3, 0, 0])])
     f = np.vstack([BOX_FACES, BOX_FACES[:, ::-1] + 8])
     res = analyze(client, "two.stl", stl_bytes(v, f))
     assert res["mass"] == pytest.approx(2000, rel=1e-14)
@@ -1929,7 +1929,7 @@ def test_inconsistent_winding_is_repaired_with_a_warning(client: TestClient) -> 
 
 def test_obj_groups_are_parts(client: TestClient) -> None:
     text = obj_bytes([("left", box_corners(1, 1, 1), BOX_FACES),
-                      ("right", box_corners(1, 1, 1) + [2, 0, 0], BOX_FACES)]).decode()
+                      ("right", box_corners(1, 1, 1) + np.array([2, 0, 0]), BOX_FACES)]).decode()
     res = analyze(client, "groups.obj", text.replace("o left", "g left").replace("o right", "g right").encode(),
                   densities=json.dumps({"right": 500}))
     parts = {p["name"]: p for p in res["parts"]}
@@ -1959,7 +1959,7 @@ def test_point_masses_far_from_the_origin_keep_their_moments(client: TestClient)
     want = [32 / 18, 2.0, 32 / 18 + 2]
     for got, w in zip(res["principal"]["moments"], want):
         assert abs(got - w) <= max(est, 4.5e-16) * w, (got, w, est)
-    np.testing.assert_allclose(res["center_of_mass"], shift + [0, 16 / 18, 0], rtol=1e-16)
+    np.testing.assert_allclose(res["center_of_mass"], shift + np.array([0, 16 / 18, 0]), rtol=1e-16)
 
 
 def test_batch_keeps_upload_order_with_files_of_very_different_cost(client: TestClient) -> None:
@@ -2024,7 +2024,7 @@ def test_pyramid_and_wedge_cells(client: TestClient, tmp_path: Path) -> None:
         ids = [P(x) for x in quad]
         if np.cross(b - a, c - a) @ (-a) < 0:  # VTK: base normal towards the apex
             ids = ids[::-1]
-        pyramids.append(ids + [apex])
+        pyramids.append([*ids, apex])
     wedges = []
     for tri in ([[1, 0], [2, 0], [2, 1]], [[1, 0], [2, 1], [1, 1]]):
         wedges.append([P([x, y, 0]) for x, y in tri] + [P([x, y, 1]) for x, y in tri])

@@ -221,7 +221,7 @@ def test_assembly_far_from_the_origin_keeps_every_moment() -> None:
     left = trimesh.Trimesh(*box(1.0, 1.0, 1.0), process=False)
     right = trimesh.Trimesh(*box(1.0, 2.0, 1.0), process=False)
     left.apply_translation(offset)
-    right.apply_translation(offset + [3.0, 1.0, 0.0])
+    right.apply_translation(offset + np.array([3.0, 1.0, 0.0]))
     scene = trimesh.Scene()
     scene.add_geometry(left, node_name="left", geom_name="left")
     scene.add_geometry(right, node_name="right", geom_name="right")

@@ -25,7 +25,7 @@ from inertia.mass import assembly_properties, mass_properties
 from inertia.pipeline import AnalysisOptions, analyze
 
 vtk = pytest.importorskip("vtk")
-from tests.load import volref
+volref = pytest.importorskip("tests.load.volref")  # needs vtk
 
 HEX = [(0, 0, 0), (1, 0, 0), (1, 1, 0), (0, 1, 0), (0, 0, 1), (1, 0, 1), (1, 1, 1), (0, 1, 1)]
 

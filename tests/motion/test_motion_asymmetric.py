@@ -177,7 +177,7 @@ def test_nearly_linear_asymmetric_body_matches_dop853() -> None:
     t = np.linspace(0.0, 0.05, 101)
     motion = _predict(moments, omega, tolerance=1e-12, duration=0.05, samples=101)
     assert motion.regime is Regime.ASYMMETRIC
-    w_ref, r_ref = euler_reference(moments, omega, t)
+    w_ref, _r_ref = euler_reference(moments, omega, t)
     assert np.max(np.abs(motion.trajectory.omega_body - w_ref)) <= 1e-8
     long = _predict(moments, omega, tolerance=1e-12, duration=1e5, samples=2001)
     assert long.diagnostics.energy_drift <= 1e-12 and long.diagnostics.momentum_drift <= 1e-12
