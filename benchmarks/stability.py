@@ -28,6 +28,7 @@ from collections.abc import Callable, Sequence
 from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import cast
 
 import mpmath
 import numpy as np
@@ -174,7 +175,7 @@ def trimesh_moments(v: Array, f: NDArray[np.int64]) -> Array | str:
     def run() -> Array:
         import trimesh
 
-        return trimesh.Trimesh(v, f, process=False).principal_inertia_components
+        return cast("Array", trimesh.Trimesh(v, f, process=False).principal_inertia_components)
 
     return _peer(run)
 
@@ -279,7 +280,7 @@ def measure_mesh(case: MeshCase, exact: Sequence[mpmath.mpf] | None = None) -> R
         if name not in case.peers:
             continue
         t0 = time.perf_counter()
-        result = run()
+        result = run()  # type: ignore[no-untyped-call]
         peer_s[name] = time.perf_counter() - t0
         peers[name] = result if isinstance(result, str) else _worst(moment_errors(result, exact), bounds)
     estimate = float(props.relative_error_estimate)
@@ -624,7 +625,7 @@ def measure_motion(case: MotionCase, samples: int = 2001, reference_samples: int
     finite = all(np.all(np.isfinite(np.asarray(a))) for a in (traj.omega_body, traj.quaternion, traj.omega))
     omega_body0 = np.asarray(frame.axes) @ np.asarray(case.omega)
     pick = np.linspace(0, samples - 1, reference_samples).astype(int)
-    ref = reference_omega(effective, omega_body0, np.asarray(traj.t)[pick])
+    ref = reference_omega(effective, omega_body0, np.asarray(traj.t)[pick])  # type: ignore[arg-type]
     scale = float(np.linalg.norm(omega_body0))
     ours_err = float(np.max(np.linalg.norm(np.asarray(traj.omega_body)[pick] - ref, axis=1)) / scale)
     out: dict[str, object] = {
@@ -656,7 +657,7 @@ def _scipy_cell(case: MotionCase, moments: Array, omega_body0: Array, frame: obj
         return {"skipped": f"raises {type(exc).__name__}: {exc}"}
     e_drift, m_drift = invariant_drift(moments, w, q, np.eye(3))
     pick = np.linspace(0, len(t) - 1, 41).astype(int)
-    ref = reference_omega(moments, omega_body0, t[pick])
+    ref = reference_omega(moments, omega_body0, t[pick])  # type: ignore[arg-type]
     err = float(np.max(np.linalg.norm(w[pick] - ref, axis=1)) / rate)
     return {"energy_drift": e_drift, "momentum_drift": m_drift, "omega_error": err, "horizon": horizon,
             "seconds": time.perf_counter() - start}
@@ -734,7 +735,7 @@ def render(geometry: list[Row], growth: list[Row], flip: dict[str, object], tess
         + ", ".join(f"{k}: {a:.1f} s / {b:.1f} s" for k, (a, b) in timings.items()) + ". "
         + "Peers on the largest mesh they ran: "
         + ", ".join(f"{k} {v:.1f} s" for r in growth[-2:-1]
-                    for k, v in r.extra.get("peer_s", {}).items())  # type: ignore[union-attr]
+                    for k, v in r.extra.get("peer_s", {}).items())  # type: ignore[attr-defined]
         + f" ({growth[-2].case.split(',')[0] if len(growth) > 1 else '-'}). "
         "numpy-stl and MuJoCo are not run at 1e7 triangles: at ten times those times "
         "the report would no longer regenerate in a few minutes; trimesh and ours are.",
@@ -762,7 +763,7 @@ def render(geometry: list[Row], growth: list[Row], flip: dict[str, object], tess
             "| body (rotated) | true class | spread of moments that should be equal | chord-error scale | "
             "smallest tolerance giving the true class | default 1e-6 gives it |", "|---|---|---|---|---|---|"]
     for t in tess:
-        out.append(f"| {t['case']} | {t['true'].value} | {_cell(t['spread'])} | {t['scale'] or '—'} | "  # type: ignore[union-attr]
+        out.append(f"| {t['case']} | {t['true'].value} | {_cell(t['spread'])} | {t['scale'] or '—'} | "  # type: ignore[arg-type, attr-defined]
                    f"{_tol(t['tol_ours'])} (exact moments: {_tol(t['tol_exact_moments'])}) | "
                    f"{'yes' if t['default_ok'] else 'no'} |")
     out += ["", *TOLERANCE_ADVICE, "", "## Motion (each over 1e5 time units)", ""]
@@ -800,9 +801,9 @@ def _flip_lines(flip: dict[str, object]) -> list[str]:
         "| case | exact flip tolerance (I3 - I1)/I3 | our rel. err of it | trimesh | numpy-stl | MuJoCo | "
         "our class at 0.99 x / 1.01 x flip | pass |",
         "|---|---|---|---|---|---|---|---|",
-        f"| box 1 x 1 x (1 + 1e-9), rotated | {flip['flip']:.6e} | {_cell(flip['flip_error'])} | "  # type: ignore[str-format]
+        f"| box 1 x 1 x (1 + 1e-9), rotated | {flip['flip']:.6e} | {_cell(flip['flip_error'])} | "  # type: ignore[arg-type]
         + " | ".join(_cell(peers[k]) for k in ("trimesh", "numpy-stl", "mujoco"))
-        + f" | {flip['below'].value} / {flip['above'].value} | "  # type: ignore[union-attr]
+        + f" | {flip['below'].value} / {flip['above'].value} | "  # type: ignore[attr-defined]
         + ("pass" if flip["passed"] else "**FAIL**") + " |",
         "",
         f"The equal pair differs by {flip['pair']:.1e} of I3 (rounding of the rotated vertices), so the class "
@@ -821,7 +822,7 @@ def _motion_lines(motion: list[dict[str, object]]) -> list[str]:
             sc = [str(s["skipped"]), "", ""]
         else:
             horizon = "" if s["horizon"] == HORIZON else f" (over {s['horizon']:.0e} s = 1e5 rad)"
-            sc = [_cell(s["energy_drift"]) + horizon, _cell(s["momentum_drift"]), _cell(s["omega_error"])]  # type: ignore[arg-type]
+            sc = [_cell(s["energy_drift"]) + horizon, _cell(s["momentum_drift"]), _cell(s["omega_error"])]
         case = str(m["case"]) + (f" ({m['note']})" if m["note"] else "")
         lines.append(f"| {case} | {m['regime']} | {_cell(m['energy_drift'])} | {_cell(m['momentum_drift'])} | "  # type: ignore[arg-type]
                      f"{_cell(m['omega_error'])} | " + " | ".join(sc)  # type: ignore[arg-type]
@@ -896,13 +897,13 @@ def nearly_symmetric_row(cases: int = 20) -> dict[str, object]:
         speed = float(np.linalg.norm(omega))
         for duration in (10.0, 1000.0):
             t = np.linspace(0.0, duration, 6)
-            res = precession(omega, principal_moments=moments, duration=duration, samples=len(t))
-            ref = reference_omega(moments, omega, t)
+            res = precession(omega, principal_moments=moments, duration=duration, samples=len(t))  # type: ignore[arg-type]
+            ref = reference_omega(moments, omega, t)  # type: ignore[arg-type]
             traj = res.motion.trajectory
             assert traj is not None
             err = float(np.max(np.linalg.norm(np.asarray(traj.omega_body) - ref, axis=1))) / speed
             worst[duration] = max(worst[duration], err / (eps * (1 + speed * duration)))
-            departed = float(np.max(np.linalg.norm(reference_omega(ideal, omega, t) - ref, axis=1))) / speed
+            departed = float(np.max(np.linalg.norm(reference_omega(ideal, omega, t) - ref, axis=1))) / speed  # type: ignore[arg-type]
             ideal_worst[duration] = max(ideal_worst[duration], departed)
     return {"case": f"nearly symmetric tops, gaps 1e-13 .. 5e-7 (labelled symmetric at tolerance 1e-6), {cases} tops",
             "ours": "; ".join(f"T = {d:g}: Omega error {w:.2g} eps per radian" for d, w in worst.items()),
@@ -1006,7 +1007,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     for _n, case in summation_cases(args.quick):
         t0 = time.perf_counter()
         growth.append(measure_mesh(case))
-        timings[f"{len(case.faces):.1e} triangles"] = (growth[-1].extra["ours_s"], time.perf_counter() - t0)
+        timings[f"{len(case.faces):.1e} triangles"] = (growth[-1].extra["ours_s"], time.perf_counter() - t0)  # type: ignore[assignment]
         print(f"  {case.name}: {growth[-1].seconds:.1f} s", file=sys.stderr)
     flip = near_symmetric_flip()
     tess = tessellation_rows()

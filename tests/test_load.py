@@ -23,7 +23,7 @@ def box_mesh() -> trimesh.Trimesh:
 
 
 def export(obj: trimesh.Trimesh | trimesh.Scene, fmt: str, **kw: object) -> bytes:
-    data = obj.export(file_type=fmt, **kw)
+    data = obj.export(file_type=fmt, **kw)  # type: ignore[arg-type]
     if isinstance(data, dict):  # gltf with embedded buffers
         data = data["model.gltf"]
     return data.encode() if isinstance(data, str) else data
