@@ -20,7 +20,7 @@ from numpy.typing import NDArray
 
 from .principal import PrincipalFrame, equal_moment_pairs
 
-__all__ = ["RotorClass", "Classification", "classify", "ray_asymmetry"]
+__all__ = ["RotorClass", "Margins", "Classification", "classify", "ray_asymmetry"]
 
 
 class RotorClass(enum.Enum):
@@ -47,13 +47,28 @@ class RotorClass(enum.Enum):
 
 
 @dataclass(frozen=True, slots=True)
+class Margins:
+    """The relative gaps that decided a classification, each to compare with its ``tolerance`` [1].
+
+    gap12 : (I2 - I1) / I3.   gap23 : (I3 - I2) / I3.
+    smallest : I1 / I3 (a linear rotator's is within tolerance of 0).
+    planarity : |I1 + I2 - I3| / I3 (a lamina's or a planar point set's is within tolerance of 0).
+    All are 0 for a body whose moments are all zero (a single point).
+    """
+
+    gap12: float = 0.0
+    gap23: float = 0.0
+    smallest: float = 0.0
+    planarity: float = 0.0
+
+
+@dataclass(frozen=True, slots=True)
 class Classification:
     """What kind of top a body is, and the margins that decided it.
 
     symmetry_axis : (3,) unit vector in the input frame, or None.
     asymmetry : Ray's kappa, or None (spherical tops and rotators).
-    margins : relative gaps (I2-I1)/I3, (I3-I2)/I3, I1/I3 and |I1+I2-I3|/I3,
-        to compare with ``tolerance``.
+    margins : the relative gaps that decided it (:class:`Margins`), to compare with ``tolerance``.
     """
 
     rotor: RotorClass
@@ -61,7 +76,7 @@ class Classification:
     asymmetry: float | None
     planar: bool
     tolerance: float
-    margins: dict[str, float] = field(default_factory=dict)
+    margins: Margins = field(default_factory=Margins)
 
     @property
     def kind(self) -> str:
@@ -88,19 +103,15 @@ def classify(frame: PrincipalFrame, tolerance: float | None = None) -> Classific
     tol = frame.tolerance if tolerance is None else tolerance
     i1, i2, i3 = (float(x) for x in frame.moments)
     if i3 == 0.0:  # all mass at one point: no axis is distinguished, every moment is zero
-        return Classification(RotorClass.SPHERICAL, None, None, True, tol, {})
-    margins = {
-        "gap12": (i2 - i1) / i3,
-        "gap23": (i3 - i2) / i3,
-        "smallest": i1 / i3,
-        "planarity": abs(i1 + i2 - i3) / i3,
-    }
+        return Classification(RotorClass.SPHERICAL, None, None, True, tol, Margins())
+    margins = Margins(gap12=(i2 - i1) / i3, gap23=(i3 - i2) / i3, smallest=i1 / i3,
+                      planarity=abs(i1 + i2 - i3) / i3)
     pairs = equal_moment_pairs(frame.moments, tol)
-    planar = margins["planarity"] <= tol
+    planar = margins.planarity <= tol
     axes = frame.axes
     if len(pairs) == 3:
         return Classification(RotorClass.SPHERICAL, None, None, planar, tol, margins)
-    if pairs == ((1, 2),) and margins["smallest"] <= tol:
+    if pairs == ((1, 2),) and margins.smallest <= tol:
         return Classification(RotorClass.LINEAR, axes[0].copy(), None, planar, tol, margins)
     kappa = ray_asymmetry(frame.moments)
     if pairs == ((1, 2),):

@@ -1,0 +1,127 @@
+"""AnalysisOptions: the options of one analysis, validated once at the edge of the library.
+
+They are the API's query parameters (API.md): lengths in ``units``, density
+kg/m^3, mass kg, omega rad/s in the input frame, duration s.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+
+from .conventions import length_scale
+from .errors import InvalidParameterError
+from .mass import Model
+from .tolerances import DEFAULT_TOLERANCES
+
+__all__ = ["AnalysisOptions", "METHODS"]
+
+METHODS = ("exact", "dop853", "rk45", "splitting")
+
+
+def _vector(name: str, value: Sequence[float] | None) -> tuple[float, float, float] | None:
+    if value is None:
+        return None
+    try:
+        vec = tuple(float(x) for x in value)
+    except (TypeError, ValueError) as exc:
+        raise InvalidParameterError(f"{name} must be three numbers x,y,z", parameter=name) from exc
+    if len(vec) != 3:
+        raise InvalidParameterError(f"{name} must have 3 components, got {len(vec)}", parameter=name)
+    if not all(math.isfinite(x) for x in vec):
+        raise InvalidParameterError(f"{name} must be finite (no NaN or infinity)", parameter=name)
+    return (vec[0], vec[1], vec[2])
+
+
+def _positive(name: str, value: float | None) -> None:
+    if value is not None and not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
+        raise InvalidParameterError(f"{name} must be a positive finite number, got {value!r}", parameter=name)
+
+
+@dataclass(frozen=True, slots=True)
+class AnalysisOptions:
+    """Options of one analysis, as in the API's query parameters.
+
+    Lengths (reference, thickness) are in ``units``; density kg/m^3; mass kg;
+    omega rad/s in the input frame; duration s.
+    """
+
+    format: str | None = None
+    units: str | None = None
+    density: float | None = None
+    mass: float | None = None
+    model: str = Model.SOLID
+    thickness: float | None = None
+    tolerance: float = DEFAULT_TOLERANCES.moment_rel
+    reference: tuple[float, float, float] | None = None
+    omega: tuple[float, float, float] | None = None
+    duration: float | None = None
+    samples: int | None = None
+    method: str = "exact"
+    densities: Mapping[str, float] | None = None
+    geometry: str = "brep"
+    deflection: float | None = None
+    export: str | None = None
+    frame: tuple[float, float, float, float] | None = None
+    isotopes: str = "standard"
+    mass_unit: str = "kg"
+
+    def __post_init__(self) -> None:
+        if self.units is not None:
+            length_scale(self.units)
+        for name in ("density", "mass", "thickness", "duration"):
+            _positive(name, getattr(self, name))
+        if self.density is not None and self.mass is not None:
+            raise InvalidParameterError("give either density or mass, not both", parameter="density")
+        if self.model not in Model.ALL:
+            raise InvalidParameterError(f"model must be 'solid' or 'shell', got {self.model!r}", parameter="model")
+        if not (isinstance(self.tolerance, (int, float)) and math.isfinite(self.tolerance) and 0 < self.tolerance < 1):
+            raise InvalidParameterError("tolerance must be a number between 0 and 1 (relative)", parameter="tolerance")
+        object.__setattr__(self, "reference", _vector("reference", self.reference))
+        object.__setattr__(self, "omega", _vector("omega", self.omega))
+        if self.samples is not None and (not isinstance(self.samples, int) or self.samples < 1):
+            raise InvalidParameterError("samples must be a positive whole number", parameter="samples")
+        if (self.duration is None) != (self.samples is None):
+            raise InvalidParameterError("duration and samples go together; give both for a trajectory", parameter="samples")
+        if self.duration is not None and self.omega is None:
+            raise InvalidParameterError("duration and samples need omega", parameter="omega")
+        if self.method not in METHODS:
+            raise InvalidParameterError(f"method must be one of {', '.join(METHODS)}", parameter="method")
+        if self.densities is not None:
+            for name, rho in self.densities.items():
+                _positive(f"densities[{name!r}]", rho)
+        _check_v11(self)
+        _check_geometry(self.geometry, self.deflection)
+
+
+def _check_v11(options: AnalysisOptions) -> None:
+    """The options of API 1.1: export, frame, isotopes, mass_unit."""
+    from .export import EXPORT_FORMATS
+    from .frames import frame_rotation
+
+    if options.export is not None and options.export not in EXPORT_FORMATS:
+        raise InvalidParameterError(f"export must be one of {', '.join(EXPORT_FORMATS)}, got {options.export!r}",
+                                    parameter="export")
+    if options.frame is not None:
+        q, _ = frame_rotation(options.frame)
+        object.__setattr__(options, "frame", tuple(float(v) for v in q))
+    if options.isotopes not in ("standard", "abundant"):
+        raise InvalidParameterError(f"isotopes must be 'standard' or 'abundant', got {options.isotopes!r}",
+                                    parameter="isotopes")
+    if options.mass_unit not in ("kg", "u"):
+        raise InvalidParameterError(f"mass_unit must be 'kg' or 'u', got {options.mass_unit!r}", parameter="mass_unit")
+
+
+def _check_geometry(geometry: str, deflection: float | None) -> None:
+    """CAD files: ``geometry`` brep or mesh; ``deflection`` (mesh only) relative to the bounding-box diagonal."""
+    if geometry not in ("brep", "mesh"):
+        raise InvalidParameterError("geometry must be 'brep' or 'mesh'", parameter="geometry")
+    if deflection is None:
+        return
+    _positive("deflection", deflection)
+    if not deflection < 1:
+        raise InvalidParameterError("deflection is relative to the bounding-box diagonal: give a number below 1",
+                                    parameter="deflection")
+    if geometry != "mesh":
+        raise InvalidParameterError("deflection applies to geometry=mesh", parameter="deflection")
