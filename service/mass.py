@@ -31,7 +31,7 @@ from .conventions import DEFAULT_DENSITY
 from .ddouble import rotated
 from .eigen import jacobi_eigh
 from .errors import InsufficientPrecisionError, InvalidParameterError, ZeroVolumeError
-from .integrals import Sums, local_origin, point_sums, simplex_sums
+from .integrals import Sums, local_origin, point_records, point_sums, simplex_sums
 from .solid import closed_surface
 from .tolerances import DEFAULT_TOLERANCES, EPS, Tolerances
 
@@ -265,11 +265,6 @@ _RESOLUTION_WARN = 1e-3
 but it may differ that much from the part it was exported from."""
 
 
-def _row_records(x: NDArray[np.float64]) -> NDArray[np.void]:
-    """The rows of a C-contiguous (n, 3) array as n opaque 24-byte records (``take`` gathers them whole)."""
-    return np.ascontiguousarray(x).view(np.dtype((np.void, 3 * x.itemsize))).reshape(-1)
-
-
 def _check_resolution(geometry: _Geometry, s: Sums, com: NDArray[np.float64], rotation: NDArray[np.float64],
                       values: NDArray[np.float64]) -> tuple[str, ...]:
     """Refuse a closed surface its stored coordinates cannot represent; warn when they barely do.
@@ -284,7 +279,7 @@ def _check_resolution(geometry: _Geometry, s: Sums, com: NDArray[np.float64], ro
     x = geometry.points
     delta = geometry.coordinate_eps * float(np.abs(x).max())
     y = x - com
-    records = _row_records(y)  # one gather of 24 bytes per corner, not numpy's slower 2-D fancy indexing
+    records = point_records(y)  # one gather of 24 bytes per corner, not numpy's slower 2-D fancy indexing
     area = 0.0
     for start in range(0, len(geometry.cells), 1 << 16):
         tri = records.take(geometry.cells[start : start + (1 << 16)]).view(np.float64).reshape(-1, 3, 3)
