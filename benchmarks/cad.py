@@ -15,7 +15,7 @@ Errors are relative, against closed forms:
   I_x = m (R^2 / 2 + 5/8 r^2) (e.g. Weisstein, MathWorld "Torus", moment of inertia);
 - the same cylinder with every face converted to NURBS (its geometry is still
   exact; only the integration is harder);
-- a filleted L-bracket: no closed form, so against its own B-rep result.
+- a filleted plate with a hole: no closed form, so against its own B-rep result.
 
 "mass" is the relative error of the mass; "moments" the largest relative error
 of the three principal moments (sorted); "estimate" is what the result reports
@@ -77,8 +77,8 @@ def nurbs(shape: Any) -> Any:
 
 
 def bracket() -> Any:
-    """An L-bracket 60 x 40 x 50 mm, 8 mm thick, every edge filleted at 2 mm, with a 10 mm hole."""
-    from OCP.BRepAlgoAPI import BRepAlgoAPI_Cut, BRepAlgoAPI_Fuse
+    """A mounting plate 60 x 40 x 8 mm, every edge filleted at 2 mm, with a 10 mm through-hole."""
+    from OCP.BRepAlgoAPI import BRepAlgoAPI_Cut
     from OCP.BRepFilletAPI import BRepFilletAPI_MakeFillet
     from OCP.BRepPrimAPI import BRepPrimAPI_MakeBox, BRepPrimAPI_MakeCylinder
     from OCP.gp import gp_Ax2, gp_Dir, gp_Pnt
@@ -86,17 +86,14 @@ def bracket() -> Any:
     from OCP.TopExp import TopExp_Explorer
     from OCP.TopoDS import TopoDS
 
-    base = BRepPrimAPI_MakeBox(60.0, 40.0, 8.0).Shape()
-    wall = BRepPrimAPI_MakeBox(gp_Pnt(0, 0, 0), 8.0, 40.0, 50.0).Shape()
-    body = BRepAlgoAPI_Fuse(base, wall).Shape()
+    body = BRepPrimAPI_MakeBox(60.0, 40.0, 8.0).Shape()
     fillet = BRepFilletAPI_MakeFillet(body)
     explorer = TopExp_Explorer(body, TopAbs_EDGE)
     while explorer.More():
         fillet.Add(2.0, TopoDS.Edge(explorer.Current()))
         explorer.Next()
-    rounded = fillet.Shape()
     hole = BRepPrimAPI_MakeCylinder(gp_Ax2(gp_Pnt(40.0, 20.0, -1.0), gp_Dir(0, 0, 1)), 5.0, 10.0).Shape()
-    return BRepAlgoAPI_Cut(rounded, hole).Shape()
+    return BRepAlgoAPI_Cut(fillet.Shape(), hole).Shape()
 
 
 def cylinder_reference(r: float = 10.0, h: float = 30.0) -> tuple[float, list[float]]:
@@ -178,7 +175,7 @@ def main(argv: list[str] | None = None) -> int:
         ("sphere r20", sphere(), sphere_reference()),
         ("torus R30 r10", torus(), torus_reference()),
         ("cylinder, NURBS faces", nurbs(cylinder()), cylinder_reference()),
-        ("filleted L-bracket", bracket(), None),
+        ("filleted plate with hole", bracket(), None),
     ]
     rows: list[str] = []
     for name, shape, ref in cases:
@@ -204,7 +201,7 @@ with other work, so times are indicative).
 tessellates them with a chordal deflection of `deflection` times the part's
 bounding-box diagonal (angular deflection 0.5 rad, OpenCASCADE's default, which
 governs the coarsest setting) and integrates the polyhedron exactly. Errors are
-relative, against closed forms (cylinder, sphere, torus) or, for the bracket,
+relative, against closed forms (cylinder, sphere, torus) or, for the filleted plate,
 against its B-rep result. *estimate* is what the result itself reports:
 `relative_error_estimate` on the B-rep rows, `tessellation_error` (difference to the
 B-rep) on the mesh rows.
@@ -212,6 +209,11 @@ B-rep) on the mesh rows.
 | solid | deflection | triangles | mass error | moments error | estimate | time [ms] |
 |---|---|---:|---:|---:|---:|---:|
 {chr(10).join(rows)}
+
+The first mesh row of the first solid includes loading the tessellator's libraries once.
+The filleted plate's B-rep row is its own reference (zero error by construction): its
+estimate is the information there. Its blends are B-spline faces, which the adaptive rule
+integrates more slowly than analytic faces (hence its time).
 
 Reading the table: the tessellation's error falls in proportion to the deflection
 once the linear deflection governs (below about 1e-2), roughly 5 x deflection in the

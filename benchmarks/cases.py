@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import struct
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -18,7 +19,7 @@ BOX_FACES = np.array([[0, 2, 1], [1, 2, 3], [4, 5, 6], [5, 7, 6], [0, 1, 4], [1,
 """Outward winding of the eight corners of ``box``: vertex k has bits (x, y, z) = (k&1, k&2, k&4)."""
 
 
-def box(a: float, b: float, c: float, origin=(0.0, 0.0, 0.0)) -> tuple[np.ndarray, np.ndarray]:
+def box(a: float, b: float, c: float, origin: Any=(0.0, 0.0, 0.0)) -> tuple[np.ndarray, np.ndarray]:
     """Axis-aligned box with outward winding; vertex k has bits (x, y, z) = (k&1, k&2, k&4)."""
     o = np.asarray(origin, dtype=float)
     v = np.array([[(k & 1) * a, ((k >> 1) & 1) * b, ((k >> 2) & 1) * c] for k in range(8)]) + o
@@ -39,11 +40,11 @@ def prism(n: int, radius: float, height: float) -> tuple[np.ndarray, np.ndarray]
 def icosahedron(edge: float) -> tuple[np.ndarray, np.ndarray]:
     phi = (1 + 5**0.5) / 2
     s = edge / 2
-    v = []
+    corners: list[list[float]] = []
     for a in (-1, 1):
         for b in (-1, 1):
-            v += [[0, a * s, b * s * phi], [a * s, b * s * phi, 0], [b * s * phi, 0, a * s]]
-    v = np.array(v)
+            corners += [[0, a * s, b * s * phi], [a * s, b * s * phi, 0], [b * s * phi, 0, a * s]]
+    v = np.array(corners)
     faces = []
     n = len(v)
     for i in range(n):

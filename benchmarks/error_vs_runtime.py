@@ -190,7 +190,8 @@ def run_all() -> tuple[list[Run], dict[float, float]]:
             if horizon == 1e3:
                 cost_at_1e3[key] = run.seconds
             runs.append(run)
-            print(f"  {method:9s} {setting:12s} {run.seconds:9.4f} s  dW {run.omega_error:.1e}  dR {run.attitude_error:.1e}", file=sys.stderr)
+            print(f"  {method:9s} {setting:12s} {run.seconds:9.4f} s  dW {run.omega_error:.1e}"
+                  f"  dR {run.attitude_error:.1e}", file=sys.stderr)
         per_sample[horizon] = exact_cost_per_sample(horizon)
     return runs, per_sample
 
@@ -218,7 +219,7 @@ def icosphere(level: int) -> tuple[np.ndarray, np.ndarray]:
     for _ in range(level):
         cache: dict[tuple[int, int], int] = {}
 
-        def mid(a: int, b: int) -> int:
+        def mid(a: int, b: int, cache: dict[tuple[int, int], int] = cache) -> int:
             key = (min(a, b), max(a, b))
             if key not in cache:
                 p = verts[a] + verts[b]
@@ -299,7 +300,8 @@ def plot(runs: list[Run], meshes: list[tuple[str, int, float, float]]) -> None:
     colours = {"exact": "k", "dop853": "tab:blue", "rk45": "tab:orange", "splitting": "tab:green"}
     markers = {10.0: "o", 1e3: "s", 1e5: "^"}
     floor = 1e-17
-    for ax, attr, title in ((axes[0], "omega_error", "max |Omega - ref| / |Omega0|"), (axes[1], "attitude_error", "max |R - R_ref| (matrix entries)")):
+    for ax, attr, title in ((axes[0], "omega_error", "max |Omega - ref| / |Omega0|"),
+                            (axes[1], "attitude_error", "max |R - R_ref| (matrix entries)")):
         for method in colours:
             for horizon in HORIZONS:
                 pts = [(r.seconds, max(getattr(r, attr), floor)) for r in runs if r.method == method and r.horizon == horizon]
@@ -365,7 +367,8 @@ def write_doc(runs: list[Run], per_sample: dict[float, float], meshes: list[tupl
         "",
         "## Table (motion)",
         "",
-        "| T [s] | method | setting | run time [s] | per sample [µs] | max Omega error (rel.) | max R error | energy drift | |M| drift |",
+        "| T [s] | method | setting | run time [s] | per sample [µs] | max Omega error (rel.) | max R error "
+        "| energy drift | |M| drift |",
         "|---:|---|---|---:|---:|---:|---:|---:|---:|",
     ]
     for r in runs:

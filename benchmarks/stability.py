@@ -28,13 +28,12 @@ from collections.abc import Callable, Sequence
 from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import cast
 
 import mpmath
 import numpy as np
 from numpy.typing import NDArray
 from scipy.spatial.transform import Rotation
-
-ROOT = Path(__file__).resolve().parents[1]
 
 from benchmarks.cases import BOX_FACES
 from benchmarks.exact import exact_eigenvalues, exact_points, exact_solid, exact_tetrahedra, relative_error
@@ -43,6 +42,8 @@ from inertia.classification import RotorClass, classify
 from inertia.mass import mass_properties
 from inertia.motion import ideal_moments, motion_rotor
 from inertia.principal import principal_frame
+
+ROOT = Path(__file__).resolve().parents[1]
 
 __all__ = ["GENERIC", "BOUND_EXACT", "BOUND_THIN", "BOUND_INVARIANT", "box", "uv_sphere", "prism",
            "two_material_boxes", "log_uniform_points", "MeshCase", "geometry_cases", "measure_mesh",
@@ -99,7 +100,7 @@ def uv_sphere(n_lat: int, n_lon: int, radius: float = 1.0) -> tuple[Array, NDArr
 
 def sphere_with_triangles(n: int) -> tuple[Array, NDArray[np.int64]]:
     """A UV sphere of about ``n`` triangles (n_lon = 2 n_lat)."""
-    k = max(3, int(round(math.sqrt(n / 4))))
+    k = max(3, round(math.sqrt(n / 4)))
     return uv_sphere(k, 2 * k)
 
 
@@ -174,7 +175,7 @@ def trimesh_moments(v: Array, f: NDArray[np.int64]) -> Array | str:
     def run() -> Array:
         import trimesh
 
-        return trimesh.Trimesh(v, f, process=False).principal_inertia_components
+        return cast("Array", trimesh.Trimesh(v, f, process=False).principal_inertia_components)
 
     return _peer(run)
 
@@ -279,7 +280,7 @@ def measure_mesh(case: MeshCase, exact: Sequence[mpmath.mpf] | None = None) -> R
         if name not in case.peers:
             continue
         t0 = time.perf_counter()
-        result = run()
+        result = run()  # type: ignore[no-untyped-call]
         peer_s[name] = time.perf_counter() - t0
         peers[name] = result if isinstance(result, str) else _worst(moment_errors(result, exact), bounds)
     estimate = float(props.relative_error_estimate)
@@ -331,7 +332,7 @@ def two_material_case(ratio: float = 1e6, offset: float = 1e3) -> Row:
     start = time.perf_counter()
     pts, tets, rho = two_material_boxes(ratio)
     pts = placed(pts, offset=offset * 2.0 * DIRECTION)
-    mass, _, tensor = exact_tetrahedra(pts, tets, rho)
+    _mass, _, tensor = exact_tetrahedra(pts, tets, rho)
     exact = exact_eigenvalues(tensor)
     props = mass_properties(VolumeBody(pts, tets, cell_density=rho))
     errors = moment_errors(props.principal_moments, exact)
@@ -624,7 +625,7 @@ def measure_motion(case: MotionCase, samples: int = 2001, reference_samples: int
     finite = all(np.all(np.isfinite(np.asarray(a))) for a in (traj.omega_body, traj.quaternion, traj.omega))
     omega_body0 = np.asarray(frame.axes) @ np.asarray(case.omega)
     pick = np.linspace(0, samples - 1, reference_samples).astype(int)
-    ref = reference_omega(effective, omega_body0, np.asarray(traj.t)[pick])
+    ref = reference_omega(effective, omega_body0, np.asarray(traj.t)[pick])  # type: ignore[arg-type]
     scale = float(np.linalg.norm(omega_body0))
     ours_err = float(np.max(np.linalg.norm(np.asarray(traj.omega_body)[pick] - ref, axis=1)) / scale)
     out: dict[str, object] = {
@@ -656,7 +657,7 @@ def _scipy_cell(case: MotionCase, moments: Array, omega_body0: Array, frame: obj
         return {"skipped": f"raises {type(exc).__name__}: {exc}"}
     e_drift, m_drift = invariant_drift(moments, w, q, np.eye(3))
     pick = np.linspace(0, len(t) - 1, 41).astype(int)
-    ref = reference_omega(moments, omega_body0, t[pick])
+    ref = reference_omega(moments, omega_body0, t[pick])  # type: ignore[arg-type]
     err = float(np.max(np.linalg.norm(w[pick] - ref, axis=1)) / rate)
     return {"energy_drift": e_drift, "momentum_drift": m_drift, "omega_error": err, "horizon": horizon,
             "seconds": time.perf_counter() - start}
@@ -734,8 +735,9 @@ def render(geometry: list[Row], growth: list[Row], flip: dict[str, object], tess
         + ", ".join(f"{k}: {a:.1f} s / {b:.1f} s" for k, (a, b) in timings.items()) + ". "
         + "Peers on the largest mesh they ran: "
         + ", ".join(f"{k} {v:.1f} s" for r in growth[-2:-1]
-                    for k, v in r.extra.get("peer_s", {}).items())  # type: ignore[union-attr]
-        + f" ({growth[-2].case.split(',')[0] if len(growth) > 1 else '-'}). numpy-stl and MuJoCo are not run at 1e7 triangles: at ten times those times "
+                    for k, v in r.extra.get("peer_s", {}).items())  # type: ignore[attr-defined]
+        + f" ({growth[-2].case.split(',')[0] if len(growth) > 1 else '-'}). "
+        "numpy-stl and MuJoCo are not run at 1e7 triangles: at ten times those times "
         "the report would no longer regenerate in a few minutes; trimesh and ours are.",
         "",
         "Notes:",
@@ -761,7 +763,7 @@ def render(geometry: list[Row], growth: list[Row], flip: dict[str, object], tess
             "| body (rotated) | true class | spread of moments that should be equal | chord-error scale | "
             "smallest tolerance giving the true class | default 1e-6 gives it |", "|---|---|---|---|---|---|"]
     for t in tess:
-        out.append(f"| {t['case']} | {t['true'].value} | {_cell(t['spread'])} | {t['scale'] or '—'} | "  # type: ignore[union-attr]
+        out.append(f"| {t['case']} | {t['true'].value} | {_cell(t['spread'])} | {t['scale'] or '—'} | "  # type: ignore[arg-type, attr-defined]
                    f"{_tol(t['tol_ours'])} (exact moments: {_tol(t['tol_exact_moments'])}) | "
                    f"{'yes' if t['default_ok'] else 'no'} |")
     out += ["", *TOLERANCE_ADVICE, "", "## Motion (each over 1e5 time units)", ""]
@@ -799,9 +801,9 @@ def _flip_lines(flip: dict[str, object]) -> list[str]:
         "| case | exact flip tolerance (I3 - I1)/I3 | our rel. err of it | trimesh | numpy-stl | MuJoCo | "
         "our class at 0.99 x / 1.01 x flip | pass |",
         "|---|---|---|---|---|---|---|---|",
-        f"| box 1 x 1 x (1 + 1e-9), rotated | {flip['flip']:.6e} | {_cell(flip['flip_error'])} | "  # type: ignore[str-format]
+        f"| box 1 x 1 x (1 + 1e-9), rotated | {flip['flip']:.6e} | {_cell(flip['flip_error'])} | "  # type: ignore[arg-type]
         + " | ".join(_cell(peers[k]) for k in ("trimesh", "numpy-stl", "mujoco"))
-        + f" | {flip['below'].value} / {flip['above'].value} | "  # type: ignore[union-attr]
+        + f" | {flip['below'].value} / {flip['above'].value} | "  # type: ignore[attr-defined]
         + ("pass" if flip["passed"] else "**FAIL**") + " |",
         "",
         f"The equal pair differs by {flip['pair']:.1e} of I3 (rounding of the rotated vertices), so the class "
@@ -820,7 +822,7 @@ def _motion_lines(motion: list[dict[str, object]]) -> list[str]:
             sc = [str(s["skipped"]), "", ""]
         else:
             horizon = "" if s["horizon"] == HORIZON else f" (over {s['horizon']:.0e} s = 1e5 rad)"
-            sc = [_cell(s["energy_drift"]) + horizon, _cell(s["momentum_drift"]), _cell(s["omega_error"])]  # type: ignore[arg-type]
+            sc = [_cell(s["energy_drift"]) + horizon, _cell(s["momentum_drift"]), _cell(s["omega_error"])]
         case = str(m["case"]) + (f" ({m['note']})" if m["note"] else "")
         lines.append(f"| {case} | {m['regime']} | {_cell(m['energy_drift'])} | {_cell(m['momentum_drift'])} | "  # type: ignore[arg-type]
                      f"{_cell(m['omega_error'])} | " + " | ".join(sc)  # type: ignore[arg-type]
@@ -831,7 +833,8 @@ def _motion_lines(motion: list[dict[str, object]]) -> list[str]:
         "frame, recomputed here from the trajectory (Omega_body and the attitude quaternion), not taken from the "
         "service's diagnostics. Omega err is max |Omega(t) - Omega_ref(t)| / |Omega| at 41 times against the "
         "mpmath closed form at 40 digits; for the exact method it is the phase error of rounding the "
-        "frequency (~ t x rate x 1e-16: ~1e-11 at 1e5 rad, 9e-6 at the 1e11 rad of the ‖Ω‖ = 1e6 row; near the separatrix the phase is "
+        "frequency (~ t x rate x 1e-16: ~1e-11 at 1e5 rad, 9e-6 at the 1e11 rad of the ‖Ω‖ = 1e6 row; "
+        "near the separatrix the phase is "
         "exponentially sensitive and any float64 method loses it). No bound is claimed on Omega err.",
         "",
         "scipy runs the full 1e5 time units except where that is more than 1e6 rad (the ‖Ω‖ = 1e6 row: "
@@ -894,13 +897,13 @@ def nearly_symmetric_row(cases: int = 20) -> dict[str, object]:
         speed = float(np.linalg.norm(omega))
         for duration in (10.0, 1000.0):
             t = np.linspace(0.0, duration, 6)
-            res = precession(omega, principal_moments=moments, duration=duration, samples=len(t))
-            ref = reference_omega(moments, omega, t)
+            res = precession(omega, principal_moments=moments, duration=duration, samples=len(t))  # type: ignore[arg-type]
+            ref = reference_omega(moments, omega, t)  # type: ignore[arg-type]
             traj = res.motion.trajectory
             assert traj is not None
             err = float(np.max(np.linalg.norm(np.asarray(traj.omega_body) - ref, axis=1))) / speed
             worst[duration] = max(worst[duration], err / (eps * (1 + speed * duration)))
-            departed = float(np.max(np.linalg.norm(reference_omega(ideal, omega, t) - ref, axis=1))) / speed
+            departed = float(np.max(np.linalg.norm(reference_omega(ideal, omega, t) - ref, axis=1))) / speed  # type: ignore[arg-type]
             ideal_worst[duration] = max(ideal_worst[duration], departed)
     return {"case": f"nearly symmetric tops, gaps 1e-13 .. 5e-7 (labelled symmetric at tolerance 1e-6), {cases} tops",
             "ours": "; ".join(f"T = {d:g}: Omega error {w:.2g} eps per radian" for d, w in worst.items()),
@@ -1001,10 +1004,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     geometry.append(point_case(100_000 if args.quick else 1_000_000))
     growth: list[Row] = []
     timings: dict[str, tuple[float, float]] = {}
-    for n, case in summation_cases(args.quick):
+    for _n, case in summation_cases(args.quick):
         t0 = time.perf_counter()
         growth.append(measure_mesh(case))
-        timings[f"{len(case.faces):.1e} triangles"] = (growth[-1].extra["ours_s"], time.perf_counter() - t0)
+        timings[f"{len(case.faces):.1e} triangles"] = (growth[-1].extra["ours_s"], time.perf_counter() - t0)  # type: ignore[assignment]
         print(f"  {case.name}: {growth[-1].seconds:.1f} s", file=sys.stderr)
     flip = near_symmetric_flip()
     tess = tessellation_rows()

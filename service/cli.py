@@ -209,9 +209,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         if args.command == "analyze":
             return _analyze(args)
         if args.command == "batch":
-            from .batch import run_batch_cli
-
-            return run_batch_cli(args)
+            return _batch(args)
         return _serve(args)
     except ServiceError as exc:
         if as_json:
@@ -246,6 +244,31 @@ def _analyze(args: argparse.Namespace) -> int:
         print(text)
     else:
         print(render_table(doc, args.output_units))
+    return 0
+
+
+def _batch(args: argparse.Namespace) -> int:
+    """``inertia batch``: run, print a one-line summary to stderr, exit 0.
+
+    Files that fail are rows of the output, not a failure of the run; a bad
+    option or a missing extra raises ``InvalidParameterError`` (exit 2).
+    """
+    if args.scheduler is None:  # a local cluster: its workers' imports start now, beside this process's
+        from .batch.workers import start_forkserver
+
+        start_forkserver()
+    from .batch import run_batch
+
+    summary = run_batch(
+        args.paths,
+        args.out,
+        options_from_args(args),
+        resume=args.resume,
+        workers=args.workers,
+        scheduler=args.scheduler,
+        progress=not args.no_progress,
+    )
+    print(summary.as_text(), file=sys.stderr)
     return 0
 
 

@@ -17,6 +17,7 @@ from .body import MeshBody, Part
 __all__ = ["triangle_area", "part_surface_area", "SURFACE_AREA_KEY"]
 
 SURFACE_AREA_KEY = "surface_area"
+AREA_BLOCK = 1 << 16  # triangles per block: ~10 MB of temporaries, not ~150 bytes per triangle at once
 
 
 def triangle_area(vertices: NDArray[np.float64], faces: NDArray[np.int64]) -> float:
@@ -26,9 +27,14 @@ def triangle_area(vertices: NDArray[np.float64], faces: NDArray[np.int64]) -> fl
     if len(f) == 0:
         return 0.0
     origin = v[f[0, 0]]
-    a, b, c = (v[f[:, k]] - origin for k in range(3))
-    cross = np.cross(b - a, c - a)
-    return float(0.5 * np.sum(np.sqrt(np.einsum("ij,ij->i", cross, cross))))
+    # each triangle's |n| in blocks (temporaries bounded), then one pairwise sum over all of them
+    norms = np.empty(len(f))
+    for start in range(0, len(f), AREA_BLOCK):
+        block = f[start : start + AREA_BLOCK]
+        a, b, c = (v[block[:, k]] - origin for k in range(3))
+        cross = np.cross(b - a, c - a)
+        norms[start : start + AREA_BLOCK] = np.sqrt(np.einsum("ij,ij->i", cross, cross))
+    return float(0.5 * np.sum(norms))
 
 
 def part_surface_area(part: Part) -> float | None:

@@ -31,7 +31,7 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 from fractions import Fraction
 from pathlib import Path
-from typing import Any
+from typing import Any, cast
 
 import mpmath
 import numpy as np
@@ -84,23 +84,23 @@ def configured_client(**env: str) -> Iterator[TestClient]:
         yield c
 
 
-def post_mesh(client: TestClient, filename: str, data: bytes, **params: Any):
+def post_mesh(client: TestClient, filename: str, data: bytes, **params: Any) -> Any:
     q = {k: (v if isinstance(v, str) else str(v)) for k, v in params.items()}
     return client.post("/v1/analyze/mesh", files={"file": (filename, data, "application/octet-stream")},
                        params=q)
 
 
-def analyze(client: TestClient, filename: str, data: bytes | None = None, **params: Any) -> dict:
+def analyze(client: TestClient, filename: str, data: bytes | None = None, **params: Any) -> dict[str, Any]:
     if data is None:
         data = (SAMPLES / filename).read_bytes()
     r = post_mesh(client, filename, data, **params)
     assert r.status_code == 200, r.text
     body = r.json()
     assert_no_nulls(body)
-    return body
+    return cast("dict[str, Any]", body)
 
 
-def assert_error(r, status: int, code: str) -> dict:
+def assert_error(r: Any, status: int, code: str) -> dict[str, Any]:
     assert r.status_code == status, (r.status_code, r.text)
     body = r.json()
     assert set(body) == {"error"}, body
@@ -109,7 +109,7 @@ def assert_error(r, status: int, code: str) -> dict:
     assert err["code"] == code, err
     assert isinstance(err["message"], str) and err["message"].strip(), err
     assert isinstance(err["details"], dict), err
-    return err
+    return cast("dict[str, Any]", err)
 
 
 def assert_no_nulls(obj: Any, path: str = "$") -> None:
@@ -180,14 +180,14 @@ def read_obj_triangles(data: bytes) -> np.ndarray:
             idx = [int(x.split("/")[0]) - 1 for x in p[1:]]
             for k in range(1, len(idx) - 1):
                 tris.append([idx[0], idx[k], idx[k + 1]])
-    return np.asarray(verts)[np.asarray(tris)]
+    return cast("np.ndarray", np.asarray(verts)[np.asarray(tris)])
 
 
 # ----------------------------------------------------------------------------------------
 # exact references
 # ----------------------------------------------------------------------------------------
 
-def exact_mass_properties(triangles: np.ndarray, density: float = RHO):
+def exact_mass_properties(triangles: np.ndarray, density: float = RHO) -> Any:
     """Exact rational mass, centre of mass and inertia tensor (about the COM) of the closed
     polyhedron with these triangles (divergence theorem, tetrahedra from the origin:
     ∫x dV = V s/4, ∫x xᵀ dV = V/20 (Σ v vᵀ + s sᵀ))."""
@@ -223,7 +223,7 @@ def exact_moments(inertia: list[list[Fraction]]) -> list[float]:
         return sorted(float(ev[i]) for i in range(3))
 
 
-def exact_of(filename: str, data: bytes | None = None):
+def exact_of(filename: str, data: bytes | None = None) -> Any:
     data = data if data is not None else (SAMPLES / filename).read_bytes()
     tris = read_stl_triangles(data) if filename.endswith(".stl") else read_obj_triangles(data)
     return exact_mass_properties(tris)
@@ -231,25 +231,25 @@ def exact_of(filename: str, data: bytes | None = None):
 
 def parallel_axis(I_com: np.ndarray, mass: float, d: np.ndarray) -> np.ndarray:
     d = np.asarray(d, float)
-    return I_com + mass * (d @ d * np.eye(3) - np.outer(d, d))
+    return cast("np.ndarray", I_com + mass * (d @ d * np.eye(3) - np.outer(d, d)))
 
 
 def box_inertia(m: float, a: float, b: float, c: float) -> np.ndarray:
     return m / 12 * np.diag([b * b + c * c, a * a + c * c, a * a + b * b])
 
 
-def rotation(axis, angle: float) -> np.ndarray:
+def rotation(axis: Any, angle: float) -> np.ndarray:
     u = np.asarray(axis, float)
     u = u / np.linalg.norm(u)
     K = hat(u)
-    return np.eye(3) + math.sin(angle) * K + (1 - math.cos(angle)) * K @ K
+    return cast("np.ndarray", np.eye(3) + math.sin(angle) * K + (1 - math.cos(angle)) * K @ K)
 
 
-def hat(w) -> np.ndarray:
+def hat(w: Any) -> np.ndarray:
     return np.array([[0, -w[2], w[1]], [w[2], 0, -w[0]], [-w[1], w[0], 0]], dtype=float)
 
 
-def quat_matrix(q) -> np.ndarray:
+def quat_matrix(q: Any) -> np.ndarray:
     w, x, y, z = np.asarray(q, float) / np.linalg.norm(q)
     return np.array([
         [1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
@@ -258,13 +258,13 @@ def quat_matrix(q) -> np.ndarray:
     ])
 
 
-def ray_kappa(moments) -> float:
+def ray_kappa(moments: Any) -> float:
     I1, I2, I3 = moments
     A, B, C = 1 / I1, 1 / I2, 1 / I3
-    return (2 * B - A - C) / (A - C)
+    return cast("float", (2 * B - A - C) / (A - C))
 
 
-def ll_asymmetric_period(I, Omega) -> float:
+def ll_asymmetric_period(I: Any, Omega: Any) -> float:
     """Landau & Lifshitz §37: period of Ω(t) in the body frame, I1 < I2 < I3."""
     I1, I2, I3 = I
     W = np.asarray(Omega, float)
@@ -279,7 +279,7 @@ def ll_asymmetric_period(I, Omega) -> float:
     return 4 * float(ellipk(k2)) / rate
 
 
-def reference_motion(moments, axes, omega0, times):
+def reference_motion(moments: Any, axes: Any, omega0: Any, times: Any) -> Any:
     """Independent torque-free motion: Euler's equations for Ω (principal frame) and
     dB/dt = B [Ω]x for B(t), the map principal frame -> fixed input frame (B(0) = axesᵀ).
     Returns (Ω(t), ω(t) = B Ω, R(t) = B(t) axes)."""
@@ -287,7 +287,7 @@ def reference_motion(moments, axes, omega0, times):
     A = np.asarray(axes, float)
     W0 = A @ np.asarray(omega0, float)
 
-    def f(_t, y):
+    def f(_t: Any, y: Any) -> Any:
         W, B = y[:3], y[3:].reshape(3, 3)
         dW = np.array([(I[1] - I[2]) * W[1] * W[2] / I[0],
                        (I[2] - I[0]) * W[2] * W[0] / I[1],
@@ -310,7 +310,7 @@ def reference_motion(moments, axes, omega0, times):
 # shared structural checks
 # ----------------------------------------------------------------------------------------
 
-def check_principal(res: dict, tensor: np.ndarray | None = None) -> None:
+def check_principal(res: dict[str, Any], tensor: np.ndarray | None = None) -> None:
     p = res["principal"]
     I = np.asarray(p["moments"], float)
     A = np.asarray(p["axes"], float)
@@ -332,7 +332,7 @@ def check_principal(res: dict, tensor: np.ndarray | None = None) -> None:
             np.testing.assert_allclose(tensor @ A[k], I[k] * A[k], atol=1e-11 * scale)
 
 
-def check_classification(res: dict, kind: str, shape: str | None = None,
+def check_classification(res: dict[str, Any], kind: str, shape: str | None = None,
                          planar: bool | None = None, tolerance: float = 1e-6) -> None:
     c = res["classification"]
     assert c["kind"] == kind, c
@@ -410,7 +410,7 @@ SAMPLE_TABLE = [
 
 @pytest.mark.parametrize("filename,mass,com,moments,kind,shape", SAMPLE_TABLE,
                          ids=[row[0] for row in SAMPLE_TABLE])
-def test_sample_mesh_matches_published_values(client: TestClient, filename, mass, com, moments, kind, shape) -> None:
+def test_sample_mesh_matches_published_values(client: TestClient, filename: str, mass: float, com: Any, moments: Any, kind: str, shape: str | None) -> None:
     res = analyze(client, filename)
     assert res["mass"] == pytest.approx(mass, rel=1e-10)
     size = max(1.0, float(np.max(np.abs(com))))
@@ -429,7 +429,7 @@ def test_sample_mesh_matches_published_values(client: TestClient, filename, mass
 
 @pytest.mark.parametrize("filename", ["box.stl", "l_bracket.stl", "tetrahedron.stl", "hex_prism.stl",
                                       "icosahedron.stl", "needle.obj", "plate.obj", "inverted_box.stl"])
-def test_moments_are_those_of_the_polyhedron_as_written_within_the_error_estimate(client: TestClient, filename) -> None:
+def test_moments_are_those_of_the_polyhedron_as_written_within_the_error_estimate(client: TestClient, filename: str) -> None:
     """API.md Accuracy: exactly the polyhedron read (float32 for binary STL), each principal
     moment to within relative_error_estimate of its own value."""
     res = analyze(client, filename)
@@ -461,7 +461,7 @@ def test_box_tensor_in_input_frame_and_reference_by_parallel_axis_theorem(client
     np.testing.assert_allclose(res["inertia_tensor"], I_com, rtol=0, atol=1e-12 * 6500)
     ref = res["reference_inertia"]
     np.testing.assert_allclose(ref["point"], [0, 0, 0], atol=0)
-    np.testing.assert_allclose(ref["tensor"], parallel_axis(I_com, 6000, [0.5, 1, 1.5]),
+    np.testing.assert_allclose(ref["tensor"], parallel_axis(I_com, 6000, [0.5, 1, 1.5]),  # type: ignore[arg-type]
                                rtol=0, atol=1e-12 * 26000)
     assert res["volume"] == pytest.approx(6.0, rel=1e-15)
     assert res["density"] == RHO
@@ -481,7 +481,7 @@ def test_inverted_winding_is_corrected_with_a_warning(client: TestClient) -> Non
 # frames: generated, rotated and translated meshes
 # ----------------------------------------------------------------------------------------
 
-def rotated_box(a, b, c, R, offset):
+def rotated_box(a: float, b: float, c: float, R: Any, offset: Any) -> Any:
     v = (box_corners(a, b, c) - np.array([a, b, c]) / 2) @ R.T + np.asarray(offset, float)
     return v, BOX_FACES
 
@@ -491,7 +491,7 @@ def test_rotated_box_tensor_axes_and_quaternion_are_in_the_input_frame(client: T
     v, f = rotated_box(1.0, 2.0, 3.0, R, [0.3, -0.2, 0.1])
     data = obj_bytes([(None, v, f)])
     res = analyze(client, "rotated.obj", data)
-    mass, com, inertia, _ = exact_mass_properties(v[f])
+    _mass, _com, inertia, _ = exact_mass_properties(v[f])
     want = np.array([[float(x) for x in r] for r in inertia])
     np.testing.assert_allclose(res["inertia_tensor"], want, rtol=0, atol=1e-12 * 6500)
     np.testing.assert_allclose(want, R @ box_inertia(6000, 1, 2, 3) @ R.T, rtol=0, atol=1e-9)
@@ -510,7 +510,7 @@ def test_far_from_origin_rotated_box_keeps_every_moment_within_the_estimate(clie
     v, f = rotated_box(1.0, 2.0, 3.0, R, [1e8, 5e7, -7e7])
     data = obj_bytes([(None, v, f)])
     res = analyze(client, "far.obj", data)
-    mass, com, inertia, _ = exact_mass_properties(v[f])
+    _mass, com, inertia, _ = exact_mass_properties(v[f])
     est = res["diagnostics"]["relative_error_estimate"]
     assert est <= 1e-12
     for got, want in zip(res["principal"]["moments"], exact_moments(inertia)):
@@ -523,7 +523,7 @@ def test_far_from_origin_binary_stl_uses_its_float32_coordinates(client: TestCli
     v, f = rotated_box(1.0, 2.0, 3.0, R, [1e4, -2e4, 3e3])
     data = stl_bytes(v, f)
     res = analyze(client, "far32.stl", data)
-    mass, com, inertia, _ = exact_of("far32.stl", data)
+    mass, _com, inertia, _ = exact_of("far32.stl", data)
     est = res["diagnostics"]["relative_error_estimate"]
     assert est <= 1e-12
     assert res["mass"] == pytest.approx(float(mass), rel=1e-13)
@@ -532,11 +532,11 @@ def test_far_from_origin_binary_stl_uses_its_float32_coordinates(client: TestCli
 
 
 @pytest.mark.parametrize("dims", [(1.0, 1e-6, 1e-6), (1.0, 1.0, 1e-6)], ids=["needle", "plate"])
-def test_needle_and_plate_of_aspect_1e6_at_an_angle_keep_the_smallest_moment(client: TestClient, dims) -> None:
+def test_needle_and_plate_of_aspect_1e6_at_an_angle_keep_the_smallest_moment(client: TestClient, dims: Any) -> None:
     """Accuracy: estimate <= 1e-9 for the smallest moment of needles and plates of aspect
     ratio up to 1e6, at any orientation."""
     R = rotation([0.2, 0.9, -0.4], 0.83)
-    v, f = rotated_box(*dims, R, [0.25, 0.5, -0.75])
+    v, f = rotated_box(*dims, R, [0.25, 0.5, -0.75])  # type: ignore[call-arg]
     data = obj_bytes([(None, v, f)])
     res = analyze(client, "thin.obj", data)
     _, _, inertia, _ = exact_mass_properties(v[f])
@@ -560,7 +560,7 @@ def test_same_input_gives_bit_identical_numbers(client: TestClient) -> None:
 # ----------------------------------------------------------------------------------------
 
 @pytest.mark.parametrize("unit", list(UNIT_SCALE))
-def test_units_convert_file_lengths_to_si(client: TestClient, unit) -> None:
+def test_units_convert_file_lengths_to_si(client: TestClient, unit: str) -> None:
     s = UNIT_SCALE[unit]
     res = analyze(client, "box.stl", units=unit, reference="1,0,0")
     m = 6 * s ** 3 * RHO
@@ -606,7 +606,7 @@ def test_density_and_mass_are_exclusive(client: TestClient) -> None:
     assert_error(r, 422, "invalid_parameter")
 
 
-def thin_box_shell_inertia(a, b, c, sigma, faces=("x0", "x1", "y0", "y1", "z0", "z1")):
+def thin_box_shell_inertia(a: float, b: float, c: float, sigma: float, faces: Any=("x0", "x1", "y0", "y1", "z0", "z1")) -> Any:
     """Inertia about the COM of the faces of [0,a]x[0,b]x[0,c] as laminae of areal density
     sigma (rectangle p x q: I_normal = m(p²+q²)/12, in-plane m q²/12, m p²/12)."""
     dims = np.array([a, b, c], float)
@@ -641,7 +641,7 @@ def test_shell_model_integrates_a_thin_wall_of_given_thickness(client: TestClien
 
 def test_shell_thickness_is_in_file_units(client: TestClient) -> None:
     res = analyze(client, "box.stl", model="shell", thickness=0.1, units="mm")
-    M, com, I = thin_box_shell_inertia(1e-3, 2e-3, 3e-3, RHO * 1e-4)
+    M, _com, I = thin_box_shell_inertia(1e-3, 2e-3, 3e-3, RHO * 1e-4)
     assert res["mass"] == pytest.approx(M, rel=1e-3)
     np.testing.assert_allclose(res["inertia_tensor"], I, rtol=0, atol=1e-3 * np.trace(I))
 
@@ -705,7 +705,7 @@ def test_volume_mesh_cell_density_takes_precedence_and_mass_scales_it(client: Te
 
 def two_cube_obj() -> bytes:
     cube = box_corners(1, 1, 1)
-    return obj_bytes([("left", cube, BOX_FACES), ("right", cube + [2, 0, 0], BOX_FACES)])
+    return obj_bytes([("left", cube, BOX_FACES), ("right", cube + np.array([2, 0, 0]), BOX_FACES)])
 
 
 def test_parts_of_a_scene_with_densities_per_part(client: TestClient) -> None:
@@ -810,7 +810,7 @@ ERROR_CASES = [
 
 @pytest.mark.parametrize("label,filename,data,params,status,code", ERROR_CASES,
                          ids=[c[0] for c in ERROR_CASES])
-def test_mesh_errors_use_the_envelope_code_and_status(client: TestClient, label, filename, data, params, status, code) -> None:
+def test_mesh_errors_use_the_envelope_code_and_status(client: TestClient, label: str, filename: str, data: bytes, params: dict[str, Any], status: int, code: str) -> None:
     if data is None:
         data = (SAMPLES / filename).read_bytes()
     assert_error(post_mesh(client, filename, data, **params), status, code)
@@ -822,7 +822,7 @@ def test_missing_file_part_is_invalid_parameter(client: TestClient) -> None:
 
 
 @pytest.mark.parametrize("fmt", ["stl", "obj"])
-def test_non_finite_coordinates_in_a_file_are_invalid_parameter(client: TestClient, fmt) -> None:
+def test_non_finite_coordinates_in_a_file_are_invalid_parameter(client: TestClient, fmt: str) -> None:
     """API.md: Non-finite numbers (NaN, ±Inf) anywhere in an input are invalid_parameter."""
     v = box_corners(1, 2, 3)
     v[7] = [np.nan, 2, 3]
@@ -834,18 +834,18 @@ def test_non_finite_coordinates_in_a_file_are_invalid_parameter(client: TestClie
 # /v1/analyze/points
 # ----------------------------------------------------------------------------------------
 
-def post_points(client: TestClient, body: dict | str):
+def post_points(client: TestClient, body: dict[str, Any] | str) -> Any:
     if isinstance(body, str):
         return client.post("/v1/analyze/points", content=body, headers={"content-type": "application/json"})
     return client.post("/v1/analyze/points", json=body)
 
 
-def points_ok(client: TestClient, body) -> dict:
+def points_ok(client: TestClient, body: Any) -> dict[str, Any]:
     r = post_points(client, body)
     assert r.status_code == 200, r.text
     res = r.json()
     assert_no_nulls(res)
-    return res
+    return cast("dict[str, Any]", res)
 
 
 TRIATOMIC = json.loads((SAMPLES / "triatomic.json").read_text())
@@ -927,7 +927,7 @@ POINTS_ERRORS = [
 
 
 @pytest.mark.parametrize("label,body", POINTS_ERRORS, ids=[c[0] for c in POINTS_ERRORS])
-def test_points_errors_are_invalid_parameter(client: TestClient, label, body) -> None:
+def test_points_errors_are_invalid_parameter(client: TestClient, label: str, body: Any) -> None:
     assert_error(post_points(client, body), 422, "invalid_parameter")
 
 
@@ -935,32 +935,32 @@ def test_points_errors_are_invalid_parameter(client: TestClient, label, body) ->
 # /v1/precession
 # ----------------------------------------------------------------------------------------
 
-def post_precession(client: TestClient, body):
+def post_precession(client: TestClient, body: Any) -> Any:
     if isinstance(body, str):
         return client.post("/v1/precession", content=body, headers={"content-type": "application/json"})
     return client.post("/v1/precession", json=body)
 
 
-def precession_ok(client: TestClient, body) -> dict:
+def precession_ok(client: TestClient, body: Any) -> dict[str, Any]:
     r = post_precession(client, body)
     assert r.status_code == 200, r.text
     res = r.json()
     assert_no_nulls(res)
     assert {"principal", "classification", "precession", "diagnostics"} <= set(res) <= {
         "principal", "classification", "precession", "diagnostics", "warnings"}, set(res)
-    return res
+    return cast("dict[str, Any]", res)
 
 
-def check_invariants(pre: dict, I_input: np.ndarray, omega0) -> None:
+def check_invariants(pre: dict[str, Any], I_input: np.ndarray, omega0: Any) -> None:
     w = np.asarray(omega0, float)
     M = I_input @ w
     scale = np.linalg.norm(M) + 1e-300
-    np.testing.assert_allclose(pre["angular_momentum"], M, rtol=0, atol=1e-13 * scale)
+    np.testing.assert_allclose(pre["angular_momentum"], M, rtol=0, atol=1e-13 * scale)  # type: ignore[call-overload]
     assert pre["angular_momentum_magnitude"] == pytest.approx(np.linalg.norm(M), rel=1e-13, abs=1e-300)
     assert pre["kinetic_energy"] == pytest.approx(0.5 * w @ I_input @ w, rel=1e-13, abs=1e-300)
 
 
-def check_symmetric_rates(pre: dict, I_perp: float, I_sym: float, n, omega0) -> None:
+def check_symmetric_rates(pre: dict[str, Any], I_perp: float, I_sym: float, n: Any, omega0: Any) -> None:
     """L&L §33: ω = Ω3(I3 − I1)/I1, |M|/I1, ψ̇ = |M| cos θ (1/I3 − 1/I1), cos θ = I3 Ω3/|M|."""
     W3 = float(np.asarray(n, float) @ np.asarray(omega0, float))
     W = np.asarray(omega0, float)
@@ -976,7 +976,7 @@ def check_symmetric_rates(pre: dict, I_perp: float, I_sym: float, n, omega0) -> 
     assert pre["period"] == pytest.approx(2 * math.pi / abs(body), rel=1e-12)
 
 
-def check_trajectory(pre: dict, moments, axes, omega0, duration, samples, I_input, tol: float=1e-8) -> None:
+def check_trajectory(pre: dict[str, Any], moments: Any, axes: Any, omega0: Any, duration: float, samples: int, I_input: Any, tol: float=1e-8) -> None:
     tr = pre["trajectory"]
     t = np.asarray(tr["t"], float)
     assert len(t) == samples
@@ -989,21 +989,21 @@ def check_trajectory(pre: dict, moments, axes, omega0, duration, samples, I_inpu
     np.testing.assert_allclose(np.linalg.norm(Q, axis=1), 1, atol=1e-12)
     np.testing.assert_allclose(quat_matrix(Q[0]), np.eye(3), atol=1e-14)
     A = np.asarray(axes, float)
-    np.testing.assert_allclose(W[0], pre["omega_body"], rtol=0, atol=1e-13 * np.linalg.norm(omega0))
-    np.testing.assert_allclose(w[0], omega0, rtol=0, atol=1e-13 * np.linalg.norm(omega0))
+    np.testing.assert_allclose(W[0], pre["omega_body"], rtol=0, atol=1e-13 * np.linalg.norm(omega0))  # type: ignore[call-overload]
+    np.testing.assert_allclose(w[0], omega0, rtol=0, atol=1e-13 * np.linalg.norm(omega0))  # type: ignore[call-overload]
     M0 = I_input @ np.asarray(omega0, float)
     wscale = np.linalg.norm(omega0)
     for k in range(samples):
         R = quat_matrix(Q[k])
         # omega(t) in the fixed input frame is the rotated body omega
-        np.testing.assert_allclose(w[k], R @ A.T @ W[k], rtol=0, atol=max(tol, 1e-12) * wscale)
+        np.testing.assert_allclose(w[k], R @ A.T @ W[k], rtol=0, atol=max(tol, 1e-12) * wscale)  # type: ignore[call-overload]
         # M stays constant in the fixed frame: I(t) = R I0 Rᵀ
-        np.testing.assert_allclose(R @ I_input @ R.T @ w[k], M0, rtol=0,
+        np.testing.assert_allclose(R @ I_input @ R.T @ w[k], M0, rtol=0,  # type: ignore[call-overload]
                                    atol=max(tol, 1e-12) * np.linalg.norm(M0) + 1e-300)
     if moments[0] > 0:
         Wr, wr, Rr = reference_motion(moments, A, omega0, t)
-        np.testing.assert_allclose(W, Wr, rtol=0, atol=tol * wscale)
-        np.testing.assert_allclose(w, wr, rtol=0, atol=tol * wscale)
+        np.testing.assert_allclose(W, Wr, rtol=0, atol=tol * wscale)  # type: ignore[call-overload]
+        np.testing.assert_allclose(w, wr, rtol=0, atol=tol * wscale)  # type: ignore[call-overload]
         for k in range(samples):
             np.testing.assert_allclose(quat_matrix(Q[k]), Rr[k], rtol=0, atol=tol)
     d = pre["diagnostics"]
@@ -1032,7 +1032,7 @@ def test_precession_from_principal_moments_asymmetric_intermediate_start(client:
 
 
 @pytest.mark.parametrize("omega,branch", [([0.05, 0.3, 1.0], "near I3"), ([1.0, 0.3, 0.05], "near I1")])
-def test_asymmetric_period_both_branches_and_stable_starts(client: TestClient, omega, branch) -> None:
+def test_asymmetric_period_both_branches_and_stable_starts(client: TestClient, omega: Any, branch: str) -> None:
     moments = [1.0, 2.0, 3.0]
     pre = precession_ok(client, {"principal_moments": moments, "omega": omega, "duration": 6,
                                  "samples": 13})["precession"]
@@ -1089,7 +1089,7 @@ def test_precession_from_a_rotated_inertia_tensor(client: TestClient) -> None:
 
 
 @pytest.mark.parametrize("moments,shape", [([2.0, 2.0, 3.0], "oblate"), ([1.0, 3.0, 3.0], "prolate")])
-def test_symmetric_top_rates_follow_landau_lifshitz(client: TestClient, moments, shape) -> None:
+def test_symmetric_top_rates_follow_landau_lifshitz(client: TestClient, moments: Any, shape: str | None) -> None:
     omega = [0.3, -0.4, 1.2]
     res = precession_ok(client, {"principal_moments": moments, "omega": omega, "duration": 4, "samples": 9})
     check_classification(res, "symmetric_top", shape)
@@ -1165,7 +1165,7 @@ def test_flip_interval_is_the_time_between_reversals_of_omega2(client: TestClien
 
 
 @pytest.mark.parametrize("method", ["dop853", "rk45", "splitting"])
-def test_numerical_methods_follow_the_same_motion(client: TestClient, method) -> None:
+def test_numerical_methods_follow_the_same_motion(client: TestClient, method: str) -> None:
     moments, omega = [1.0, 2.0, 3.0], [0.3, 0.8, 0.5]
     res = precession_ok(client, {"principal_moments": moments, "omega": omega, "duration": 3, "samples": 7,
                                  "method": method})
@@ -1189,7 +1189,7 @@ def test_rest(client: TestClient) -> None:
 
 
 @pytest.mark.parametrize("axis,stable", [(0, True), (1, False), (2, True)])
-def test_permanent_rotation_about_a_principal_axis(client: TestClient, axis, stable) -> None:
+def test_permanent_rotation_about_a_principal_axis(client: TestClient, axis: Any, stable: bool) -> None:
     omega = [0.0, 0.0, 0.0]
     omega[axis] = 1.5
     # box.stl: x has the largest moment (6500), y the intermediate, z the smallest
@@ -1265,7 +1265,7 @@ PRECESSION_ERRORS = [
 
 
 @pytest.mark.parametrize("label,body", PRECESSION_ERRORS, ids=[c[0] for c in PRECESSION_ERRORS])
-def test_precession_errors_are_invalid_parameter(client: TestClient, label, body) -> None:
+def test_precession_errors_are_invalid_parameter(client: TestClient, label: str, body: Any) -> None:
     assert_error(post_precession(client, body), 422, "invalid_parameter")
 
 
@@ -1273,7 +1273,7 @@ def test_precession_errors_are_invalid_parameter(client: TestClient, label, body
 # /v1/batch
 # ----------------------------------------------------------------------------------------
 
-def ndjson_lines(r) -> list[dict]:
+def ndjson_lines(r: Any) -> list[dict[str, Any]]:
     assert r.status_code == 200, r.text
     assert r.headers["content-type"].split(";")[0].strip() == "application/x-ndjson"
     lines = [json.loads(x) for x in r.text.splitlines() if x.strip()]
@@ -1285,7 +1285,7 @@ def ndjson_lines(r) -> list[dict]:
 BATCH_FILES = ["box.stl", "open_box.stl", "tetrahedron.stl", "l_bracket.stl"]
 
 
-def check_batch_lines(client: TestClient, lines, params) -> None:
+def check_batch_lines(client: TestClient, lines: list[dict[str, Any]], params: dict[str, Any]) -> None:
     assert [line["source"]["filename"].rsplit("/", 1)[-1] for line in lines] == BATCH_FILES
     assert set(lines[1]) == {"source", "error"}
     err = lines[1]["error"]
@@ -1390,7 +1390,7 @@ def test_api_key_guards_v1_but_not_healthz() -> None:
 # command line
 # ----------------------------------------------------------------------------------------
 
-def run_cli(*args: str, cwd: Path = SAMPLES) -> subprocess.CompletedProcess:
+def run_cli(*args: str, cwd: Path = SAMPLES) -> subprocess.CompletedProcess:  # type: ignore[type-arg]
     env = {k: v for k, v in os.environ.items() if not k.startswith("INERTIA_")}
     return subprocess.run([sys.executable, "-m", "inertia", *args], cwd=cwd, env=env,
                           capture_output=True, text=True, timeout=60)
@@ -1405,7 +1405,7 @@ def test_cli_json_equals_the_http_response(client: TestClient) -> None:
     p = run_cli(*args)
     assert p.returncode == 0, p.stderr
     cli = json.loads(p.stdout)
-    http = analyze(client, "box.stl", **opts)
+    http = analyze(client, "box.stl", **opts)  # type: ignore[arg-type]
     assert strip_elapsed(cli) == strip_elapsed(http)
 
 
@@ -1474,11 +1474,11 @@ def off_ascii(v: np.ndarray, f: np.ndarray) -> bytes:
 
 
 @pytest.mark.parametrize("fmt", ["ply", "off", "obj", "stl"])
-def test_surface_formats_give_the_same_box(client: TestClient, fmt) -> None:
-    v = box_corners(1, 2, 3) + [1, -1, 2]
+def test_surface_formats_give_the_same_box(client: TestClient, fmt: str) -> None:
+    v = box_corners(1, 2, 3) + np.array([1, -1, 2])
     writer = {"ply": ply_ascii, "off": off_ascii, "obj": lambda a, b: obj_bytes([(None, a, b)]),
               "stl": stl_bytes}[fmt]
-    res = analyze(client, f"box.{fmt}", writer(v, BOX_FACES))
+    res = analyze(client, f"box.{fmt}", writer(v, BOX_FACES))  # type: ignore[no-untyped-call]
     assert res["source"]["format"] == fmt
     assert res["mass"] == pytest.approx(6000, rel=1e-14)
     np.testing.assert_allclose(res["center_of_mass"], [1.5, 0, 3.5], rtol=0, atol=1e-14 * 4)
@@ -1486,7 +1486,7 @@ def test_surface_formats_give_the_same_box(client: TestClient, fmt) -> None:
     check_classification(res, "asymmetric_top")
 
 
-def two_box_scene():
+def two_box_scene() -> Any:
     import trimesh  # a writer only: the expected values below are closed formulas
 
     tf = trimesh.transformations
@@ -1499,7 +1499,7 @@ def two_box_scene():
     return scene, rot[:3, :3]
 
 
-def check_two_box_scene(res: dict, s: float = 1.0) -> None:
+def check_two_box_scene(res: dict[str, Any], s: float = 1.0) -> None:
     R = rotation([1, 0, 0], 0.5)
     ma, mb = 6000 * s ** 3, 2000 * s ** 3
     Ia = box_inertia(ma, s, 2 * s, 3 * s)
@@ -1553,12 +1553,12 @@ def test_3mf_default_units(client: TestClient) -> None:
     check_two_box_scene(res, s=UNIT_SCALE[unit])
 
 
-def kuhn_tetrahedra(origin, size) -> tuple[np.ndarray, np.ndarray]:
+def kuhn_tetrahedra(origin: Any, size: Any) -> tuple[np.ndarray, np.ndarray]:
     """The cube [origin, origin + size]³ as six positively oriented tetrahedra on its diagonal."""
     from itertools import permutations
 
     o = np.asarray(origin, float)
-    pts, cells = [], []
+    pts, cells = [], []  # type: ignore[var-annotated]
     for perm in permutations(range(3)):
         p = [o.copy()]
         for axis in perm:
@@ -1572,7 +1572,7 @@ def kuhn_tetrahedra(origin, size) -> tuple[np.ndarray, np.ndarray]:
     return np.array(pts), np.array(cells)
 
 
-def two_cube_volume_mesh():
+def two_cube_volume_mesh() -> Any:
     """Cubes [0,1]³ (1000 kg/m³) and [1,2]x[0,1]² (8000 kg/m³) in one tetra block."""
     pa, ca = kuhn_tetrahedra([0, 0, 0], 1.0)
     pb, cb = kuhn_tetrahedra([1, 0, 0], 1.0)
@@ -1587,7 +1587,7 @@ TWO_CUBES_MOMENTS = [1500.0, TWO_CUBES_MOMENTS[1], TWO_CUBES_MOMENTS[1]]
 
 
 @pytest.mark.parametrize("fmt", ["vtu", "vtk", "msh"])
-def test_volume_meshes_with_cell_density(client: TestClient, fmt, tmp_path: Path) -> None:
+def test_volume_meshes_with_cell_density(client: TestClient, fmt: str, tmp_path: Path) -> None:
     import meshio  # a writer only
 
     points, cells, density = two_cube_volume_mesh()
@@ -1678,7 +1678,7 @@ def test_collinear_points_along_a_diagonal_are_a_linear_rotator(client: TestClie
 
 
 def test_size_limit_applies_to_chunked_and_json_bodies() -> None:
-    def chunks():
+    def chunks() -> Any:
         for _ in range(50):
             yield b"x" * 1000
 
@@ -1723,7 +1723,7 @@ def test_random_convex_body_far_from_the_origin_within_the_estimate(client: Test
     v = local @ rotation([3, 1, -2], 2.0).T + [3e7, -4e7, 5e7]
     data = obj_bytes([(None, v, faces)])
     res = analyze(client, "hull.obj", data)
-    mass, com, inertia, _ = exact_mass_properties(v[faces])
+    mass, _com, inertia, _ = exact_mass_properties(v[faces])
     est = res["diagnostics"]["relative_error_estimate"]
     assert est <= 1e-12
     assert res["mass"] == pytest.approx(float(mass), rel=1e-13)
@@ -1758,7 +1758,7 @@ def test_exact_motion_over_many_periods(client: TestClient) -> None:
 
 
 @pytest.mark.parametrize("eps", [1e-3, -1e-3, 1e-5, -1e-5])
-def test_period_near_the_separatrix(client: TestClient, eps) -> None:
+def test_period_near_the_separatrix(client: TestClient, eps: float) -> None:
     moments = [1.0, 2.0, 3.0]
     omega = [0.1 * math.sqrt(3) * (1 + eps), 1.0, 0.1]
     pre = precession_ok(client, {"principal_moments": moments, "omega": omega})["precession"]
@@ -1779,7 +1779,7 @@ def test_separatrix_of_a_mesh_body(client: TestClient) -> None:
 
 
 @pytest.mark.parametrize("omega", [[0.3, -0.4, -1.2], [-0.7, 0.1, 0.05], [0.0, 0.5, -2.0]])
-def test_symmetric_top_signs_follow_the_reported_symmetry_axis(client: TestClient, omega) -> None:
+def test_symmetric_top_signs_follow_the_reported_symmetry_axis(client: TestClient, omega: Any) -> None:
     moments = [2.0, 2.0, 3.0]
     res = precession_ok(client, {"principal_moments": moments, "omega": omega, "duration": 2, "samples": 5})
     n = res["classification"]["symmetry_axis"]
@@ -1814,7 +1814,7 @@ def test_inertia_console_script_runs_analyze() -> None:
 
 
 @pytest.mark.parametrize("suffix", [".csv", ".parquet"])
-def test_cli_batch_tabular_outputs_have_one_row_per_file(tmp_path: Path, suffix) -> None:
+def test_cli_batch_tabular_outputs_have_one_row_per_file(tmp_path: Path, suffix: str) -> None:
     buf = io.BytesIO()
     with zipfile.ZipFile(buf, "w") as z:
         for name in ("box.stl", "open_box.stl", "l_bracket.stl"):
@@ -1910,7 +1910,7 @@ def test_cavity_is_subtracted_not_mistaken_for_inverted_winding(client: TestClie
 
 
 def test_a_separate_inverted_shell_is_corrected_with_a_warning(client: TestClient) -> None:
-    v = np.vstack([box_corners(1, 1, 1), box_corners(1, 1, 1) + [3, 0, 0]])
+    v = np.vstack([box_corners(1, 1, 1), box_corners(1, 1, 1) + np.array([3, 0, 0])])
     f = np.vstack([BOX_FACES, BOX_FACES[:, ::-1] + 8])
     res = analyze(client, "two.stl", stl_bytes(v, f))
     assert res["mass"] == pytest.approx(2000, rel=1e-14)
@@ -1929,7 +1929,7 @@ def test_inconsistent_winding_is_repaired_with_a_warning(client: TestClient) -> 
 
 def test_obj_groups_are_parts(client: TestClient) -> None:
     text = obj_bytes([("left", box_corners(1, 1, 1), BOX_FACES),
-                      ("right", box_corners(1, 1, 1) + [2, 0, 0], BOX_FACES)]).decode()
+                      ("right", box_corners(1, 1, 1) + np.array([2, 0, 0]), BOX_FACES)]).decode()
     res = analyze(client, "groups.obj", text.replace("o left", "g left").replace("o right", "g right").encode(),
                   densities=json.dumps({"right": 500}))
     parts = {p["name"]: p for p in res["parts"]}
@@ -1942,7 +1942,7 @@ def test_obj_groups_are_parts(client: TestClient) -> None:
 @pytest.mark.parametrize("name,data", [("empty.stl", b""), ("ascii.stl", b"solid x\nendsolid x\n"),
                                        ("points.obj", b"v 0 0 0\nv 1 0 0\nv 0 1 0\n")],
                          ids=["zero bytes", "ascii stl without facets", "obj without faces"])
-def test_files_without_triangles_are_empty_geometry(client: TestClient, name, data) -> None:
+def test_files_without_triangles_are_empty_geometry(client: TestClient, name: str, data: bytes) -> None:
     r = post_mesh(client, name, data)
     if name == "empty.stl" and r.json().get("error", {}).get("code") == "unreadable_file":
         # a zero-byte file is arguably not a readable STL at all: both codes are accepted
@@ -1959,7 +1959,7 @@ def test_point_masses_far_from_the_origin_keep_their_moments(client: TestClient)
     want = [32 / 18, 2.0, 32 / 18 + 2]
     for got, w in zip(res["principal"]["moments"], want):
         assert abs(got - w) <= max(est, 4.5e-16) * w, (got, w, est)
-    np.testing.assert_allclose(res["center_of_mass"], shift + [0, 16 / 18, 0], rtol=1e-16)
+    np.testing.assert_allclose(res["center_of_mass"], shift + np.array([0, 16 / 18, 0]), rtol=1e-16)
 
 
 def test_batch_keeps_upload_order_with_files_of_very_different_cost(client: TestClient) -> None:
@@ -2012,7 +2012,7 @@ def test_pyramid_and_wedge_cells(client: TestClient, tmp_path: Path) -> None:
 
     pts: list[list[float]] = []
 
-    def P(p):
+    def P(p: Any) -> Any:
         pts.append(list(map(float, p)))
         return len(pts) - 1
 
@@ -2024,7 +2024,7 @@ def test_pyramid_and_wedge_cells(client: TestClient, tmp_path: Path) -> None:
         ids = [P(x) for x in quad]
         if np.cross(b - a, c - a) @ (-a) < 0:  # VTK: base normal towards the apex
             ids = ids[::-1]
-        pyramids.append(ids + [apex])
+        pyramids.append([*ids, apex])
     wedges = []
     for tri in ([[1, 0], [2, 0], [2, 1]], [[1, 0], [2, 1], [1, 1]]):
         wedges.append([P([x, y, 0]) for x, y in tri] + [P([x, y, 1]) for x, y in tri])
@@ -2038,7 +2038,7 @@ def test_pyramid_and_wedge_cells(client: TestClient, tmp_path: Path) -> None:
 
 
 @pytest.mark.parametrize("method", ["exact", "dop853", "rk45", "splitting"])
-def test_drift_diagnostics_are_honest(client: TestClient, method) -> None:
+def test_drift_diagnostics_are_honest(client: TestClient, method: str) -> None:
     """'diagnostics reports how well the trajectory keeps [M] and the energy': the reported drift
     is at least what the returned samples show (half of it, for definitions that differ)."""
     moments, omega = [1.0, 2.0, 3.0], [0.3, 0.8, 0.5]

@@ -21,7 +21,7 @@ import subprocess
 import sys
 import warnings
 from pathlib import Path
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
 import pytest
@@ -62,7 +62,7 @@ POINTS = [
 def _rotation(axis: list[float], angle: float) -> np.ndarray:
     a = np.asarray(axis, dtype=float) / np.linalg.norm(axis)
     K = np.array([[0, -a[2], a[1]], [a[2], 0, -a[0]], [-a[1], a[0], 0]])
-    return np.eye(3) + math.sin(angle) * K + (1 - math.cos(angle)) * K @ K
+    return cast("np.ndarray", np.eye(3) + math.sin(angle) * K + (1 - math.cos(angle)) * K @ K)
 
 
 BOX = (0.4, 0.25, 0.1)  # edge lengths [m]
@@ -102,7 +102,7 @@ def _assert_same_body(compiled: tuple[float, np.ndarray, np.ndarray], doc: dict[
     mass, com, tensor = compiled
     ours = np.array(doc["inertia_tensor"])
     assert mass == pytest.approx(doc["mass"], rel=REL)
-    np.testing.assert_allclose(com, doc["center_of_mass"], rtol=0, atol=REL * np.linalg.norm(doc["center_of_mass"]))
+    np.testing.assert_allclose(com, doc["center_of_mass"], rtol=0, atol=REL * np.linalg.norm(doc["center_of_mass"]))  # type: ignore[call-overload]
     np.testing.assert_allclose(tensor, ours, rtol=0, atol=REL * np.abs(ours).max())
 
 

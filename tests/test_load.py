@@ -23,7 +23,7 @@ def box_mesh() -> trimesh.Trimesh:
 
 
 def export(obj: trimesh.Trimesh | trimesh.Scene, fmt: str, **kw: object) -> bytes:
-    data = obj.export(file_type=fmt, **kw)
+    data = obj.export(file_type=fmt, **kw)  # type: ignore[arg-type]
     if isinstance(data, dict):  # gltf with embedded buffers
         data = data["model.gltf"]
     return data.encode() if isinstance(data, str) else data
@@ -221,7 +221,7 @@ def test_assembly_far_from_the_origin_keeps_every_moment() -> None:
     left = trimesh.Trimesh(*box(1.0, 1.0, 1.0), process=False)
     right = trimesh.Trimesh(*box(1.0, 2.0, 1.0), process=False)
     left.apply_translation(offset)
-    right.apply_translation(offset + [3.0, 1.0, 0.0])
+    right.apply_translation(offset + np.array([3.0, 1.0, 0.0]))
     scene = trimesh.Scene()
     scene.add_geometry(left, node_name="left", geom_name="left")
     scene.add_geometry(right, node_name="right", geom_name="right")

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any, cast
 
 import mpmath
 import numpy as np
@@ -20,17 +21,17 @@ GENERIC = Rotation.from_euler("zyx", [0.3, 0.7, 1.1]).as_matrix()
 
 def exact_moments(vertices: np.ndarray, faces: np.ndarray, density: float = 1.0) -> list[float]:
     """Principal moments of exactly this polyhedron: Fraction integration, 50-digit eigenvalues."""
-    vol, _, tensor = exact_solid(vertices, faces)
+    _vol, _, tensor = exact_solid(vertices, faces)
     mpmath.mp.dps = 50
     matrix = mpmath.matrix([[mpmath.mpf(x.numerator) / x.denominator for x in row] for row in tensor])
     return sorted(float(ev) * density for ev in mpmath.eigsy(matrix)[0])
 
 
 def rel(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    return np.abs(np.asarray(a) - np.asarray(b)) / np.abs(np.asarray(b))
+    return cast("np.ndarray", np.abs(np.asarray(a) - np.asarray(b)) / np.abs(np.asarray(b)))
 
 
-def moments(props) -> np.ndarray:
+def moments(props: Any) -> np.ndarray:
     return np.sort(props.principal_moments)
 
 
@@ -51,9 +52,9 @@ def test_translated_box_keeps_every_moment(offset_sizes: float) -> None:
     shifted = v + offset_sizes * 3.0 * np.array([1.0, -0.6180339887, 0.4142135623])
     props = mass_properties(MeshBody(shifted, f), density=1.0)
     exact = exact_moments(shifted, f)
-    assert np.all(rel(moments(props), exact) <= 1e-12)
+    assert np.all(rel(moments(props), exact) <= 1e-12)  # type: ignore[arg-type]
     assert props.relative_error_estimate <= 1e-12
-    assert np.all(rel(moments(props), exact) <= max(props.relative_error_estimate, 1e-15))
+    assert np.all(rel(moments(props), exact) <= max(props.relative_error_estimate, 1e-15))  # type: ignore[arg-type]
 
 
 @pytest.mark.parametrize("thin", [1e-3, 1e-6])
@@ -62,7 +63,7 @@ def test_needle_under_generic_rotation_keeps_smallest_moment(thin: float) -> Non
     rotated = v @ GENERIC.T + np.array([0.25, -1.5, 2.0])
     props = mass_properties(MeshBody(rotated, f), density=1.0)
     exact = exact_moments(rotated, f)
-    errors = rel(moments(props), exact)
+    errors = rel(moments(props), exact)  # type: ignore[arg-type]
     assert errors[0] <= 1e-9
     assert np.all(errors <= props.relative_error_estimate)
     assert props.relative_error_estimate <= 1e-9
@@ -72,7 +73,7 @@ def test_plate_under_generic_rotation_keeps_every_moment() -> None:
     v, f = box(1.0, 1.0, 1e-6, origin=(-0.5, -0.5, -5e-7))
     rotated = v @ GENERIC.T
     props = mass_properties(MeshBody(rotated, f), density=1.0)
-    errors = rel(moments(props), exact_moments(rotated, f))
+    errors = rel(moments(props), exact_moments(rotated, f))  # type: ignore[arg-type]
     assert np.all(errors <= 1e-9)
     assert np.all(errors <= props.relative_error_estimate)
 
@@ -213,7 +214,7 @@ def test_two_material_volume_mesh_matches_composite_box() -> None:
     from tests.support.paths import SAMPLES
 
     loaded = load_body(SAMPLES / "two_density.vtu")
-    props = mass_properties(loaded.body)
+    props = mass_properties(loaded.body)  # type: ignore[arg-type]
     m1, m2 = 1000.0, 8000.0
     cx = (m1 * 0.5 + m2 * 1.5) / (m1 + m2)
     iyy = (m1 + m2) * 2 / 12 + m1 * (0.5 - cx) ** 2 + m2 * (1.5 - cx) ** 2
@@ -224,7 +225,7 @@ def test_two_material_volume_mesh_matches_composite_box() -> None:
 
 
 def test_volume_mesh_density_ratio_of_a_million() -> None:
-    v, f = box(2.0, 1.0, 1.0)
+    _v, _f = box(2.0, 1.0, 1.0)
     pts = np.array([[x, y, z] for z in (0, 1) for y in (0, 1) for x in (0, 1, 2)], dtype=float)
     split = [[0, 1, 2, 6], [0, 2, 3, 6], [0, 3, 7, 6], [0, 7, 4, 6], [0, 4, 5, 6], [0, 5, 1, 6]]
     left = [0, 1, 4, 3, 6, 7, 10, 9]
@@ -242,9 +243,9 @@ def test_diatomic_molecule_is_a_linear_rotator() -> None:
     from inertia.classification import RotorClass, classify
     from inertia.principal import principal_frame
 
-    m1, m2, l = 1.0, 16.0, 1.2e-10
-    props = mass_properties(PointBody(np.array([m1, m2]), np.array([[0, 0, 0], [l, 0, 0]], float)))
-    expected = m1 * m2 * l * l / (m1 + m2)  # seed notes eq. (31)
+    m1, m2, bond = 1.0, 16.0, 1.2e-10
+    props = mass_properties(PointBody(np.array([m1, m2]), np.array([[0, 0, 0], [bond, 0, 0]], float)))
+    expected = m1 * m2 * bond * bond / (m1 + m2)  # seed notes eq. (31)
     mom = moments(props)
     assert mom[0] == pytest.approx(0.0, abs=1e-15 * expected)
     np.testing.assert_allclose(mom[1:], [expected, expected], rtol=1e-14)
@@ -264,7 +265,7 @@ def test_tetratomic_pyramid_molecule() -> None:
     m1, m2, a, h = 1.0, 3.0, 1.5, 0.9
     r = a / np.sqrt(3)  # circumradius of the equilateral base
     base = [[r * np.cos(t), r * np.sin(t), 0.0] for t in (0, 2 * np.pi / 3, 4 * np.pi / 3)]
-    x = np.array(base + [[0.0, 0.0, h]])
+    x = np.array([*base, [0.0, 0.0, h]])
     props = mass_properties(PointBody(np.array([m1, m1, m1, m2]), x))
     mu = 3 * m1 + m2
     i12 = 3 * m1 * m2 * h * h / mu + m1 * a * a / 2  # seed notes, example 2c

@@ -105,7 +105,7 @@ def test_analyze_takes_a_trimesh_object() -> None:
 
 def test_analyze_refuses_other_objects_with_a_sentence() -> None:
     with pytest.raises(InvalidParameterError, match=r"trimesh\.Trimesh or a \(vertices, faces\)"):
-        analyze(42)  # type: ignore[arg-type]
+        analyze(42)
 
 
 def test_public_names_are_never_shadowed_by_submodules() -> None:

@@ -10,6 +10,7 @@ results that do not depend on the block size beyond the error estimate.
 from __future__ import annotations
 
 import struct
+from typing import Any
 
 import numpy as np
 import pytest
@@ -80,7 +81,7 @@ def test_ascii_stl_comes_back_welded_like_binary() -> None:
 
 @pytest.mark.parametrize("degraded_hash", [lambda h: h & np.uint64(0), lambda h: h & np.uint64(3)],
                          ids=["every-row-collides", "two-bit-hash"])
-def test_row_ids_exact_when_hashes_collide(monkeypatch: pytest.MonkeyPatch, degraded_hash) -> None:
+def test_row_ids_exact_when_hashes_collide(monkeypatch: pytest.MonkeyPatch, degraded_hash: Any) -> None:
     rng = np.random.default_rng(7)
     rows = rng.integers(0, 5, size=(3000, 3)).astype(np.uint32)  # ~125 distinct rows, many repeats
     cols = [rows[:, 0], rows[:, 1], rows[:, 2]]

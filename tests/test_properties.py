@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 from hypothesis import given, settings
 from hypothesis import strategies as st
@@ -13,17 +15,17 @@ from tests.support.strategies import boxes, convex_bodies, offsets, rotations
 FAST = settings(max_examples=40, deadline=None)
 
 
-def props_of(mesh: tuple[np.ndarray, np.ndarray], **kw):
+def props_of(mesh: tuple[np.ndarray, np.ndarray], **kw: Any) -> Any:
     return mass_properties(MeshBody(*mesh), **kw)
 
 
-def scale_of(props) -> float:
+def scale_of(props: Any) -> float:
     return float(np.max(np.abs(props.principal_moments)))
 
 
 @FAST
 @given(convex_bodies(), rotations)
-def test_rotating_the_body_rotates_the_tensor(mesh, rotation) -> None:
+def test_rotating_the_body_rotates_the_tensor(mesh: Any, rotation: Any) -> None:
     v, f = mesh
     base = props_of(mesh)
     turned = mass_properties(MeshBody(v @ rotation.T, f))
@@ -35,7 +37,7 @@ def test_rotating_the_body_rotates_the_tensor(mesh, rotation) -> None:
 
 @FAST
 @given(convex_bodies(), offsets)
-def test_translation_leaves_the_centre_of_mass_tensor_alone(mesh, offset) -> None:
+def test_translation_leaves_the_centre_of_mass_tensor_alone(mesh: Any, offset: Any) -> None:
     v, f = mesh
     base = props_of(mesh)
     moved = mass_properties(MeshBody(v + offset, f))
@@ -46,7 +48,7 @@ def test_translation_leaves_the_centre_of_mass_tensor_alone(mesh, offset) -> Non
 
 @FAST
 @given(convex_bodies(), st.floats(min_value=1e-3, max_value=1e3))
-def test_scaling_by_s_scales_inertia_by_s_to_the_fifth(mesh, s) -> None:
+def test_scaling_by_s_scales_inertia_by_s_to_the_fifth(mesh: Any, s: Any) -> None:
     v, f = mesh
     base = props_of(mesh)
     scaled = mass_properties(MeshBody(v * s, f))
@@ -57,7 +59,7 @@ def test_scaling_by_s_scales_inertia_by_s_to_the_fifth(mesh, s) -> None:
 
 @FAST
 @given(boxes(), boxes())
-def test_inertia_of_disjoint_parts_adds_up(first, second) -> None:
+def test_inertia_of_disjoint_parts_adds_up(first: Any, second: Any) -> None:
     (v1, f1), (v2, f2) = first, second
     v2 = v2 + np.array([v1[:, 0].max() + 1.0, 0.0, 0.0])  # beside the first, not touching
     a, b = props_of((v1, f1)), props_of((v2, f2))
@@ -72,7 +74,7 @@ def test_inertia_of_disjoint_parts_adds_up(first, second) -> None:
 
 @FAST
 @given(convex_bodies())
-def test_principal_moments_obey_triangle_inequality_and_mass_is_positive(mesh) -> None:
+def test_principal_moments_obey_triangle_inequality_and_mass_is_positive(mesh: Any) -> None:
     props = props_of(mesh)
     i1, i2, i3 = np.sort(props.principal_moments)
     assert props.mass > 0
@@ -82,7 +84,7 @@ def test_principal_moments_obey_triangle_inequality_and_mass_is_positive(mesh) -
 
 @FAST
 @given(convex_bodies(), st.permutations(list(range(20))))
-def test_vertex_reindexing_changes_nothing(mesh, perm) -> None:
+def test_vertex_reindexing_changes_nothing(mesh: Any, perm: tuple[int, ...]) -> None:
     v, f = mesh
     n = len(v)
     order = np.array([p for p in perm if p < n] + list(range(20, n)))
@@ -95,7 +97,7 @@ def test_vertex_reindexing_changes_nothing(mesh, perm) -> None:
 
 @FAST
 @given(st.integers(min_value=2, max_value=40), st.integers(min_value=0, max_value=2**32 - 1), rotations)
-def test_point_sets_rotate_covariantly(n, seed, rotation) -> None:
+def test_point_sets_rotate_covariantly(n: int, seed: int, rotation: Any) -> None:
     rng = np.random.default_rng(seed)
     masses = rng.uniform(0.1, 10.0, n)
     x = rng.normal(size=(n, 3))

@@ -21,6 +21,7 @@ import sys
 import warnings
 from collections.abc import Iterator
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
@@ -50,7 +51,7 @@ def binary_stl(vertices: np.ndarray, faces: np.ndarray) -> bytes:
 def flat_shells(offset: float, count: int = 189) -> tuple[np.ndarray, np.ndarray]:
     """``count`` closed tetrahedral shells whose four corners lie in one plane: zero volume."""
     rng = np.random.default_rng(0)
-    vertices, faces = [], []
+    vertices, faces = [], []  # type: ignore[var-annotated]
     for _ in range(count):
         centre = rng.normal(size=3) * 10 + offset
         u, v = rng.normal(size=3), rng.normal(size=3)
@@ -67,7 +68,7 @@ def obj_text(vertices: np.ndarray, faces: np.ndarray) -> bytes:
 
 
 @pytest.mark.parametrize("exponent", range(9))
-def test_float32_part_at_growing_offsets_is_exact_or_refused(exponent) -> None:
+def test_float32_part_at_growing_offsets_is_exact_or_refused(exponent: float) -> None:
     offset = 10.0**exponent * np.array([1.0, 0.7, 0.4])
     vertices = CORNERS @ ROT.T + offset
     data = binary_stl(vertices, FACES)
@@ -129,7 +130,7 @@ def _collinear(seed: int) -> list[dict[str, object]]:
 
 
 @pytest.mark.parametrize("points", [COLLINEAR] + [_collinear(s) for s in range(20)])
-def test_collinear_points_with_omega_are_a_rotator(points) -> None:
+def test_collinear_points_with_omega_are_a_rotator(points: Any) -> None:
     result = analyze_points(points, AnalysisOptions(omega=(0.1, 1.0, 0.3)))
     assert result.classification.kind == "linear_rotator"
     assert result.motion is not None and result.motion.regime.value == "rotator"

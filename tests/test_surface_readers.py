@@ -6,6 +6,7 @@ import io
 import json
 import zipfile
 from pathlib import Path
+from typing import Any, cast
 
 import numpy as np
 import pytest
@@ -220,10 +221,10 @@ def test_3mf_beam_lattice_required_is_unsupported() -> None:
 
 # --- glTF ----------------------------------------------------------------------------------------------
 
-def gltf_box_doc() -> dict:
+def gltf_box_doc() -> dict[str, Any]:
     data = trimesh.Scene(trimesh.Trimesh(*box(1.0, 2.0, 3.0), process=False)).export(file_type="gltf",
                                                                                       embed_buffers=True)
-    return json.loads(data["model.gltf"])
+    return cast("dict[str, Any]", json.loads(data["model.gltf"]))
 
 
 def test_gltf_mirrored_node_is_read_outward() -> None:
@@ -245,9 +246,9 @@ def test_gltf_mirrored_node_is_read_outward() -> None:
     (lambda d: d["meshes"][0].update(weights=[0.5]), "morph"),
     (lambda d: [n.update(skin=0) for n in d["nodes"] if "mesh" in n], "skinned"),
 ])
-def test_gltf_geometry_trimesh_would_misread_is_refused(change, words: str) -> None:
+def test_gltf_geometry_trimesh_would_misread_is_refused(change: str, words: str) -> None:
     doc = gltf_box_doc()
-    change(doc)
+    change(doc)  # type: ignore[operator]
     with pytest.raises(UnsupportedFormatError) as err:
         analyze(json.dumps(doc).encode(), filename="x.gltf")
     assert words in err.value.message

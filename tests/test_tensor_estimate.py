@@ -27,7 +27,7 @@ def _reference(tensor: np.ndarray) -> list[mp.mpf]:
 
 
 @pytest.mark.parametrize("exponent", np.linspace(0.0, -12.0, 13))
-def test_rotated_tensor_estimate_is_never_below_the_error(exponent) -> None:
+def test_rotated_tensor_estimate_is_never_below_the_error(exponent: float) -> None:
     rng = np.random.default_rng(int(-exponent * 10) + 1)
     worst = 0.0
     for _ in range(20):

@@ -9,19 +9,18 @@
 
 Every row is what ``pipeline.analyze`` gives for that file with the run's
 options, so numbers equal those of ``inertia analyze``.  Dask, tqdm and pyarrow
-are optional extras, imported only when a batch runs.
+are optional extras, imported only when a batch runs.  The command line
+(``inertia batch``) lives in ``cli``: this package takes plain arguments.
 """
 
 from __future__ import annotations
 
-import argparse
-import sys
 from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
     from .runner import BatchSummary
 
-__all__ = ["BatchSummary", "run_batch", "run_batch_cli"]
+__all__ = ["BatchSummary", "run_batch"]
 
 
 def run_batch(*args: Any, **kwargs: Any) -> BatchSummary:
@@ -29,32 +28,6 @@ def run_batch(*args: Any, **kwargs: Any) -> BatchSummary:
     from .runner import run_batch as _run_batch
 
     return _run_batch(*args, **kwargs)
-
-
-def run_batch_cli(args: argparse.Namespace) -> int:
-    """``inertia batch``: run, print a one-line summary to stderr, exit 0.
-
-    Files that fail are rows of the output, not a failure of the run; a bad
-    option or a missing extra raises ``InvalidParameterError`` (exit 2).
-    """
-    if args.scheduler is None:  # a local cluster: its workers' imports start now, beside this process's
-        from .workers import start_forkserver
-
-        start_forkserver()
-    from ..cli import options_from_args
-    from .runner import run_batch as _run_batch
-
-    summary = _run_batch(
-        args.paths,
-        args.out,
-        options_from_args(args),
-        resume=args.resume,
-        workers=args.workers,
-        scheduler=args.scheduler,
-        progress=not args.no_progress,
-    )
-    print(summary.as_text(), file=sys.stderr)
-    return 0
 
 
 def __getattr__(name: str) -> Any:

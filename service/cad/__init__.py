@@ -22,10 +22,11 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ..body import BrepBody, MeshBody, Part
-from ..conventions import DEFAULT_DENSITY, LENGTH_UNITS
-from ..errors import InvalidParameterError, UnsupportedFormatError
+from ..conventions import DEFAULT_DENSITY
+from ..errors import InvalidParameterError
 from ..surface import SURFACE_AREA_KEY
 from ..tolerances import EPS
+from .read import CAD_FORMATS, DEFAULT_DEFLECTION, GEOMETRIES, read_cad_parts
 
 if TYPE_CHECKING:
     from ..load import Loaded
@@ -33,47 +34,6 @@ if TYPE_CHECKING:
 
 __all__ = ["CAD_FORMATS", "GEOMETRIES", "DEFAULT_DEFLECTION", "read_cad_parts", "brep_mass_properties",
            "combined_properties", "tessellated", "tessellation_error", "source_counts"]
-
-CAD_FORMATS = ("step", "iges")
-GEOMETRIES = ("brep", "mesh")
-DEFAULT_DEFLECTION = 1e-3  # of the bounding-box diagonal: about 1e-3 relative in mass (docs/cad.md)
-
-
-def _binding() -> None:
-    from . import occ
-
-    if not occ.available():
-        raise UnsupportedFormatError(
-            f"reading STEP and IGES files needs the 'cad' extra (OpenCASCADE): {occ.CAD_EXTRA_HINT}",
-            extra="cad")
-
-
-def read_cad_parts(data: bytes, fmt: str, units: str | None) -> tuple[list[Part], str, str, tuple[str, ...]]:
-    """The solids of a CAD file as ``BrepBody`` parts, the unit applied, where it came from, warnings."""
-    try:
-        _binding()
-    except ImportError as exc:  # pragma: no cover - occ itself imports nothing heavy
-        raise UnsupportedFormatError(f"reading CAD files needs the 'cad' extra: {exc}", extra="cad") from exc
-    from . import occ
-
-    solids, declared = occ.read_solids(data, fmt)
-    warnings: list[str] = []
-    file_scale = LENGTH_UNITS.get(declared) if declared else None
-    if units is not None:
-        if file_scale is None:
-            raise InvalidParameterError(
-                f"the file's length unit ({declared or 'several units'}) cannot be overridden; omit units", parameter="units")
-        scale, unit, units_from = occ.MODEL_UNIT * LENGTH_UNITS[units] / file_scale, units, "request"
-    elif file_scale is None:
-        scale, unit, units_from = occ.MODEL_UNIT, "m", "file"
-        warnings.append(f"the file's length unit ({declared or 'several units'}) was converted to metres; "
-                        "reference points are read in metres")
-    else:
-        assert declared is not None
-        scale, unit, units_from = occ.MODEL_UNIT, declared, "file"
-    parts = [Part(s.name, BrepBody(s, scale, s.name), {SURFACE_AREA_KEY: occ.surface_area(s) * scale**2})
-             for s in solids]
-    return parts, unit, units_from, tuple(warnings)
 
 
 def brep_mass_properties(body: BrepBody, *, density: float | None = None, mass: float | None = None,

@@ -127,7 +127,7 @@ def _load_bytes(data: bytes, filename: str | None, format: str | None, units: st
     # includes, external references, inflation bounds: before any reader
     check_upload(data, fmt, companions=tuple(companions or ()))
     if fmt in CAD_FORMATS:
-        from ..cad import read_cad_parts
+        from ..cad.read import read_cad_parts
 
         cad_parts, unit, units_from, warnings = read_cad_parts(data, fmt, units)
         return Loaded(tuple(cad_parts), filename, fmt, "cad", unit, units_from, warnings)

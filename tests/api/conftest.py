@@ -39,7 +39,7 @@ class LiveServer:
         self.url = f"http://127.0.0.1:{self.port}"
         full_env = {k: v for k, v in os.environ.items() if not k.startswith("INERTIA_")}
         full_env.update(env)
-        self.log = open(ROOT / ".pytest_cache" / f"serve-{self.port}.log", "w+b")
+        self.log = open(ROOT / ".pytest_cache" / f"serve-{self.port}.log", "w+b")  # noqa: SIM115  (the server writes to it until stop() closes it)
         self.process = subprocess.Popen(
             [sys.executable, "-m", "inertia", "serve", "--host", "127.0.0.1", "--port", str(self.port)],
             cwd=ROOT, env=full_env, stdout=self.log, stderr=subprocess.STDOUT)
@@ -98,5 +98,5 @@ def server(live_server: Callable[..., LiveServer]) -> LiveServer:
 @pytest.fixture(scope="session")
 def client() -> Iterator[TestClient]:
     """In-process client of an app with default settings (two compute processes)."""
-    with TestClient(create_app(Settings(compute_processes=2))) as c:
+    with TestClient(create_app(Settings(compute_processes=2))) as c:  # type: ignore[call-arg]  # fields come from INERTIA_* variables
         yield c

@@ -5,6 +5,7 @@ from __future__ import annotations
 import asyncio
 import multiprocessing
 import struct
+from typing import Any
 
 import pytest
 
@@ -29,7 +30,7 @@ def pool_processes(pool: ComputePool) -> list[multiprocessing.process.BaseProces
 def test_timed_out_job_is_killed_and_the_pool_recovers() -> None:
     pool = ComputePool(size=1, timeout_s=0.2)
 
-    async def scenario() -> dict:
+    async def scenario() -> dict[str, Any]:
         await pool.warm_up()
         (warm,) = pool_processes(pool)
         with pytest.raises(ComputeTimeoutError):

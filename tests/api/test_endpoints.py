@@ -6,6 +6,7 @@ import io
 import json
 import math
 import zipfile
+from typing import Any
 
 import numpy as np
 import pytest
@@ -26,7 +27,7 @@ def box_tensor(m: float, a: float, b: float, c: float) -> np.ndarray:
     return np.diag([m * (b * b + c * c) / 12, m * (a * a + c * c) / 12, m * (a * a + b * b) / 12])
 
 
-def upload(client: TestClient, data: bytes, name: str = "box.stl", **params: object):
+def upload(client: TestClient, data: bytes, name: str = "box.stl", **params: object) -> Any:
     return client.post("/v1/analyze/mesh", files={"file": (name, data)}, params=params)
 
 
@@ -153,7 +154,7 @@ def test_formats_lists_surfaces_volumes_and_scenes(client: TestClient) -> None:
     assert "msh" in doc["volume"] and "glb" in doc["scene"] and "stl" in doc["surface"]
 
 
-def _lines(response) -> list[dict]:
+def _lines(response: Any) -> list[dict[str, Any]]:
     assert response.status_code == 200, response.text
     assert response.headers["content-type"].startswith("application/x-ndjson")
     return [json.loads(line) for line in response.text.splitlines()]

@@ -107,7 +107,7 @@ def assert_envelope(response: Any, code: str, status: int) -> dict[str, Any]:
 
 @pytest.mark.parametrize(("cls", "code", "status", "request_"), CASES,
                          ids=[f"{c[1]}-{i}" for i, c in enumerate(CASES)])
-def test_bad_request_gets_its_code_and_status(client: TestClient, cls, code, status, request_) -> None:
+def test_bad_request_gets_its_code_and_status(client: TestClient, cls, code: str, status: int, request_: Any) -> None:  # type: ignore[no-untyped-def]
     assert cls.code == code and STATUS[next(k for k in type.mro(cls) if k in STATUS)] == status
     assert_envelope(request_(client), code, status)
 
@@ -129,20 +129,20 @@ def busy(c: Any) -> Any:
 
 
 LIMITED = [
-    (E.PayloadTooLargeError, "payload_too_large", 413, Settings(max_upload_bytes=1000, compute_processes=1),
+    (E.PayloadTooLargeError, "payload_too_large", 413, Settings(max_upload_bytes=1000, compute_processes=1),  # type: ignore[call-arg]  # fields come from INERTIA_* variables
      mesh(box_stl(1, 2, 3) * 10)),
-    (E.UnauthorizedError, "unauthorized", 401, Settings(api_key="s3cret", compute_processes=1), mesh(BOX)),
-    (E.ComputeTimeoutError, "timeout", 503, Settings(timeout_s=0.05, compute_processes=1),
+    (E.UnauthorizedError, "unauthorized", 401, Settings(api_key="s3cret", compute_processes=1), mesh(BOX)),  # type: ignore[call-arg]  # fields come from INERTIA_* variables
+    (E.ComputeTimeoutError, "timeout", 503, Settings(timeout_s=0.05, compute_processes=1),  # type: ignore[call-arg]  # fields come from INERTIA_* variables
      mesh(torus_stl(500, 500))),
-    (E.ServerBusyError, "server_busy", 503, Settings(max_waiting=0, compute_processes=1), busy),
+    (E.ServerBusyError, "server_busy", 503, Settings(max_waiting=0, compute_processes=1), busy),  # type: ignore[call-arg]  # fields come from INERTIA_* variables
 ]
 
 
 @pytest.mark.parametrize(("cls", "code", "status", "settings", "request_"), LIMITED,
                          ids=[c[1] for c in LIMITED])
-def test_limits_get_their_code_and_status(cls, code, status, settings, request_) -> None:
+def test_limits_get_their_code_and_status(cls, code: str, status: int, settings: dict[str, str], request_: Any) -> None:  # type: ignore[no-untyped-def]
     assert cls.code == code
-    with TestClient(create_app(settings)) as c:
+    with TestClient(create_app(settings)) as c:  # type: ignore[arg-type]
         assert_envelope(request_(c), code, status)
 
 
@@ -159,7 +159,7 @@ def test_unknown_path_and_method_use_the_envelope(client: TestClient) -> None:
 
 
 def test_unexpected_exception_is_500_envelope_with_logged_traceback(caplog: LogCaptureFixture) -> None:
-    app = create_app(Settings(compute_processes=1))
+    app = create_app(Settings(compute_processes=1))  # type: ignore[call-arg]  # fields come from INERTIA_* variables
 
     @app.get("/boom")
     async def boom() -> None:

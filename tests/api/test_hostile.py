@@ -16,7 +16,7 @@ import time
 import warnings
 from collections.abc import Iterator
 from pathlib import Path
-from typing import Any
+from typing import Any, cast
 
 import httpx
 import numpy as np
@@ -140,7 +140,7 @@ def test_zip_bomb_member_is_an_error_line_and_the_batch_goes_on(client: Any) -> 
         z.writestr("a.stl", BOX)
         z.writestr("bomb.stl", b"\0" * (200 * MIB))
         z.writestr("c.stl", BOX)
-    with TestClient(create_app(Settings(compute_processes=1, max_upload_bytes=64 * MIB))) as c:
+    with TestClient(create_app(Settings(compute_processes=1, max_upload_bytes=64 * MIB))) as c:  # type: ignore[call-arg]  # fields come from INERTIA_* variables
         lines = [json.loads(x) for x in c.post("/v1/batch", files={"files": ("z.zip", out.getvalue())}).text.splitlines()]
     assert [line.get("error", {}).get("code") for line in lines] == [None, "payload_too_large", None]
 
@@ -149,7 +149,7 @@ def test_zip_bomb_member_is_an_error_line_and_the_batch_goes_on(client: Any) -> 
 
 def test_job_past_its_memory_allowance_is_413_and_the_worker_serves_on() -> None:
     # a cap below what a 500 x 500 torus needs (>100 MiB of arrays): the job fails in its process only
-    settings = Settings(compute_processes=1, max_job_memory_bytes=24 * MIB)
+    settings = Settings(compute_processes=1, max_job_memory_bytes=24 * MIB)  # type: ignore[call-arg]  # fields come from INERTIA_* variables
     with TestClient(create_app(settings)) as c:
         error = error_of(post_mesh(c, "torus.stl", torus_stl(500, 500)), 413, "payload_too_large")
         assert "memory" in error["message"]
@@ -158,10 +158,10 @@ def test_job_past_its_memory_allowance_is_413_and_the_worker_serves_on() -> None
 
 
 def test_queue_beyond_its_bound_is_503_with_retry_after() -> None:
-    settings = Settings(compute_processes=1, max_waiting=0, timeout_s=60)
+    settings = Settings(compute_processes=1, max_waiting=0, timeout_s=60)  # type: ignore[call-arg]  # fields come from INERTIA_* variables
     slow = torus_stl(400, 400)
     with TestClient(create_app(settings)) as c:
-        pool = c.app.state.pool
+        pool = c.app.state.pool  # type: ignore[attr-defined]
         results: list[Any] = []
         runner = threading.Thread(target=lambda: results.append(post_mesh(c, "torus.stl", slow)))
         runner.start()
@@ -214,7 +214,7 @@ def buggy_server() -> Iterator[str]:
     """A uvicorn server in this process with one route that fails like a bug."""
     import uvicorn
 
-    app = create_app(Settings(compute_processes=1))
+    app = create_app(Settings(compute_processes=1))  # type: ignore[call-arg]  # fields come from INERTIA_* variables
 
     @app.get("/v1/boom")
     async def boom() -> None:
@@ -296,7 +296,7 @@ def test_concurrent_large_uploads_stay_within_a_memory_bound(live_server: Any) -
 
     def one(_: int) -> int:
         with httpx.Client(base_url=server.url, timeout=120) as c:
-            return post_mesh(c, "blob.off", upload).status_code
+            return cast("int", post_mesh(c, "blob.off", upload).status_code)
 
     from concurrent.futures import ThreadPoolExecutor
 

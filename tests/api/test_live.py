@@ -32,7 +32,7 @@ def without_timing(doc: Any) -> Any:
     return doc
 
 
-def test_every_endpoint_answers_over_http(server) -> None:
+def test_every_endpoint_answers_over_http(server: Any) -> None:
     url = server.url
     assert httpx.get(f"{url}/healthz").json() == {"status": "ok"}
     assert "stl" in httpx.get(f"{url}/v1/formats").json()["surface"]
@@ -50,7 +50,7 @@ def test_every_endpoint_answers_over_http(server) -> None:
     assert httpx.get(f"{url}/openapi.json").json()["paths"]["/v1/batch"]
 
 
-def test_access_log_has_method_path_status_elapsed(server) -> None:
+def test_access_log_has_method_path_status_elapsed(server: Any) -> None:
     httpx.get(f"{server.url}/v1/formats?probe=1")
     time.sleep(0.2)
     records = [json.loads(line[line.index("{"):]) for line in server.output().splitlines()
@@ -68,7 +68,7 @@ def _multipart_chunks(data: bytes, chunk: int = 64 * 1024) -> Iterator[bytes]:
     yield b"\r\n--BOUNDARY--\r\n"
 
 
-def test_upload_limit_refuses_large_bodies_with_413(live_server) -> None:
+def test_upload_limit_refuses_large_bodies_with_413(live_server: Any) -> None:
     url = live_server(INERTIA_MAX_UPLOAD_BYTES="200000").url
     big = torus_stl(60, 60) * 3  # ~1 MB
     declared = post_mesh(url, big)
@@ -82,7 +82,7 @@ def test_upload_limit_refuses_large_bodies_with_413(live_server) -> None:
     assert small.status_code == 200 and small.json()["source"]["filename"] == "big.stl"
 
 
-def test_api_key_guards_v1_but_not_healthz(live_server) -> None:
+def test_api_key_guards_v1_but_not_healthz(live_server: Any) -> None:
     url = live_server(INERTIA_API_KEY="k3y").url
     assert httpx.get(f"{url}/healthz").status_code == 200
     for headers in ({}, {"X-API-Key": "wrong"}):
@@ -94,7 +94,7 @@ def test_api_key_guards_v1_but_not_healthz(live_server) -> None:
     assert "X-API-Key" in json.dumps(spec["components"]["securitySchemes"])
 
 
-def test_timeout_stops_a_long_computation_with_503_and_the_server_recovers(live_server) -> None:
+def test_timeout_stops_a_long_computation_with_503_and_the_server_recovers(live_server: Any) -> None:
     url = live_server(INERTIA_TIMEOUT_S="0.3").url
     start = time.monotonic()
     r = post_mesh(url, torus_stl(600, 600), name="torus.stl")
@@ -104,7 +104,7 @@ def test_timeout_stops_a_long_computation_with_503_and_the_server_recovers(live_
     assert post_mesh(url, BOX).status_code == 200
 
 
-def test_32_parallel_clients_get_identical_answers(server) -> None:
+def test_32_parallel_clients_get_identical_answers(server: Any) -> None:
     def one(_: int) -> Any:
         r = post_mesh(server.url, BOX, omega="0.1,1,0.1", duration=1, samples=20)
         assert r.status_code == 200, r.text
@@ -117,7 +117,7 @@ def test_32_parallel_clients_get_identical_answers(server) -> None:
 
 
 @pytest.mark.slow
-def test_healthz_answers_within_a_second_during_a_long_analysis(server) -> None:
+def test_healthz_answers_within_a_second_during_a_long_analysis(server: Any) -> None:
     big = torus_stl(1000, 1000)  # 2,000,000 triangles
     result: dict[str, Any] = {}
 
@@ -126,7 +126,7 @@ def test_healthz_answers_within_a_second_during_a_long_analysis(server) -> None:
 
     worker = threading.Thread(target=analyse)
     worker.start()
-    latencies = []
+    latencies = []  # type: ignore[var-annotated]
     time.sleep(0.5)  # let the upload reach the server
     while worker.is_alive() and len(latencies) < 20:
         start = time.monotonic()

@@ -21,7 +21,7 @@ from inertia.api import Settings, create_app
 
 with warnings.catch_warnings():
     warnings.filterwarnings("ignore", message="Using `httpx` with `starlette.testclient`")
-    app = create_app(Settings(compute_processes=2, timeout_s=20))
+    app = create_app(Settings(compute_processes=2, timeout_s=20))  # type: ignore[call-arg]  # fields come from INERTIA_* variables
 
 CHECKS = [
     checks.not_a_server_error,
@@ -41,5 +41,5 @@ EXAMPLES = int(os.environ.get("INERTIA_SCHEMATHESIS_EXAMPLES", "25"))
 
 @schema.parametrize()
 @settings(max_examples=EXAMPLES, deadline=None, suppress_health_check=list(HealthCheck))
-def test_api_conforms_to_its_schema(case: schemathesis.Case) -> None:
+def test_api_conforms_to_its_schema(case: schemathesis.Case) -> None:  # type: ignore[type-arg]
     case.call_and_validate(checks=CHECKS)

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import json
 from pathlib import Path
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
 
@@ -21,7 +21,7 @@ def box(size: tuple[float, float, float], angle: float, offset: tuple[float, flo
     axis = np.ones(3) / np.sqrt(3.0)
     k = np.array([[0, -axis[2], axis[1]], [axis[2], 0, -axis[0]], [-axis[1], axis[0], 0]])
     rot = np.eye(3) + np.sin(angle) * k + (1 - np.cos(angle)) * k @ k  # Rodrigues
-    return (v @ rot.T + np.asarray(offset))[faces]
+    return cast("np.ndarray", (v @ rot.T + np.asarray(offset))[faces])
 
 
 def stl_bytes(tri: np.ndarray) -> bytes:
@@ -42,7 +42,7 @@ def make_library(root: Path) -> dict[str, str | None]:
     for i in range(N_FILES - len(BROKEN)):
         folder = folders[i % len(folders)]
         size = tuple(float(x) for x in rng.uniform(0.01, 2.0, 3))
-        tri = box(size, float(rng.uniform(0, np.pi)), tuple(float(x) for x in rng.uniform(-50, 50, 3)))
+        tri = box(size, float(rng.uniform(0, np.pi)), tuple(float(x) for x in rng.uniform(-50, 50, 3)))  # type: ignore[arg-type]
         name = f"{folder}part_{i:02d}." + ("obj" if folder == "objs/" else "stl")
         path = root / name
         path.parent.mkdir(parents=True, exist_ok=True)
@@ -74,7 +74,7 @@ def without_timing(row: dict[str, Any]) -> dict[str, Any]:
     """A result row minus its run time, the one field that differs between runs."""
     out = json.loads(json.dumps(row))
     out.get("diagnostics", {}).pop("elapsed_s", None)
-    return out
+    return cast("dict[str, Any]", out)
 
 
 def by_name(rows: list[dict[str, Any]]) -> dict[str, dict[str, Any]]:

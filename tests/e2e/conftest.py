@@ -51,7 +51,7 @@ class Server:
         env["INERTIA_COMPUTE_PROCESSES"] = "1"
         env.update(settings)
         (ROOT / ".pytest_cache").mkdir(exist_ok=True)
-        self.log = open(ROOT / ".pytest_cache" / f"e2e-serve-{self.port}.log", "w+b")
+        self.log = open(ROOT / ".pytest_cache" / f"e2e-serve-{self.port}.log", "w+b")  # noqa: SIM115  (the server writes to it until stop() closes it)
         self.process = subprocess.Popen(
             [sys.executable, "-m", "inertia", "serve", "--host", "127.0.0.1", "--port", str(self.port)],
             cwd=ROOT, env=env, stdout=self.log, stderr=subprocess.STDOUT)

@@ -57,7 +57,7 @@ def _trimesh_seeds() -> list[tuple[str, bytes]]:
         if isinstance(data, dict):  # gltf with embed_buffers gives {name: bytes}
             data = data["model.gltf"]
         out.append((f"tet.{ext}", data if isinstance(data, bytes) else data.encode()))
-    out.append(("tet_ascii.stl", mesh.export(file_type="stl_ascii").encode()))
+    out.append(("tet_ascii.stl", mesh.export(file_type="stl_ascii").encode()))  # type: ignore[union-attr]
     return out
 
 

@@ -182,7 +182,7 @@ EXTENSIONS = ["stl", "obj", "ply", "off", "glb", "gltf", "3mf", "vtu", "vtk", "m
 
 @pytest.fixture(scope="module")
 def app_client() -> Iterator[TestClient]:
-    with TestClient(create_app(Settings(compute_processes=1, timeout_s=TIMEOUT_S,
+    with TestClient(create_app(Settings(compute_processes=1, timeout_s=TIMEOUT_S,  # type: ignore[call-arg]  # fields come from INERTIA_* variables
                                         max_upload_bytes=MAX_UPLOAD))) as c:
         yield c
 

@@ -5,6 +5,7 @@ from __future__ import annotations
 import itertools
 from fractions import Fraction
 from math import factorial
+from typing import Any, cast
 
 import numpy as np
 import pytest
@@ -34,10 +35,10 @@ def curved(name: str, seed: int, amplitude: float = 0.08) -> np.ndarray:
         if name == "pyramid13":
             base[9:13] = 0.5 * (base[[0, 1, 2, 3]] + base[4])
     a = np.array([[1.3, 0.2, 0.1], [0.1, 0.9, -0.2], [0.05, 0.1, 1.1]])
-    return base @ a.T + amplitude * rng.uniform(-1, 1, base.shape) + np.array([0.3, -0.2, 0.5])
+    return cast("np.ndarray", base @ a.T + amplitude * rng.uniform(-1, 1, base.shape) + np.array([0.3, -0.2, 0.5]))
 
 
-def compare(props, m0: float, m1: np.ndarray, m2: np.ndarray, rel: float) -> None:
+def compare(props: Any, m0: float, m1: np.ndarray, m2: np.ndarray, rel: float) -> None:
     mass, com, tensor = volref.inertia_about_centre(m0, m1, m2, density=1000.0)
     scale = np.abs(tensor).max()
     size = np.sqrt(scale / mass)  # radius of gyration: the length scale of the centre's error
@@ -81,7 +82,7 @@ def test_rules_integrate_every_monomial_of_their_stated_degree_exactly(name: str
     rule = cell_rule(name)
     worst = 0.0
     for e in itertools.product(range(11), repeat=3):
-        if _within_degree(name, e):
+        if _within_degree(name, e):  # type: ignore[arg-type]
             value = float((rule.weights * np.prod(rule.points ** np.array(e), axis=1)).sum())
             exact = _exact_monomial(_kind(name), *e)
             worst = max(worst, abs(value - float(exact)) / float(exact))
@@ -181,7 +182,7 @@ def test_collapsed_hexahedron_is_not_twice_the_volume() -> None:
 def test_curved_cell_matches_vtk_map_integrated_independently(name: str, seed: int) -> None:
     nodes = curved(name, seed)
     props = mass_properties(body_of(name, nodes))
-    compare(props, *volref.reference_integrals(name, nodes), rel=1e-12)
+    compare(props, *volref.reference_integrals(name, nodes), rel=1e-12)  # type: ignore[misc]
 
 
 def test_warped_hexahedron_is_the_trilinear_cell_not_a_tetrahedral_split() -> None:

@@ -13,6 +13,7 @@ import io
 import sys
 import zipfile
 from pathlib import Path
+from typing import Any
 
 import meshio
 import numpy as np
@@ -25,12 +26,12 @@ from inertia.mass import assembly_properties, mass_properties
 from inertia.pipeline import AnalysisOptions, analyze
 
 vtk = pytest.importorskip("vtk")
-from tests.load import volref
+volref = pytest.importorskip("tests.load.volref")  # needs vtk
 
 HEX = [(0, 0, 0), (1, 0, 0), (1, 1, 0), (0, 1, 0), (0, 0, 1), (1, 0, 1), (1, 1, 1), (0, 1, 1)]
 
 
-def grid(cells: list[tuple[int, list[int]]], points: np.ndarray, density: list[float] | None = None):
+def grid(cells: list[tuple[int, list[int]]], points: np.ndarray, density: list[float] | None = None) -> Any:
     ug = vtk.vtkUnstructuredGrid()
     pts = vtk.vtkPoints()
     pts.SetDataTypeToDouble()  # VTK stores float32 unless told
@@ -51,7 +52,7 @@ def grid(cells: list[tuple[int, list[int]]], points: np.ndarray, density: list[f
     return ug
 
 
-def write_vtu(ug, path: Path, mode: str = "appended", compressor: str | None = "zlib", encode: bool = True) -> bytes:
+def write_vtu(ug: float, path: Path, mode: str = "appended", compressor: str | None = "zlib", encode: bool = True) -> bytes:
     w = vtk.vtkXMLUnstructuredGridWriter()
     w.SetFileName(str(path))
     w.SetInputData(ug)
@@ -63,7 +64,7 @@ def write_vtu(ug, path: Path, mode: str = "appended", compressor: str | None = "
     return path.read_bytes()
 
 
-def write_legacy(ug, path: Path, binary: bool = False) -> bytes:
+def write_legacy(ug: float, path: Path, binary: bool = False) -> bytes:
     w = vtk.vtkUnstructuredGridWriter()
     w.SetFileName(str(path))
     w.SetInputData(ug)
@@ -82,7 +83,7 @@ def points_as_vtk_reads_them(path: Path) -> np.ndarray:
     return np.array([data.GetTuple3(i) for i in range(data.GetNumberOfTuples())])
 
 
-def vtk_volume(ug) -> float:
+def vtk_volume(ug: float) -> float:
     f = vtk.vtkCellSizeFilter()
     f.SetInputData(ug)
     f.Update()
@@ -94,8 +95,8 @@ def vtk_volume(ug) -> float:
 def volume_of(data: bytes, filename: str) -> float:
     loaded = load_body(data, filename=filename)
     if loaded.is_assembly:
-        return assembly_properties([(p.body, 1.0) for p in loaded.parts]).mass
-    return mass_properties(loaded.body, density=1.0).mass
+        return assembly_properties([(p.body, 1.0) for p in loaded.parts]).mass  # type: ignore[misc]
+    return mass_properties(loaded.body, density=1.0).mass  # type: ignore[arg-type]
 
 
 def warped_hexes() -> tuple[np.ndarray, list[tuple[int, list[int]]]]:
@@ -147,7 +148,7 @@ def test_voxels_are_read_in_vtks_node_order(tmp_path: Path, ext: str) -> None:
     pts = np.array([(0, 0, 0), (2, 0, 0), (0, 3, 0), (2, 3, 0), (0, 0, 5), (2, 0, 5), (0, 3, 5), (2, 3, 5)], float)
     ug = grid([(11, list(range(8)))], pts)
     data = write_vtu(ug, tmp_path / f"v.{ext}") if ext == "vtu" else write_legacy(ug, tmp_path / f"v.{ext}")
-    props = mass_properties(load_body(data, filename=f"v.{ext}").body, density=1.0)
+    props = mass_properties(load_body(data, filename=f"v.{ext}").body, density=1.0)  # type: ignore[arg-type]
     assert props.mass == pytest.approx(30.0, rel=1e-15) == vtk_volume(ug)
     # a box 2 x 3 x 5: I_xx = m (b^2 + c^2) / 12
     np.testing.assert_allclose(np.diag(props.inertia.matrix), 30 * np.array([3**2 + 5**2, 2**2 + 5**2, 2**2 + 3**2]) / 12,
@@ -164,7 +165,7 @@ def test_quadratic_cells_in_vtk_files(tmp_path: Path, name: str, ext: str) -> No
         nodes[9:13] = 0.5 * (nodes[[0, 1, 2, 3]] + nodes[4])
     ug = grid([(volref.VTK_TYPE_IDS[name], list(range(len(nodes))))], nodes, density=[2500.0])
     data = write_vtu(ug, tmp_path / f"q.{ext}") if ext == "vtu" else write_legacy(ug, tmp_path / f"q.{ext}")
-    props = mass_properties(load_body(data, filename=f"q.{ext}").body)
+    props = mass_properties(load_body(data, filename=f"q.{ext}").body)  # type: ignore[arg-type]
     m0 = volref.reference_integrals(name, points_as_vtk_reads_them(tmp_path / f"q.{ext}"))[0]
     assert props.mass == pytest.approx(2500.0 * m0, rel=1e-13)  # the cell's own density
 
@@ -184,7 +185,7 @@ def test_legacy_cell_lists_longer_than_the_type_use_vtks_first_ids(tmp_path: Pat
     reader.SetFileName(str(path))
     reader.Update()
     loaded = load_body(data, filename="long.vtk")
-    props = mass_properties(loaded.body, density=1.0)
+    props = mass_properties(loaded.body, density=1.0)  # type: ignore[arg-type]
     assert props.mass == pytest.approx(vtk_volume(reader.GetOutput()), rel=1e-14) == 8.0
     assert any("first 8" in w for w in props.warnings)
 
@@ -306,13 +307,13 @@ def test_tetgen_ele_with_its_node_file_as_pairs_and_as_a_zip() -> None:
     expected = 1 / 6 + 1 / 3  # the corner tetrahedron; the second has |det [e1 e2 e3]| = 2
     pairs = load_body([("cube/mesh.ele", ele), ("cube/mesh.node", node)])
     assert pairs.format == "ele" and pairs.filename == "mesh.ele"
-    assert assembly_properties([(p.body, 1.0) for p in pairs.parts]).mass == pytest.approx(expected, rel=1e-15)
+    assert assembly_properties([(p.body, 1.0) for p in pairs.parts]).mass == pytest.approx(expected, rel=1e-15)  # type: ignore[misc]
     buf = io.BytesIO()
     with zipfile.ZipFile(buf, "w") as zf:
         zf.writestr("mesh.node", node)
         zf.writestr("mesh.ele", ele)
     zipped = load_body(buf.getvalue(), filename="mesh.zip")
-    assert assembly_properties([(p.body, 1.0) for p in zipped.parts]).mass == pytest.approx(expected, rel=1e-15)
+    assert assembly_properties([(p.body, 1.0) for p in zipped.parts]).mass == pytest.approx(expected, rel=1e-15)  # type: ignore[misc]
 
 
 def test_tetgen_ele_alone_asks_for_its_node_file() -> None:
@@ -334,7 +335,7 @@ def test_meshio_reorders_gmsh_quadratic_cells_to_vtk_order(tmp_path: Path) -> No
     nodes = volref.parametric_nodes("tetra10") + np.random.default_rng(2).uniform(-0.04, 0.04, (10, 3))
     path = tmp_path / "t.msh"
     meshio.write(path, meshio.Mesh(nodes, [("tetra10", np.arange(10)[None, :])]), file_format="gmsh", binary=False)
-    props = mass_properties(load_body(path).body, density=1.0)
+    props = mass_properties(load_body(path).body, density=1.0)  # type: ignore[arg-type]
     assert props.mass == pytest.approx(volref.reference_integrals("tetra10", nodes)[0], rel=1e-13)
 
 
@@ -395,4 +396,4 @@ def test_alternating_cell_types_make_one_part_per_type(tmp_path: Path) -> None:
     loaded = load_body(data, filename="mixed.vtu")
     assert [p.name for p in loaded.parts] == ["tetra_0", "hexahedron_1"]
     expected = sum(rho * (1.0 if ctype == 12 else 1 / 6) for (ctype, _), rho in zip(cells, density))
-    assert assembly_properties([(p.body, None) for p in loaded.parts]).mass == pytest.approx(expected, rel=1e-14)
+    assert assembly_properties([(p.body, None) for p in loaded.parts]).mass == pytest.approx(expected, rel=1e-14)  # type: ignore[misc]

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import itertools
 from fractions import Fraction
+from typing import Any
 
 import numpy as np
 import pytest
@@ -29,7 +30,7 @@ VTK_TYPE_IDS = {"tetra": 10, "voxel": 11, "hexahedron": 12, "wedge": 13, "pyrami
                 "hexahedron20": 25, "wedge15": 26, "pyramid13": 27, "hexahedron27": 29, "wedge18": 32}
 
 
-def vtk_cell(name: str):
+def vtk_cell(name: str) -> Any:
     return getattr(vtk, VTK_CELLS[name])()
 
 

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
@@ -24,13 +26,13 @@ GENERIC = [
 ]
 
 
-def _predict(moments, omega_body, rotation=ROT, tolerance: float=1e-6, **kw):
+def _predict(moments: Any, omega_body: Any, rotation: Any=ROT, tolerance: float=1e-6, **kw: Any) -> Any:
     frame, cls = body(moments, rotation, tolerance)
     return predict_motion(frame, cls, np.asarray(rotation).T @ np.asarray(omega_body, dtype=float), **kw)
 
 
 @pytest.mark.parametrize("moments, omega", GENERIC)
-def test_period_is_4K_over_rate(moments, omega) -> None:
+def test_period_is_4K_over_rate(moments: Any, omega: Any) -> None:
     motion = _predict(moments, omega)
     assert motion.regime is Regime.ASYMMETRIC
     expected = ll_period(moments, omega)
@@ -38,7 +40,7 @@ def test_period_is_4K_over_rate(moments, omega) -> None:
 
 
 @pytest.mark.parametrize("moments, omega", GENERIC)
-def test_omega_and_attitude_match_dop853(moments, omega) -> None:
+def test_omega_and_attitude_match_dop853(moments: Any, omega: Any) -> None:
     t = np.linspace(0.0, 25.0, 201)
     motion = _predict(moments, omega, duration=25.0, samples=201)
     w_ref, r_ref = euler_reference(moments, omega, t)
@@ -54,7 +56,7 @@ def test_omega_and_attitude_match_dop853(moments, omega) -> None:
 
 
 @pytest.mark.parametrize("moments, omega", GENERIC[:3])
-def test_momentum_in_input_frame_is_constant(moments, omega) -> None:
+def test_momentum_in_input_frame_is_constant(moments: Any, omega: Any) -> None:
     motion = _predict(moments, omega, duration=1e3, samples=2001)
     traj = motion.trajectory
     m_body = traj.omega_body * np.asarray(moments)
@@ -113,7 +115,7 @@ def test_separatrix_has_no_period_and_follows_the_hyperbolic_limit() -> None:
 
 
 @pytest.mark.parametrize("side", [+1.0, -1.0])
-def test_within_1e_12_of_the_separatrix(side) -> None:
+def test_within_1e_12_of_the_separatrix(side: Any) -> None:
     """2E I2 / M^2 - 1 ~ 1e-12 on either side: k'^2 ~ 1e-12, m rounds to 1 if formed as 1 - k'^2."""
     moments = (1.0, 2.0, 3.0)
     omega = (1.0, 0.4, np.sqrt((1.0 + side * 1e-12) / 3.0))  # I3 (I3 - I2) W3^2 - I1 (I2 - I1) W1^2 = +-1e-12
@@ -160,7 +162,7 @@ def test_fast_spin_with_slow_asymmetry() -> None:
 
 
 @pytest.mark.parametrize("scale", [1e-30, 1e30])
-def test_extreme_moment_scales_give_the_same_omega(scale) -> None:
+def test_extreme_moment_scales_give_the_same_omega(scale: Any) -> None:
     moments, omega = np.array([1.0, 2.0, 3.0]), (0.3, 0.2, 1.0)
     unit = _predict(moments, omega, duration=1e5, samples=2001)
     scaled = _predict(moments * scale, omega, duration=1e5, samples=2001)
@@ -177,7 +179,7 @@ def test_nearly_linear_asymmetric_body_matches_dop853() -> None:
     t = np.linspace(0.0, 0.05, 101)
     motion = _predict(moments, omega, tolerance=1e-12, duration=0.05, samples=101)
     assert motion.regime is Regime.ASYMMETRIC
-    w_ref, r_ref = euler_reference(moments, omega, t)
+    w_ref, _r_ref = euler_reference(moments, omega, t)
     assert np.max(np.abs(motion.trajectory.omega_body - w_ref)) <= 1e-8
     long = _predict(moments, omega, tolerance=1e-12, duration=1e5, samples=2001)
     assert long.diagnostics.energy_drift <= 1e-12 and long.diagnostics.momentum_drift <= 1e-12

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from typing import Any
+
 import mpmath as mp
 import numpy as np
 import pytest
@@ -24,22 +26,23 @@ from tests.support.motion import body, euler_reference
 MOMENTS, OMEGA = (1.0, 2.0, 3.0), (0.3, 0.2, 1.0)
 
 
-def _exact(moments, omega, duration, samples, **kw):
+def _exact(moments: Any, omega: Any, duration: float, samples: int, **kw: Any) -> Any:
     frame, cls = body(moments, **kw)
     return predict_motion(frame, cls, omega, duration=duration, samples=samples)
 
 
 @pytest.mark.parametrize("method, tol", [("dop853", 1e-8), ("rk45", 1e-7), ("splitting", 1e-5)])
-@pytest.mark.parametrize("moments, omega", [(MOMENTS, OMEGA), ((1.0, 2.0, 3.0), (1.0, 0.4, 0.1)), ((2.0, 2.0, 3.0), (0.3, -0.4, 1.2))])
-def test_numerical_methods_agree_with_exact(method, tol, moments, omega) -> None:
+@pytest.mark.parametrize("moments, omega", [(MOMENTS, OMEGA), ((1.0, 2.0, 3.0), (1.0, 0.4, 0.1)),
+                                           ((2.0, 2.0, 3.0), (0.3, -0.4, 1.2))])
+def test_numerical_methods_agree_with_exact(method: str, tol: float, moments: Any, omega: Any) -> None:
     frame, cls = body(moments)
     numeric = predict_motion(frame, cls, omega, duration=20.0, samples=41, method=method)
     exact = _exact(moments, omega, 20.0, 41)
     assert numeric.method is MotionMethod(method) and numeric.regime is exact.regime
-    assert np.max(np.abs(numeric.trajectory.omega_body - exact.trajectory.omega_body)) <= tol
+    assert np.max(np.abs(numeric.trajectory.omega_body - exact.trajectory.omega_body)) <= tol  # type: ignore[union-attr]
     dq = np.minimum(
-        np.abs(numeric.trajectory.quaternion - exact.trajectory.quaternion).max(1),
-        np.abs(numeric.trajectory.quaternion + exact.trajectory.quaternion).max(1),
+        np.abs(numeric.trajectory.quaternion - exact.trajectory.quaternion).max(1),  # type: ignore[union-attr]
+        np.abs(numeric.trajectory.quaternion + exact.trajectory.quaternion).max(1),  # type: ignore[union-attr]
     )
     assert np.max(dq) <= tol
 
@@ -47,8 +50,8 @@ def test_numerical_methods_agree_with_exact(method, tol, moments, omega) -> None
 def test_splitting_keeps_momentum_exactly_and_energy_without_drift() -> None:
     frame, cls = body(MOMENTS)
     motion = predict_motion(frame, cls, OMEGA, duration=100.0, samples=11, method="splitting")
-    assert motion.diagnostics.momentum_drift <= 1e-12  # rounding only, over ~4e5 sub-rotations
-    assert motion.diagnostics.energy_drift <= 1e-6  # O((h Omega)^2), bounded, not growing
+    assert motion.diagnostics.momentum_drift <= 1e-12  # type: ignore[operator]  # rounding only, over ~4e5 sub-rotations
+    assert motion.diagnostics.energy_drift <= 1e-6  # type: ignore[operator]  # O((h Omega)^2), bounded, not growing
 
 
 def test_splitting_converges_at_its_declared_order() -> None:
@@ -65,12 +68,12 @@ def test_integrator_tolerance_is_taken_from_tolerances() -> None:
     frame, cls = body(MOMENTS)
     loose = predict_motion(frame, cls, OMEGA, duration=20.0, samples=5, method="rk45", tolerances=Tolerances(integrator_rtol=1e-4))
     exact = _exact(MOMENTS, OMEGA, 20.0, 5)
-    error = np.max(np.abs(loose.trajectory.omega_body - exact.trajectory.omega_body))
+    error = np.max(np.abs(loose.trajectory.omega_body - exact.trajectory.omega_body))  # type: ignore[union-attr]
     assert 1e-7 < error < 1e-2
 
 
 @pytest.mark.parametrize("m1", [0.9, 0.5, 1e-3, 1e-9, 2e-18])
-def test_jacobi_functions_match_mpmath(m1) -> None:
+def test_jacobi_functions_match_mpmath(m1: float) -> None:
     K = quarter_period(m1)
     u = np.linspace(-K, K, 17)
     sn, cn, dn = jacobi_sncndn(u, m1)
@@ -85,7 +88,7 @@ def test_jacobi_functions_match_mpmath(m1) -> None:
 
 
 @pytest.mark.parametrize("m1, b", [(0.5, 0.3), (1e-12, 0.9), (0.99, 1e-3)])
-def test_elliptic_integrals_match_mpmath(m1, b) -> None:
+def test_elliptic_integrals_match_mpmath(m1: float, b: float) -> None:
     phi = 1.1
     s, c = np.sin(phi), np.cos(phi)
     d = np.sqrt(c * c + m1 * s * s)
@@ -110,7 +113,7 @@ omega_st = st.tuples(st.floats(-5.0, 5.0), st.floats(-5.0, 5.0), st.floats(-5.0,
 
 @settings(max_examples=40, deadline=None)
 @given(moments_st, omega_st, st.floats(1.0, 1e5))
-def test_exact_path_keeps_energy_and_momentum(moments, omega, duration) -> None:
+def test_exact_path_keeps_energy_and_momentum(moments: Any, omega: Any, duration: float) -> None:
     motion = _exact(moments, omega, duration, 257)
     assert motion.regime is Regime.ASYMMETRIC
     assert motion.diagnostics.energy_drift <= 1e-12
@@ -120,9 +123,9 @@ def test_exact_path_keeps_energy_and_momentum(moments, omega, duration) -> None:
 
 @settings(max_examples=15, deadline=None)
 @given(moments_st, omega_st)
-def test_exact_path_agrees_with_dop853(moments, omega) -> None:
+def test_exact_path_agrees_with_dop853(moments: Any, omega: Any) -> None:
     rate = np.linalg.norm(omega)
     duration = 10.0 / rate  # ~10 radians: beyond, DOP853's own error grows near separatrices
-    motion = _exact(moments, omega, duration, 21)
-    w_ref, r_ref = euler_reference(moments, omega, motion.trajectory.t)
+    motion = _exact(moments, omega, duration, 21)  # type: ignore[arg-type]
+    w_ref, _r_ref = euler_reference(moments, omega, motion.trajectory.t)
     assert np.max(np.abs(motion.trajectory.omega_body - w_ref)) <= 1e-8 * rate

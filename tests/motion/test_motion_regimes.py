@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 import subprocess
 import sys
+from typing import Any
 
 import mpmath as mp
 import numpy as np
@@ -23,7 +24,7 @@ BASE_KEYS = {"regime", "angular_momentum", "angular_momentum_magnitude", "kineti
 SYMMETRIC_KEYS = BASE_KEYS | {"body_precession_rate", "space_precession_rate", "spin_rate", "nutation_angle", "period", "stable"}
 
 
-def _predict(moments, omega_body, rotation=ROT, tolerance: float=1e-6, **kw):
+def _predict(moments: Any, omega_body: Any, rotation: Any=ROT, tolerance: float=1e-6, **kw: Any) -> Any:
     frame, cls = body(moments, rotation, tolerance)
     return predict_motion(frame, cls, np.asarray(rotation).T @ np.asarray(omega_body, dtype=float), **kw)
 
@@ -32,7 +33,7 @@ def _predict(moments, omega_body, rotation=ROT, tolerance: float=1e-6, **kw):
     "moments, omega, unique",
     [((2.0, 2.0, 3.0), (0.3, -0.4, 1.2), 2), ((1.0, 2.5, 2.5), (0.8, 0.3, -0.4), 0), ((2.0, 2.0, 3.0), (0.3, 0.1, -2.0), 2)],
 )
-def test_symmetric_top_rates_match_landau_lifshitz(moments, omega, unique) -> None:
+def test_symmetric_top_rates_match_landau_lifshitz(moments: Any, omega: Any, unique: bool) -> None:
     motion = _predict(moments, omega)
     assert motion.regime is Regime.REGULAR_PRECESSION and set(motion.as_dict()) == SYMMETRIC_KEYS
     i_perp = moments[1] if unique == 0 else moments[0]
@@ -130,7 +131,7 @@ def test_rest() -> None:
 
 
 @pytest.mark.parametrize("axis, stable", [(0, True), (1, False), (2, True)])
-def test_permanent_rotation_stability_per_axis(axis, stable) -> None:
+def test_permanent_rotation_stability_per_axis(axis: Any, stable: bool) -> None:
     omega = np.zeros(3)
     omega[axis] = 2.0
     motion = _predict((1.0, 2.0, 3.0), omega, duration=100.0, samples=101)
@@ -172,7 +173,7 @@ def test_as_dict_is_json_and_has_a_trajectory_only_when_asked() -> None:
         ({"method": "euler"}, (1.0, 0.0, 0.0), "method"),
     ],
 )
-def test_invalid_input_is_refused_with_the_parameter_named(kwargs, omega, parameter) -> None:
+def test_invalid_input_is_refused_with_the_parameter_named(kwargs: Any, omega: Any, parameter: Any) -> None:
     with pytest.raises(InvalidParameterError) as info:
         frame, cls = body((1.0, 2.0, 3.0))
         predict_motion(frame, cls, omega, **kwargs)
@@ -181,7 +182,7 @@ def test_invalid_input_is_refused_with_the_parameter_named(kwargs, omega, parame
 
 
 @pytest.mark.parametrize("method", ["dop853", "rk45", "splitting"])
-def test_numerical_methods_refuse_a_linear_rotator(method) -> None:
+def test_numerical_methods_refuse_a_linear_rotator(method: str) -> None:
     frame, cls = body((0.0, 1.0, 1.0))
     with pytest.raises(MotionError, match="method='exact'"):
         predict_motion(frame, cls, (0.0, 1.0, 0.0), method=method)

@@ -8,6 +8,8 @@ form at 50 digits, itself checked against mpmath's Taylor-series ODE solver).
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 import pytest
 
@@ -17,7 +19,7 @@ from tests.support.motion import elliptic_reference, euler_taylor_reference
 EPS = np.finfo(float).eps
 
 
-def _tops(seed: int, count: int):
+def _tops(seed: int, count: int) -> Any:
     rng = np.random.default_rng(seed)
     for _ in range(count):
         gap = 10 ** rng.uniform(-13, -6.3)  # above rounding, below the default tolerance
@@ -37,7 +39,7 @@ def test_the_elliptic_reference_solves_eulers_equations() -> None:
 
 
 @pytest.mark.parametrize("duration", [10.0, 1000.0])
-def test_nearly_symmetric_tops_move_as_given_at_the_default_tolerance(duration) -> None:
+def test_nearly_symmetric_tops_move_as_given_at_the_default_tolerance(duration: float) -> None:
     t = np.linspace(0.0, duration, 6)
     labelled_symmetric = 0
     for moments, omega in _tops(12, 60):
@@ -45,7 +47,7 @@ def test_nearly_symmetric_tops_move_as_given_at_the_default_tolerance(duration) 
         labelled_symmetric += res.classification.kind == "symmetric_top"
         ref = elliptic_reference(moments, omega, t)
         speed = float(np.linalg.norm(omega))
-        err = np.max(np.abs(res.motion.trajectory.omega_body - ref)) / speed
+        err = np.max(np.abs(res.motion.trajectory.omega_body - ref)) / speed  # type: ignore[union-attr]
         # the exact motion: rounding per radian turned (measured worst 0.42 eps per radian)
         assert err <= 8 * EPS * (1 + speed * duration), (moments, omega, err)
         assert res.motion.regime.value == "asymmetric"
@@ -55,7 +57,7 @@ def test_nearly_symmetric_tops_move_as_given_at_the_default_tolerance(duration) 
 def test_tensor_input_of_a_nearly_symmetric_top_keeps_its_moments() -> None:
     moments, omega = (1.0, 1.0 + 3e-8, 2.0), np.array([0.4, 0.9, 0.3])
     t = np.linspace(0.0, 10.0, 5)
-    res = precession(omega, inertia_tensor=np.diag(moments), duration=10.0, samples=5)
+    res = precession(omega, inertia_tensor=np.diag(moments), duration=10.0, samples=5)  # type: ignore[arg-type]
     assert res.classification.kind == "symmetric_top"
-    err = np.max(np.abs(res.motion.trajectory.omega_body - elliptic_reference(moments, omega, t)))
+    err = np.max(np.abs(res.motion.trajectory.omega_body - elliptic_reference(moments, omega, t)))  # type: ignore[union-attr]
     assert err <= 1e-13

@@ -8,6 +8,8 @@
 
 from __future__ import annotations
 
+from typing import Any
+
 import mpmath as mp
 import numpy as np
 from scipy.integrate import solve_ivp
@@ -16,7 +18,7 @@ from inertia.classification import Classification, classify
 from inertia.principal import PrincipalFrame
 
 
-def body(moments, rotation=None, tolerance: float=1e-6) -> tuple[PrincipalFrame, Classification]:
+def body(moments: Any, rotation: Any=None, tolerance: float=1e-6) -> tuple[PrincipalFrame, Classification]:
     """Principal frame and classification of a body with these principal moments,
     its principal axes the rows of ``rotation`` (identity by default)."""
     axes = np.eye(3) if rotation is None else np.asarray(rotation, dtype=float)
@@ -25,11 +27,11 @@ def body(moments, rotation=None, tolerance: float=1e-6) -> tuple[PrincipalFrame,
     return frame, classify(frame)
 
 
-def euler_reference(moments, omega_body, t, rtol: float=1e-12):
+def euler_reference(moments: Any, omega_body: Any, t: Any, rtol: float=1e-12) -> Any:
     """Omega(t) (N, 3) in the body and R(t) (N, 3, 3), the rotation since t = 0 in the body frame at 0."""
     I1, I2, I3 = (float(x) for x in moments)
 
-    def rhs(_t, y):
+    def rhs(_t: Any, y: Any) -> Any:
         w = y[:3]
         r = y[3:].reshape(3, 3)
         dw = [(I2 - I3) / I1 * w[1] * w[2], (I3 - I1) / I2 * w[2] * w[0], (I1 - I2) / I3 * w[0] * w[1]]
@@ -44,7 +46,7 @@ def euler_reference(moments, omega_body, t, rtol: float=1e-12):
     return sol.y[:3].T, sol.y[3:].T.reshape(-1, 3, 3)
 
 
-def ll_period(moments, omega_body) -> float:
+def ll_period(moments: Any, omega_body: Any) -> float:
     """4 K(k) / rate for the asymmetric top, L&L eqs. 37.10-37.12, at 50 digits."""
     with mp.workdps(50):
         I1, I2, I3 = (mp.mpf(float(x)) for x in moments)
@@ -58,7 +60,7 @@ def ll_period(moments, omega_body) -> float:
         return float(4 * mp.ellipk(k2) / rate)
 
 
-def quaternion_matrix(q):
+def quaternion_matrix(q: Any) -> Any:
     """Rotation matrices of quaternions [w, x, y, z] (written out, independent of the service)."""
     w, x, y, z = np.moveaxis(np.asarray(q, dtype=float), -1, 0)
     return np.stack(
@@ -71,7 +73,7 @@ def quaternion_matrix(q):
     )
 
 
-def elliptic_reference(moments, omega_body, t, dps: int=50):
+def elliptic_reference(moments: Any, omega_body: Any, t: Any, dps: int=50) -> Any:
     """Omega(t) (N, 3) in the body frame of an asymmetric top (I1 < I2 < I3), from the
     closed form of L&L §37 (eqs. 37.10-37.12) evaluated with mpmath's Jacobi
     functions at ``dps`` digits, for the moments exactly as given.
@@ -101,7 +103,7 @@ def elliptic_reference(moments, omega_body, t, dps: int=50):
         sn0 = max(-1, min(1, W[b] / (rho * s * Ab)))
         u0 = mp.ellipf(mp.asin(sn0), m)
 
-        def euler(w):
+        def euler(w: Any) -> Any:
             return [(I[1] - I[2]) / I[0] * w[1] * w[2], (I[2] - I[0]) / I[1] * w[2] * w[0],
                     (I[0] - I[1]) / I[2] * w[0] * w[1]]
 
@@ -125,13 +127,13 @@ def elliptic_reference(moments, omega_body, t, dps: int=50):
         return out
 
 
-def euler_taylor_reference(moments, omega_body, t, dps: int=30):
+def euler_taylor_reference(moments: Any, omega_body: Any, t: Any, dps: int=30) -> Any:
     """Omega(t) (N, 3) from Euler's equations integrated by mpmath's Taylor-series solver
     (``mpmath.odefun``) at ``dps`` digits: slow, for short horizons."""
     with mp.workdps(dps):
         I1, I2, I3 = (mp.mpf(float(x)) for x in moments)
 
-        def rhs(_t, w):
+        def rhs(_t: Any, w: Any) -> Any:
             return [(I2 - I3) / I1 * w[1] * w[2], (I3 - I1) / I2 * w[2] * w[0], (I1 - I2) / I3 * w[0] * w[1]]
 
         sol = mp.odefun(rhs, 0, [mp.mpf(float(x)) for x in omega_body])
