@@ -23,7 +23,7 @@ SOURCE = ROOT / "service"
 LAYERS: list[tuple[str, list[str]]] = [
     ("kernels", [
         "errors", "tolerances", "conventions", "arrays", "integrals", "eigen", "ddouble", "cpus",
-        "cells", "elements",
+        "cells", "elements", "vocabulary",
     ]),
     ("body", ["body"]),
     ("geometry", ["topology", "seams", "solid", "surface"]),
