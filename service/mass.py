@@ -34,17 +34,12 @@ from .errors import InsufficientPrecisionError, InvalidParameterError, ZeroVolum
 from .integrals import Sums, local_origin, point_records, point_sums, simplex_sums
 from .solid import closed_surface
 from .tolerances import DEFAULT_TOLERANCES, EPS, Tolerances
+from .vocabulary import MODELS, Model
 
 __all__ = ["InertiaTensor", "MassProperties", "mass_properties", "assembly_properties", "Model", "parallel_axis"]
 
 MAX_PASSES = 4  # one coarse pass plus refinements; the frame settles in 2-3
 FRAME_SETTLED = 1e-7  # off-diagonal / sqrt(diag product) below this: the next pass moves moments < 1e-14
-
-
-class Model:
-    SOLID = "solid"
-    SHELL = "shell"
-    ALL = (SOLID, SHELL)
 
 
 @dataclass(frozen=True, slots=True)
@@ -541,7 +536,7 @@ def _check_finite_results(mass: float, com: NDArray[np.float64], tensor: NDArray
 
 
 def _check_material(body: Body, density: float | None, mass: float | None, model: str, thickness: float | None) -> None:
-    if model not in Model.ALL:
+    if model not in MODELS:
         raise InvalidParameterError(f"unknown model {model!r}; use 'solid' or 'shell'", parameter="model")
     if density is not None and mass is not None:
         raise InvalidParameterError("give either density or mass, not both", parameter="density")
