@@ -1,14 +1,17 @@
 """Command line: ``inertia analyze | batch | serve``, a thin front end over the pipeline.
 
 Errors are printed to stderr as a sentence (``error: ... (code)``), or in the API's
-envelope with ``--json``; the exit status comes from ``EXIT_CODES``:
+envelope with ``--json``; the exit status comes from ``EXIT_CODES``, chosen by the
+error's class (its nearest listed base class):
 
     0  success
     1  an unexpected internal error (a bug: please report it)
     2  a bad option or parameter
-    3  a file that cannot be read: unsupported format, unreadable, no geometry
-    4  a body that is not a solid: open mesh, zero volume
-    5  a time limit was reached
+    3  a file that cannot be read: unsupported format, unreadable, an external
+       reference that did not come with it, no geometry, past a size bound
+    4  a body that is not a solid: open mesh, zero volume, insufficient precision,
+       an inertia a simulator refuses
+    5  a time limit was reached (reserved: the command line sets none)
     6  the environment refused: a port in use, an output that cannot be written
   130  interrupted (Ctrl-C)
 """
@@ -24,22 +27,30 @@ import sys
 from collections.abc import Sequence
 from typing import Any
 
-from .errors import InvalidParameterError, ServiceError
+from .errors import (
+    DegenerateBodyError,
+    InputTooLargeError,
+    InvalidInertiaError,
+    InvalidMeshError,
+    InvalidParameterError,
+    LoadError,
+    ServiceError,
+)
+from .tolerances import DEFAULT_TOLERANCES
+from .vocabulary import METHODS, MODELS, Model, MotionMethod
 
-__all__ = ["main", "EXIT_CODES"]
+__all__ = ["main", "EXIT_CODES", "exit_code"]
 
-EXIT_CODES = {
-    "invalid_parameter": 2,
-    "unsupported_format": 3,
-    "unreadable_file": 3,
-    "empty_geometry": 3,
-    "not_watertight": 4,
-    "zero_volume": 4,
-    "insufficient_precision": 4,
-    "invalid_inertia": 4,
-    "timeout": 5,
-}
 EXIT_INTERNAL = 1
+EXIT_CODES: dict[type[ServiceError], int] = {
+    InvalidParameterError: 2,  # MotionError too
+    LoadError: 3,  # unsupported_format, unreadable_file, external_reference, empty_geometry
+    InputTooLargeError: 3,
+    InvalidMeshError: 4,  # not_watertight
+    DegenerateBodyError: 4,  # zero_volume, insufficient_precision
+    InvalidInertiaError: 4,
+    ServiceError: EXIT_INTERNAL,
+}
 EXIT_ENVIRONMENT = 6
 EXIT_INTERRUPTED = 130
 
@@ -84,9 +95,9 @@ def add_analysis_options(p: argparse.ArgumentParser) -> None:
     group = p.add_mutually_exclusive_group()
     group.add_argument("--density", type=float, help="density in kg/m^3 (default 1000)")
     group.add_argument("--mass", type=float, help="total mass in kg (density is derived)")
-    p.add_argument("--model", choices=("solid", "shell"), default="solid", help="closed solid or thin shell")
+    p.add_argument("--model", choices=MODELS, default=Model.SOLID.value, help="closed solid or thin shell")
     p.add_argument("--thickness", type=float, help="shell wall thickness, in the file's units")
-    p.add_argument("--tolerance", type=float, default=1e-6, help="relative tolerance for equal moments")
+    p.add_argument("--tolerance", type=float, default=DEFAULT_TOLERANCES.moment_rel, help="relative tolerance for equal moments")
     p.add_argument("--reference", type=_triple, metavar="X,Y,Z",
                    help="point (file units): also report the tensor about it; negative values as written: -1,0,0")
     p.add_argument("--densities", help="JSON file: part name -> density (kg/m^3) for files of several parts")
@@ -126,7 +137,7 @@ def options_from_args(args: argparse.Namespace) -> Any:
         omega=getattr(args, "omega", None),
         duration=getattr(args, "duration", None),
         samples=getattr(args, "samples", None),
-        method=getattr(args, "method", "exact"),
+        method=getattr(args, "method", MotionMethod.EXACT.value),
         densities=densities,
         geometry=getattr(args, "geometry", None) or ("mesh" if getattr(args, "deflection", None) else "brep"),
         deflection=getattr(args, "deflection", None),
@@ -148,7 +159,7 @@ def _parser() -> argparse.ArgumentParser:
                    help="initial angular velocity, rad/s, input frame (adds the precession section)")
     a.add_argument("--duration", type=float, help="seconds of motion to predict (with --omega and --samples)")
     a.add_argument("--samples", type=int, help="number of time samples of the trajectory")
-    a.add_argument("--method", default="exact", choices=("exact", "dop853", "rk45", "splitting"),
+    a.add_argument("--method", default=MotionMethod.EXACT.value, choices=METHODS,
                    help="motion method: exact (closed form / elliptic), dop853, rk45 or splitting (default exact)")
     a.add_argument("--json", action="store_true", help="print the API's JSON instead of a table (errors as JSON too)")
     a.add_argument("--output-units", choices=tuple(OUTPUT_UNITS), default="si",
@@ -217,13 +228,18 @@ def main(argv: Sequence[str] | None = None) -> int:
             print(json.dumps(exc.as_dict()), file=sys.stderr)
         else:
             print(f"error: {exc.message} ({exc.code})", file=sys.stderr)
-        return EXIT_CODES.get(exc.code, EXIT_INTERNAL)
+        return exit_code(exc)
     except BrokenPipeError:  # output piped into head & co.: not an error of ours
         sys.stderr.close()
         return 0
     except KeyboardInterrupt:
         print("interrupted", file=sys.stderr)
         return EXIT_INTERRUPTED
+
+
+def exit_code(exc: ServiceError) -> int:
+    """The exit status of an error: that of its nearest base class in ``EXIT_CODES``."""
+    return next(EXIT_CODES[cls] for cls in type(exc).__mro__ if cls in EXIT_CODES)
 
 
 def _analyze(args: argparse.Namespace) -> int:
