@@ -12,13 +12,10 @@ from dataclasses import dataclass
 
 from .conventions import length_scale
 from .errors import InvalidParameterError
-from .mass import Model
 from .tolerances import DEFAULT_TOLERANCES
+from .vocabulary import METHODS, MODELS, Model
 
 __all__ = ["AnalysisOptions", "METHODS"]
-
-METHODS = ("exact", "dop853", "rk45", "splitting")
-
 
 def _vector(name: str, value: Sequence[float] | None) -> tuple[float, float, float] | None:
     if value is None:
@@ -74,7 +71,7 @@ class AnalysisOptions:
             _positive(name, getattr(self, name))
         if self.density is not None and self.mass is not None:
             raise InvalidParameterError("give either density or mass, not both", parameter="density")
-        if self.model not in Model.ALL:
+        if self.model not in MODELS:
             raise InvalidParameterError(f"model must be 'solid' or 'shell', got {self.model!r}", parameter="model")
         if not (isinstance(self.tolerance, (int, float)) and math.isfinite(self.tolerance) and 0 < self.tolerance < 1):
             raise InvalidParameterError("tolerance must be a number between 0 and 1 (relative)", parameter="tolerance")

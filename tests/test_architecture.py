@@ -23,7 +23,7 @@ SOURCE = ROOT / "service"
 LAYERS: list[tuple[str, list[str]]] = [
     ("kernels", [
         "errors", "tolerances", "conventions", "arrays", "integrals", "eigen", "ddouble", "cpus",
-        "cells", "elements",
+        "cells", "elements", "vocabulary",
     ]),
     ("body", ["body"]),
     ("geometry", ["topology", "seams", "solid", "surface"]),
@@ -32,7 +32,7 @@ LAYERS: list[tuple[str, list[str]]] = [
     ("principal", ["principal"]),
     ("classification", ["classification"]),
     ("motion", ["motion"]),
-    ("derived", ["elements", "export", "frames", "rotational"]),
+    ("derived", ["export", "frames", "rotational"]),
     ("results", ["options", "results", "report"]),
     ("pipeline", ["pipeline"]),
     ("surfaces", ["api", "app", "batch", "cli", "web", "__main__", ""]),
@@ -210,6 +210,20 @@ def test_no_import_cycle() -> None:
 def test_no_module_imports_a_layer_above_its_own() -> None:
     bad = upward(edges())
     assert bad == [], "imports against the layer order:\n" + "\n".join(bad)
+
+
+def test_docs_describe_the_same_layers() -> None:
+    """docs/architecture.md has a row per layer, in this order, naming each module prefix of it."""
+    text = (ROOT / "docs" / "architecture.md").read_text(encoding="utf-8")
+    rows = [line for line in text.splitlines() if line.startswith("| ") and not line.startswith("| layer")]
+    rows = [r for r in rows if not set(r) <= set("|- ")]
+    assert [r.split("|")[1].strip() for r in rows] == [name for name, _ in LAYERS]
+    for row, (_, prefixes) in zip(rows, LAYERS):
+        cell = row.split("|")[2]
+        for prefix in prefixes:
+            if prefix:
+                shown = prefix.replace(".", "/")
+                assert f"`{prefix}" in cell or f"`{shown}" in cell, (prefix, row)
 
 
 if __name__ == "__main__":  # print the graph's problems without pytest

@@ -16,18 +16,17 @@ from starlette.exceptions import HTTPException
 from starlette.responses import JSONResponse
 
 from ..errors import (
-    ComputeTimeoutError,
     DegenerateBodyError,
+    InputTooLargeError,
     InvalidInertiaError,
     InvalidMeshError,
     InvalidParameterError,
     LoadError,
-    PayloadTooLargeError,
     ServerBusyError,
     ServiceError,
-    UnauthorizedError,
     UnsupportedFormatError,
 )
+from .transport import ComputeTimeoutError, PayloadTooLargeError, UnauthorizedError
 
 __all__ = ["STATUS", "error_response", "install_error_handlers", "status_of", "internal_error_response"]
 
@@ -41,6 +40,7 @@ STATUS: dict[type[ServiceError], int] = {
     DegenerateBodyError: 422,  # zero_volume, insufficient_precision
     InvalidParameterError: 422,
     InvalidInertiaError: 422,
+    InputTooLargeError: 413,
     PayloadTooLargeError: 413,
     UnauthorizedError: 401,
     ComputeTimeoutError: 503,

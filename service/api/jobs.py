@@ -28,8 +28,9 @@ from contextlib import contextmanager
 from dataclasses import dataclass
 from typing import Any
 
-from ..errors import InvalidParameterError, PayloadTooLargeError, ServiceError, UnreadableFileError
+from ..errors import InvalidParameterError, ServiceError, UnreadableFileError
 from ..pipeline import AnalysisOptions, analyze_loaded, analyze_points, precession
+from .transport import PayloadTooLargeError
 
 log = logging.getLogger("inertia.api")
 

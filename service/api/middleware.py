@@ -10,9 +10,10 @@ from typing import Any
 
 from starlette.types import ASGIApp, Message, Receive, Scope, Send
 
-from ..errors import PayloadTooLargeError, ServiceError, UnauthorizedError
+from ..errors import ServiceError
 from .errors import error_response, internal_error_response
 from .settings import Settings
+from .transport import PayloadTooLargeError, UnauthorizedError
 
 __all__ = ["AccessLog", "Guard", "LastResort"]
 

@@ -23,7 +23,8 @@ from dataclasses import dataclass
 from pathlib import PurePosixPath, PureWindowsPath
 from typing import BinaryIO
 
-from ..errors import PayloadTooLargeError, ServiceError, UnreadableFileError
+from ..errors import ServiceError, UnreadableFileError
+from .transport import PayloadTooLargeError
 
 __all__ = ["Item", "Upload", "Workspace", "client_name", "expand", "save"]
 

@@ -20,7 +20,7 @@ protected alike:
   every block is inflated with a bound of its declared size, discarding the
   output, so a block that inflates past what its header says is caught
   without holding it. The total may not exceed :func:`inflate_budget` of
-  the upload's size (:class:`PayloadTooLargeError`). GLB chunk lengths, and
+  the upload's size (:class:`InputTooLargeError`). GLB chunk lengths, and
   the element counts in PLY and OFF headers, must fit in the file.
 
 What each reader does with each kind of reference is tabled in
@@ -43,7 +43,7 @@ from dataclasses import dataclass
 from pathlib import PurePosixPath, PureWindowsPath
 from typing import Any
 
-from ..errors import ExternalReferenceError, PayloadTooLargeError, UnreadableFileError
+from ..errors import ExternalReferenceError, InputTooLargeError, UnreadableFileError
 
 __all__ = ["check_upload", "inflate_budget", "INFLATE_RATIO", "INFLATE_FLOOR_BYTES", "MAX_INFLATED_BYTES",
            "MAX_JSON_DEPTH"]
@@ -74,7 +74,7 @@ class _Context:
         """Count ``nbytes`` more of inflated content; refuse past the budget."""
         self.inflated += nbytes
         if self.inflated > self.budget:
-            raise PayloadTooLargeError(
+            raise InputTooLargeError(
                 f"the {self.fmt.upper()} file would inflate to more than {self.budget} bytes ({what}); "
                 f"at most {INFLATE_RATIO} times the upload's size (or {INFLATE_FLOOR_BYTES} bytes) is accepted",
                 limit_bytes=self.budget, format=self.fmt)
@@ -100,7 +100,7 @@ def check_upload(data: bytes, fmt: str, companions: Collection[str] = ()) -> Non
     """Refuse ``data`` (format ``fmt``) if it names a file outside ``companions`` or inflates past its budget.
 
     companions : the plain file names of the other files that came in the same upload.
-    Raises ``ExternalReferenceError`` (422), ``PayloadTooLargeError`` (413) or
+    Raises ``ExternalReferenceError`` (422), ``InputTooLargeError`` (413) or
     ``UnreadableFileError`` (422, a header that contradicts the file).
     """
     check = _CHECKS.get(fmt)
@@ -284,7 +284,7 @@ class _Blocks:
         except (zlib.error, lzma.LZMAError) as exc:
             raise self._lie(f"a block does not inflate: {exc}") from None
         if len(out) > expected:
-            raise PayloadTooLargeError(
+            raise InputTooLargeError(
                 f"a compressed block of the {self.ctx.fmt.upper()} file inflates past the {expected} bytes "
                 "its header declares; refused before inflating it", format=self.ctx.fmt)
 

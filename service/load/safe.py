@@ -22,7 +22,7 @@ import zlib
 from collections.abc import Callable
 from typing import TypeVar
 
-from ..errors import PayloadTooLargeError, ServiceError, UnreadableFileError
+from ..errors import InputTooLargeError, ServiceError, UnreadableFileError
 
 __all__ = ["guarded_read", "explain"]
 
@@ -67,7 +67,7 @@ def guarded_read(fn: Callable[[], T], fmt: str) -> T:
     except ServiceError:
         raise
     except MemoryError as exc:
-        raise PayloadTooLargeError(f"the {fmt.upper()} file is too large to read in the memory available; "
+        raise InputTooLargeError(f"the {fmt.upper()} file is too large to read in the memory available; "
                                    "send a smaller or decimated mesh", format=fmt) from exc
     except BaseException as exc:
         raise UnreadableFileError(

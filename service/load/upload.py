@@ -12,7 +12,7 @@ import io
 import posixpath
 import zipfile
 
-from ..errors import PayloadTooLargeError, UnreadableFileError, UnsupportedFormatError
+from ..errors import InputTooLargeError, UnreadableFileError, UnsupportedFormatError
 from .guard import inflate_budget
 from .sniff import FORMATS, POINT_FORMATS
 
@@ -34,12 +34,12 @@ def unpack_zip(data: bytes) -> list[tuple[str, bytes]]:
                                   format="zip") from exc
     infos = [i for i in infos if not any(p.startswith((".", "__MACOSX")) for p in i.filename.split("/"))]
     if len(infos) > MAX_FILES:
-        raise PayloadTooLargeError(f"the zip holds {len(infos)} files; at most {MAX_FILES} are accepted in one upload",
+        raise InputTooLargeError(f"the zip holds {len(infos)} files; at most {MAX_FILES} are accepted in one upload",
                                    format="zip")
     budget = inflate_budget(len(data))
     total = sum(i.file_size for i in infos)
     if total > budget:
-        raise PayloadTooLargeError(f"the zip would inflate to {total} bytes, more than the {budget} accepted for an "
+        raise InputTooLargeError(f"the zip would inflate to {total} bytes, more than the {budget} accepted for an "
                                    f"upload of {len(data)} bytes", format="zip", limit_bytes=budget)
     files = []
     for info in infos:

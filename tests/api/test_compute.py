@@ -11,7 +11,8 @@ import pytest
 
 from inertia.api.compute import ComputePool
 from inertia.api.jobs import MeshJob
-from inertia.errors import ComputeTimeoutError, NotWatertightError
+from inertia.api.transport import ComputeTimeoutError
+from inertia.errors import NotWatertightError
 from inertia.pipeline import AnalysisOptions
 from tests.support.meshes import box_stl, torus_stl
 

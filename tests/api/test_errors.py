@@ -18,6 +18,7 @@ from pytest import LogCaptureFixture
 
 from inertia import errors as E
 from inertia.api import Settings, create_app
+from inertia.api import transport as T
 from inertia.api.errors import STATUS
 from tests.support.meshes import box_stl, stl_bytes, torus_stl
 
@@ -129,10 +130,10 @@ def busy(c: Any) -> Any:
 
 
 LIMITED = [
-    (E.PayloadTooLargeError, "payload_too_large", 413, Settings(max_upload_bytes=1000, compute_processes=1),  # type: ignore[call-arg]  # fields come from INERTIA_* variables
+    (T.PayloadTooLargeError, "payload_too_large", 413, Settings(max_upload_bytes=1000, compute_processes=1),  # type: ignore[call-arg]  # fields come from INERTIA_* variables
      mesh(box_stl(1, 2, 3) * 10)),
-    (E.UnauthorizedError, "unauthorized", 401, Settings(api_key="s3cret", compute_processes=1), mesh(BOX)),  # type: ignore[call-arg]  # fields come from INERTIA_* variables
-    (E.ComputeTimeoutError, "timeout", 503, Settings(timeout_s=0.05, compute_processes=1),  # type: ignore[call-arg]  # fields come from INERTIA_* variables
+    (T.UnauthorizedError, "unauthorized", 401, Settings(api_key="s3cret", compute_processes=1), mesh(BOX)),  # type: ignore[call-arg]  # fields come from INERTIA_* variables
+    (T.ComputeTimeoutError, "timeout", 503, Settings(timeout_s=0.05, compute_processes=1),  # type: ignore[call-arg]  # fields come from INERTIA_* variables
      mesh(torus_stl(500, 500))),
     (E.ServerBusyError, "server_busy", 503, Settings(max_waiting=0, compute_processes=1), busy),  # type: ignore[call-arg]  # fields come from INERTIA_* variables
 ]

@@ -83,13 +83,13 @@ def _descendants(pid: int) -> list[int]:
 
 @pytest.fixture(scope="module")
 def fuzz_server(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Any]:
-    from api.conftest import LiveServer
+    from tests.api.conftest import LiveServer
 
     tmp = tmp_path_factory.mktemp("fuzz-tmp")
     (Path(__file__).resolve().parents[2] / ".pytest_cache").mkdir(exist_ok=True)
     server = LiveServer({"INERTIA_TIMEOUT_S": str(TIMEOUT_S), "INERTIA_COMPUTE_PROCESSES": "2",
                          "INERTIA_MAX_UPLOAD_BYTES": str(MAX_UPLOAD), "TMPDIR": str(tmp)})
-    server.tmp = tmp
+    server.tmp = tmp  # type: ignore[attr-defined]  # where the test looks for leftover files
     try:
         yield server
     finally:

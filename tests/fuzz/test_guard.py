@@ -12,7 +12,8 @@ import time
 
 import pytest
 
-from inertia.errors import ExternalReferenceError, PayloadTooLargeError, ServiceError, UnreadableFileError
+from inertia.errors import ExternalReferenceError, ServiceError, UnreadableFileError
+from inertia.errors import InputTooLargeError as PayloadTooLargeError
 from inertia.load import load_body
 from inertia.load.guard import check_upload, inflate_budget
 

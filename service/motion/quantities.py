@@ -1,0 +1,66 @@
+"""The quantities of the API's ``precession`` section: M, E, rates, angles, periods of the regime."""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+
+from ..tolerances import Tolerances
+from .jacobi import AsymmetricTop
+from .regime import Setup
+from .result import FreeMotion, MotionDiagnostics, MotionMethod, Regime
+from .symmetric import SymmetricTop
+
+__all__ = ["precession_quantities"]
+
+
+def precession_quantities(setup: Setup, method: MotionMethod, tol: Tolerances) -> FreeMotion:
+    problem = setup.problem
+    # M = I Omega and E = Omega.I Omega/2 of the state as given, with the reported moments (API.md);
+    # the ideal top's moments only shape the motion that follows
+    given = setup.initial if setup.initial is not None else problem
+    momentum = given.momentum_input
+    base = FreeMotion(
+        regime=setup.regime,
+        method=method,
+        angular_momentum=momentum,
+        angular_momentum_magnitude=float(np.linalg.norm(momentum)),
+        kinetic_energy=given.energy,
+        omega_body=given.omega_body,
+        diagnostics=MotionDiagnostics(elapsed_s=0.0),
+        stable=setup.stable,
+        warnings=setup.warnings,
+    )
+    if setup.regime is Regime.REGULAR_PRECESSION:
+        assert setup.unique is not None
+        top = SymmetricTop(problem.moments, problem.omega_body, setup.unique)
+        return replace(
+            base,
+            body_precession_rate=top.body_precession_rate,
+            space_precession_rate=top.space_precession_rate,
+            spin_rate=top.spin_rate,
+            nutation_angle=top.nutation_angle,
+            period=2.0 * np.pi / abs(top.body_precession_rate),
+        )
+    if setup.regime is Regime.ROTATOR:
+        return replace(
+            base,
+            space_precession_rate=float(np.linalg.norm(problem.omega_body)),
+            nutation_angle=0.5 * np.pi,
+        )
+    if setup.regime is Regime.ASYMMETRIC:
+        return _asymmetric_quantities(base, AsymmetricTop.from_initial(problem.moments, problem.omega_body, tol.separatrix_rel))
+    return base
+
+
+def _asymmetric_quantities(base: FreeMotion, top: AsymmetricTop) -> FreeMotion:
+    if top.separatrix:
+        warning = (
+            "Omega starts on the separatrix (2 E I2 = |M|^2 within rounding): the motion approaches "
+            "rotation about the intermediate axis forever, so it has no period"
+        )
+        return replace(base, warnings=(*base.warnings, warning))
+    period = top.period
+    flip = 0.5 * period if base.stable is False else None
+    return replace(base, period=period, flip_interval=flip)

@@ -1,0 +1,143 @@
+"""The regime decision: which motion the body makes, and the ideal problem that is solved.
+
+``decide_regime`` maps a principal frame, its classification and Omega(0) to a
+``Setup``: the regime (rest, permanent rotation, spherical top, regular
+precession, asymmetric top, linear rotator), its stability, the warnings, and
+the ``RigidProblem`` whose motion the methods compute.  The modelling decisions
+are stated in the package's docstring.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from ..classification import Classification, RotorClass
+from ..principal import PrincipalFrame
+from ..tolerances import EPS, Tolerances
+from .invariants import RigidProblem
+from .result import Regime
+
+__all__ = ["Setup", "decide_regime", "ideal_moments", "motion_rotor", "MOTION_ROUNDING"]
+
+MOTION_ROUNDING = 64 * EPS
+"""Moments closer than this times the largest moment are equal to rounding: the
+closed form of a symmetric, spherical or linear top is exact for them (their
+spread is below the error of any computed moment)."""
+
+Array = NDArray[np.float64]
+
+
+@dataclass(frozen=True, slots=True)
+class Setup:
+    """What the regime decision produced: the problem to solve and its labels."""
+
+    problem: RigidProblem
+    regime: Regime
+    stable: bool | None
+    warnings: tuple[str, ...]
+    unique: int | None = None  # symmetry axis index of a symmetric top
+    initial: RigidProblem | None = None  # the state as given: reported M, E and omega_body come from it
+
+
+def decide_regime(frame: PrincipalFrame, classification: Classification, omega: Array, tol: Tolerances) -> Setup:
+    """The regime, and the ideal problem that is solved; the state as given is kept beside it."""
+    decided = _decide(frame, classification, omega, tol)
+    axes = np.asarray(frame.axes, dtype=np.float64)
+    given = RigidProblem(np.asarray(frame.moments, dtype=np.float64), axes @ omega, axes, frame.quaternion)
+    return replace(decided, initial=given)
+
+
+def _decide(frame: PrincipalFrame, classification: Classification, omega: Array, tol: Tolerances) -> Setup:
+    axes = np.asarray(frame.axes, dtype=np.float64)
+    omega_body = axes @ omega
+    rotor = motion_rotor(frame, classification)
+    moments = ideal_moments(np.asarray(frame.moments, dtype=np.float64), rotor)
+    warnings: list[str] = []
+    if rotor is RotorClass.LINEAR and omega_body[0] != 0.0:
+        along = abs(float(omega_body[0]))
+        if along > tol.permanent_rotation_rel * float(np.linalg.norm(omega_body)):
+            warnings.append(
+                f"the component of omega along the rotator axis ({along:.3g} rad/s) has no physical effect "
+                "on a linear rotator and was dropped"
+            )
+        omega_body = omega_body.copy()
+        omega_body[0] = 0.0
+    problem = RigidProblem(moments, omega_body, axes, frame.quaternion)
+    rate = float(np.linalg.norm(omega_body))
+    if rate == 0.0:
+        return Setup(problem, Regime.REST, None, tuple(warnings))
+    if rotor is RotorClass.SPHERICAL:
+        return Setup(problem, Regime.SPHERICAL, True, tuple(warnings))
+    if rotor is RotorClass.LINEAR:
+        return Setup(problem, Regime.ROTATOR, True, tuple(warnings))
+    along_axis = _principal_axis_of(omega_body, tol.permanent_rotation_rel)
+    if rotor.is_symmetric:
+        unique = 0 if rotor is RotorClass.SYMMETRIC_PROLATE else 2
+        perpendicular = abs(omega_body[unique]) <= tol.permanent_rotation_rel * rate
+        if along_axis is not None or perpendicular:
+            snapped = _snap(problem, along_axis, unique if perpendicular else None)
+            return Setup(snapped, Regime.PERMANENT_ROTATION, True, tuple(warnings))
+        return Setup(problem, Regime.REGULAR_PRECESSION, True, tuple(warnings), unique)
+    if along_axis is not None:
+        return Setup(_snap(problem, along_axis, None), Regime.PERMANENT_ROTATION, along_axis != 1, tuple(warnings))
+    nearest = int(np.argmax(np.abs(omega_body)))
+    return Setup(problem, Regime.ASYMMETRIC, nearest != 1, tuple(warnings))
+
+
+def ideal_moments(moments: ArrayLike, rotor: RotorClass) -> Array:
+    """Moments of the ideal top of class ``rotor``, the ones the motion is computed with.
+
+    Moments of a pair the class makes equal become their mean; the smallest
+    moment of a linear rotator becomes 0.  ``predict_motion`` passes the class
+    of ``motion_rotor``, so this changes moments by rounding only.
+    """
+    given = np.asarray(moments, dtype=np.float64)
+    ideal = given.copy()
+    if rotor is RotorClass.SPHERICAL:
+        ideal[:] = given.mean()
+    elif rotor is RotorClass.SYMMETRIC_OBLATE:
+        ideal[:2] = given[:2].mean()
+    elif rotor in (RotorClass.SYMMETRIC_PROLATE, RotorClass.LINEAR):
+        ideal[1:] = given[1:].mean()
+    if rotor is RotorClass.LINEAR:
+        ideal[0] = 0.0
+    return ideal
+
+
+def motion_rotor(frame: PrincipalFrame, classification: Classification) -> RotorClass:
+    """The rotor class whose motion is computed: the classification's only where its moments agree to rounding.
+
+    The classification labels the body with its own ``tolerance``; the motion
+    uses a closed form (symmetric, spherical, linear) only for moments equal
+    within ``MOTION_ROUNDING`` (or the classification's tolerance, if smaller).
+    Otherwise the class is decided again at that level, so a nearly symmetric
+    top moves as the asymmetric top it is.
+    """
+    from ..classification import classify
+
+    level = min(MOTION_ROUNDING, classification.tolerance)
+    if classification.tolerance <= level:
+        return classification.rotor
+    return classify(frame, level).rotor
+
+
+def _principal_axis_of(omega_body: Array, rel: float) -> int | None:
+    """Index of the principal axis Omega lies along (within ``rel`` |Omega|), else None."""
+    limit = rel * float(np.linalg.norm(omega_body))
+    big = np.abs(omega_body) > limit
+    return int(np.argmax(big)) if int(big.sum()) == 1 else None
+
+
+def _snap(problem: RigidProblem, axis: int | None, zero: int | None) -> RigidProblem:
+    """Remove the rounding-level components that made the rotation permanent."""
+    omega = problem.omega_body.copy()
+    if axis is not None:
+        kept = omega[axis]
+        omega[:] = 0.0
+        omega[axis] = kept
+    if zero is not None:
+        omega[zero] = 0.0
+    return replace(problem, omega_body=omega)
