@@ -83,7 +83,7 @@ def _descendants(pid: int) -> list[int]:
 
 @pytest.fixture(scope="module")
 def fuzz_server(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Any]:
-    from api.conftest import LiveServer
+    from tests.api.conftest import LiveServer
 
     tmp = tmp_path_factory.mktemp("fuzz-tmp")
     (Path(__file__).resolve().parents[2] / ".pytest_cache").mkdir(exist_ok=True)
