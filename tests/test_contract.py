@@ -37,10 +37,10 @@ import mpmath
 import numpy as np
 import pytest
 from fastapi.testclient import TestClient
-from scipy.integrate import solve_ivp
 from scipy.special import ellipk
 
 from benchmarks.cases import stl_bytes
+from tests.support.motion import euler_reference
 
 with warnings.catch_warnings():
     warnings.simplefilter("ignore")
@@ -280,30 +280,14 @@ def ll_asymmetric_period(I: Any, Omega: Any) -> float:
 
 
 def reference_motion(moments: Any, axes: Any, omega0: Any, times: Any) -> Any:
-    """Independent torque-free motion: Euler's equations for Ω (principal frame) and
-    dB/dt = B [Ω]x for B(t), the map principal frame -> fixed input frame (B(0) = axesᵀ).
-    Returns (Ω(t), ω(t) = B Ω, R(t) = B(t) axes)."""
-    I = np.asarray(moments, float)
+    """Independent torque-free motion (``tests.support.motion.euler_reference``: Euler's equations and
+    dR/dt = R [Ω]x by DOP853 at rtol 1e-12) with B(t) = axesᵀ R(t), the map principal frame -> fixed
+    input frame. Returns (Ω(t), ω(t) = B Ω, R(t) = B(t) axes)."""
     A = np.asarray(axes, float)
-    W0 = A @ np.asarray(omega0, float)
-
-    def f(_t: Any, y: Any) -> Any:
-        W, B = y[:3], y[3:].reshape(3, 3)
-        dW = np.array([(I[1] - I[2]) * W[1] * W[2] / I[0],
-                       (I[2] - I[0]) * W[2] * W[0] / I[1],
-                       (I[0] - I[1]) * W[0] * W[1] / I[2]])
-        return np.concatenate([dW, (B @ hat(W)).ravel()])
-
-    y0 = np.concatenate([W0, A.T.ravel()])
-    scale = max(1.0, float(np.linalg.norm(W0)))
-    sol = solve_ivp(f, (times[0], times[-1]), y0, method="DOP853", t_eval=times,
-                    rtol=1e-12, atol=1e-13 * scale)
-    assert sol.success
-    Ws = sol.y[:3].T
-    Bs = sol.y[3:].T.reshape(-1, 3, 3)
+    Ws, Rs_body = euler_reference(moments, A @ np.asarray(omega0, float), np.asarray(times, float))
+    Bs = A.T @ Rs_body
     omegas = np.einsum("nij,nj->ni", Bs, Ws)
-    Rs = Bs @ A
-    return Ws, omegas, Rs
+    return Ws, omegas, Bs @ A
 
 
 # ----------------------------------------------------------------------------------------

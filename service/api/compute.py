@@ -29,6 +29,7 @@ input that needs more fails with ``MemoryError`` (413) in that process only.
 from __future__ import annotations
 
 import asyncio
+import importlib
 import logging
 import math
 import multiprocessing
@@ -71,6 +72,7 @@ log = logging.getLogger("inertia.api")
 
 PRELOAD = [f"{_ROOT}.api.jobs", f"{_ROOT}.report", f"{_ROOT}.load.stl", f"{_ROOT}.load.meshes", f"{_ROOT}.motion"]
 KILL_GRACE_S = 5.0  # how long to wait for a killed process to be reaped
+START_TIMEOUT_S = 60.0  # how long a new compute process may take to import what jobs need
 
 
 class WorkerCrashError(RuntimeError):
@@ -118,7 +120,13 @@ def _memory_bounded(limit: int | None) -> Iterator[None]:
 
 
 def _serve_jobs(conn: Connection) -> None:
-    """Main loop of a compute process: receive a job, send back its outcome."""
+    """Main loop of a compute process: say it is ready, then receive a job, send back its outcome."""
+    # What a job needs is imported before the process counts as started, so a job's deadline never pays for
+    # it: the forkserver is one per parent process and may have been started by someone else (the batch
+    # engine) without these modules preloaded, which made a replacement's first job seconds long.
+    for name in PRELOAD:
+        importlib.import_module(name)
+    conn.send(("ready", os.getpid()))
     while True:
         try:
             job = conn.recv()
@@ -169,6 +177,17 @@ class _Worker:
             self.process.start()
         child.close()
         self.conn = parent
+        # start() returns once the process exists; wait until it has imported what jobs need and said so,
+        # so that starting it (not counted against a job's deadline) really is over before a job is sent
+        try:
+            ready = parent.poll(START_TIMEOUT_S) and parent.recv()[0] == "ready"
+        except (EOFError, OSError):
+            ready = False
+        if not ready:
+            self.kill()
+            parent.close()
+            raise WorkerCrashError(f"compute process did not start within {START_TIMEOUT_S:g} s "
+                                   f"(exit code {self.process.exitcode})")
 
     def call(self, job: Job) -> tuple[str, Any]:
         try:

@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import json
 import os
-import socket
 import threading
 import time
 import warnings
@@ -25,6 +24,7 @@ import pytest
 from inertia.api import Settings, create_app
 from tests.fuzz import hostile as H
 from tests.support.meshes import box_stl, torus_stl
+from tests.support.server import free_port
 
 with warnings.catch_warnings():
     warnings.filterwarnings("ignore", message="Using `httpx` with `starlette.testclient`")
@@ -203,12 +203,6 @@ def test_formats_lists_only_readable_formats(client: Any) -> None:
 
 # --- a real server: connections, temporary files, memory ------------------------------------------------
 
-def _free_port() -> int:
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return int(s.getsockname()[1])
-
-
 @pytest.fixture
 def buggy_server() -> Iterator[str]:
     """A uvicorn server in this process with one route that fails like a bug."""
@@ -220,7 +214,7 @@ def buggy_server() -> Iterator[str]:
     async def boom() -> None:
         raise RuntimeError("a bug")
 
-    port = _free_port()
+    port = free_port()
     server = uvicorn.Server(uvicorn.Config(app, host="127.0.0.1", port=port, log_level="critical"))
     thread = threading.Thread(target=server.run, daemon=True)
     thread.start()

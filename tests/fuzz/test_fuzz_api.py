@@ -89,7 +89,7 @@ def fuzz_server(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Any]:
     (Path(__file__).resolve().parents[2] / ".pytest_cache").mkdir(exist_ok=True)
     server = LiveServer({"INERTIA_TIMEOUT_S": str(TIMEOUT_S), "INERTIA_COMPUTE_PROCESSES": "2",
                          "INERTIA_MAX_UPLOAD_BYTES": str(MAX_UPLOAD), "TMPDIR": str(tmp)})
-    server.tmp = tmp
+    server.tmp = tmp  # type: ignore[attr-defined]  # where the test looks for leftover files
     try:
         yield server
     finally:
