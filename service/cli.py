@@ -21,6 +21,7 @@ from __future__ import annotations
 import argparse
 import gc
 import json
+import os
 import re
 import sys
 from collections.abc import Sequence
@@ -267,25 +268,51 @@ def _batch(args: argparse.Namespace) -> int:
     """``inertia batch``: run, print a one-line summary to stderr, exit 0.
 
     Files that fail are rows of the output, not a failure of the run; a bad
-    option or a missing extra raises ``InvalidParameterError`` (exit 2).
+    option or a missing extra raises ``InvalidParameterError`` (exit 2).  The
+    output's folder is made when missing; on Ctrl-C the rows written so far
+    stay, and one line says how ``--resume`` continues.
     """
+    if not _output_folder_ready(args.out):
+        return EXIT_ENVIRONMENT
     if args.scheduler is None:  # a local cluster: its workers' imports start now, beside this process's
         from .batch.workers import start_forkserver
 
         start_forkserver()
     from .batch import run_batch
 
-    summary = run_batch(
-        args.paths,
-        args.out,
-        options_from_args(args),
-        resume=args.resume,
-        workers=args.workers,
-        scheduler=args.scheduler,
-        progress=not args.no_progress,
-    )
+    try:
+        summary = run_batch(
+            args.paths,
+            args.out,
+            options_from_args(args),
+            resume=args.resume,
+            workers=args.workers,
+            scheduler=args.scheduler,
+            progress=not args.no_progress,
+        )
+    except KeyboardInterrupt:
+        print(f"\ninterrupted: the rows written so far are kept in {args.out}; run the same command with --resume "
+              "to analyse the rest", file=sys.stderr)
+        return EXIT_INTERRUPTED
     print(summary.as_text(), file=sys.stderr)
     return 0
+
+
+def _output_folder_ready(out: str) -> bool:
+    """Make the output's folder if it is missing; say why in one sentence when it cannot be written."""
+    if "://" in out:  # a remote output: its filesystem says
+        return True
+    folder = os.path.dirname(os.path.abspath(out))
+    try:
+        os.makedirs(folder, exist_ok=True)
+    except OSError as exc:
+        print(f"error: cannot create the output folder {folder!r}: {exc.strerror}; choose another --out",
+              file=sys.stderr)
+        return False
+    if not os.access(folder, os.W_OK):
+        print(f"error: the output folder {folder!r} is not writable; choose another --out", file=sys.stderr)
+        return False
+    return True
 
 
 def _port_free(host: str, port: int) -> bool:

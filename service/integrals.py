@@ -25,7 +25,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ["Sums", "simplex_sums", "point_sums", "local_origin", "CHUNK"]
+__all__ = ["Sums", "simplex_sums", "point_sums", "local_origin", "CHUNK", "point_records", "gather_corners"]
 
 CHUNK = 1 << 15  # elements per vectorised block: its (n,) temporaries (256 KB each) stay in cache
 
@@ -98,7 +98,23 @@ def _measure(corners: list[Vec], kind: str) -> tuple[NDArray[np.float64], NDArra
     return twice_area, twice_area
 
 
-def _block_sums(xyz: Vec, cells: NDArray[np.int64], kind: str,
+def point_records(points: NDArray[np.float64]) -> NDArray[np.void]:
+    """The rows of an (n, 3) float64 array as n opaque 24-byte records, for ``gather_corners``."""
+    return np.ascontiguousarray(points, dtype=np.float64).view(np.dtype((np.void, 24))).reshape(-1)
+
+
+def gather_corners(records: NDArray[np.void], cells: NDArray[np.int64]) -> list[Vec]:
+    """corners[k][j]: coordinate j of corner k of each cell, each a contiguous (n,) row.
+
+    Each corner is gathered once as one 24-byte record (one random access per
+    corner instead of three), then the coordinates are split into rows.
+    """
+    block = records.take(cells).view(np.float64).reshape(len(cells), cells.shape[1], 3)
+    rows = block.transpose(1, 2, 0).copy()  # (corners, 3, n)
+    return [list(rows[k]) for k in range(cells.shape[1])]
+
+
+def _block_sums(xyz: NDArray[np.void], cells: NDArray[np.int64], kind: str,
                 weight: NDArray[np.float64] | None) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """Sums over one block of simplices of every row, and of their absolute values.
 
@@ -106,7 +122,7 @@ def _block_sums(xyz: Vec, cells: NDArray[np.int64], kind: str,
     array of terms, summed row by row (numpy's pairwise summation along each
     contiguous row, the same as summing each row alone) in one call.
     """
-    corners = [[x.take(cells[:, k]) for x in xyz] for k in range(cells.shape[1])]
+    corners = gather_corners(xyz, cells)
     raw, cond = _measure(corners, kind)
     f0, f1, f2 = _FACTORS[kind]
     dm = raw * f0
@@ -148,7 +164,7 @@ def simplex_sums(
 ) -> Sums:
     """Integrals of the simplices ``points[cells]``: "apex" (faces of a closed
     surface, each with the origin), "tet" (volume cells) or "tri" (area)."""
-    xyz = [np.ascontiguousarray(points[:, k]) for k in range(3)]
+    xyz = point_records(points)
     starts = range(0, len(cells), CHUNK)
     per_block = np.empty((2, ROWS, len(starts)))
     for b, start in enumerate(starts):

@@ -35,7 +35,7 @@ __all__ = [
 ]
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, kw_only=True)
 class Source:
     """The ``source`` section: what was read, how, and how many elements it had.
 
@@ -49,20 +49,20 @@ class Source:
     parts : the number of parts of a scene or assembly (absent for one body).
     """
 
+    filename: str | None = None
     format: str
     kind: str
     units: str
     units_from: str
-    filename: str | None = None
-    geometry: str | None = None
-    solids: int | None = None
-    deflection: float | None = None
     vertices: int | None = None
     triangles: int | None = None
     watertight: bool | None = None
     points: int | None = None
     tetrahedra: int | None = None
     cells: int | None = None
+    geometry: str | None = None
+    solids: int | None = None
+    deflection: float | None = None
     parts: int | None = None
 
     # the order of the keys in the JSON: the identity, then what the kind of input counts

@@ -16,7 +16,6 @@ from .jobs import Job, MeshJob, PointsJob, PrecessionJob, is_small, run_job
 from .ndjson import batch_lines
 from .schemas import (
     AnalysisOut,
-    ErrorOut,
     FormatOut,
     FormatsOut,
     HealthOut,
@@ -25,6 +24,7 @@ from .schemas import (
     PrecessionRequest,
     PrecessionResponse,
     UnavailableFormatOut,
+    error_responses,
 )
 from .settings import Settings
 from .uploads import Upload, Workspace, client_name, expand, save
@@ -56,18 +56,20 @@ MeshFiles = Annotated[list[UploadFile], File(description="mesh files, or one .zi
 health = APIRouter()
 v1 = APIRouter(prefix="/v1")
 
-_UNSUPPORTED: dict[int | str, dict[str, Any]] = {415: {"model": ErrorOut, "description": "unsupported_format"}}
+# the error statuses each endpoint can answer (401 is added to every /v1 route when a key is configured)
+_ANALYSIS_ERRORS = error_responses(413, 422, 500, 503)
+_MESH_ERRORS = error_responses(413, 415, 422, 500, 503)
 _CURL = ("Example (from the repository root):\n\n"
          "    curl -F file=@sample_meshes/box.stl 'http://localhost:8000/v1/analyze/mesh?units=m&density=1000'")
 
 
-@health.get("/healthz", response_model=HealthOut, tags=["service"])
+@health.get("/healthz", response_model=HealthOut, tags=["service"], responses=error_responses(500))
 async def healthz() -> dict[str, str]:
     """Liveness: answers at once, whatever the compute pool is doing."""
     return {"status": "ok"}
 
 
-@v1.get("/formats", response_model=FormatsOut, tags=["service"])
+@v1.get("/formats", response_model=FormatsOut, tags=["service"], responses=error_responses(500))
 async def formats() -> FormatsOut:
     """The formats this installation can read, and which hold surfaces, volume cells, or scenes of several parts.
 
@@ -88,7 +90,7 @@ async def formats() -> FormatsOut:
 
 
 @v1.post("/analyze/mesh", response_model=AnalysisOut, response_model_exclude_none=True,
-         responses=_UNSUPPORTED, tags=["analysis"], description=_CURL)
+         responses=_MESH_ERRORS, tags=["analysis"], description=_CURL)
 async def analyze_mesh(file: MeshFile, query: Options, pool: Pool, settings: Config,
                        workspace: Folders) -> dict[str, Any]:
     """Mass properties, principal frame and class of one uploaded mesh (and its precession with omega)."""
@@ -112,21 +114,24 @@ async def _small_or_pooled(job: Job, pool: ComputePool) -> dict[str, Any]:
     return run_job(job) if is_small(job) else await pool.run(job)
 
 
-@v1.post("/analyze/points", response_model=AnalysisOut, response_model_exclude_none=True, tags=["analysis"])
+@v1.post("/analyze/points", response_model=AnalysisOut, response_model_exclude_none=True, tags=["analysis"],
+         responses=_ANALYSIS_ERRORS)
 async def analyze_points(body: PointsRequest, pool: Pool) -> dict[str, Any]:
     """Mass properties, principal frame and class of point masses."""
     return await _small_or_pooled(PointsJob(body.records(), body.as_options()), pool)
 
 
-@v1.post("/precession", response_model=PrecessionResponse, response_model_exclude_none=True, tags=["analysis"])
+@v1.post("/precession", response_model=PrecessionResponse, response_model_exclude_none=True, tags=["analysis"],
+         responses=_ANALYSIS_ERRORS)
 async def precession(body: PrecessionRequest, pool: Pool) -> dict[str, Any]:
     """Torque-free motion of a body of known inertia."""
     return await _small_or_pooled(PrecessionJob(body.arguments()), pool)
 
 
 @v1.post("/batch", tags=["analysis"], responses={200: {
-    "description": "one line per file, in upload order: an analysis result or {source, error}",
-    "content": {"application/x-ndjson": {"schema": {"type": "string"}}}}})
+    "description": "one line per file, in upload order: an analysis result (AnalysisOut) or "
+                   "{\"source\": {\"filename\": ...}, \"error\": {...}} (the envelope)",
+    "content": {"application/x-ndjson": {"schema": {"type": "string"}}}}, **_ANALYSIS_ERRORS})
 async def batch(files: MeshFiles, query: Options, pool: Pool, settings: Config,
                 workspace: Folders) -> StreamingResponse:
     """Many meshes (or one .zip of them), streamed as NDJSON lines as each result is ready."""
