@@ -24,8 +24,10 @@ BOX = ROOT / "sample_meshes" / "box.stl"
 
 
 def inertia(*args: str, **kwargs: object) -> subprocess.CompletedProcess[str]:
-    return subprocess.run([sys.executable, "-m", "inertia", "batch", *args], capture_output=True, text=True,
-                          timeout=300, **kwargs)  # type: ignore[call-overload]
+    run: subprocess.CompletedProcess[str] = subprocess.run(  # type: ignore[call-overload]
+        [sys.executable, "-m", "inertia", "batch", *args], capture_output=True, text=True, timeout=300, **kwargs
+    )
+    return run
 
 
 def test_a_missing_output_folder_is_made(tmp_path: Path) -> None:
