@@ -13,7 +13,7 @@ from dataclasses import dataclass
 from .conventions import length_scale
 from .errors import InvalidParameterError
 from .tolerances import DEFAULT_TOLERANCES
-from .vocabulary import METHODS, MODELS, Model
+from .vocabulary import METHODS, MODELS, Model, MotionMethod
 
 __all__ = ["AnalysisOptions", "METHODS"]
 
@@ -55,7 +55,7 @@ class AnalysisOptions:
     omega: tuple[float, float, float] | None = None
     duration: float | None = None
     samples: int | None = None
-    method: str = "exact"
+    method: str = MotionMethod.EXACT.value
     densities: Mapping[str, float] | None = None
     geometry: str = "brep"
     deflection: float | None = None

@@ -26,6 +26,7 @@ from ..conventions import DEFAULT_DENSITY
 from ..errors import InvalidParameterError
 from ..surface import SURFACE_AREA_KEY
 from ..tolerances import EPS
+from ..vocabulary import Model
 from .read import CAD_FORMATS, DEFAULT_DEFLECTION, GEOMETRIES, read_cad_parts
 
 if TYPE_CHECKING:
@@ -37,13 +38,13 @@ __all__ = ["CAD_FORMATS", "GEOMETRIES", "DEFAULT_DEFLECTION", "read_cad_parts", 
 
 
 def brep_mass_properties(body: BrepBody, *, density: float | None = None, mass: float | None = None,
-                         model: str = "solid") -> MassProperties:
+                         model: str = Model.SOLID) -> MassProperties:
     """Mass properties of one B-rep solid, SI units; density kg/m^3 (default 1000) or a total ``mass`` kg."""
     from ..eigen import jacobi_eigh
     from ..mass import InertiaTensor, MassProperties
     from . import occ
 
-    if model != "solid":
+    if model != Model.SOLID:
         raise InvalidParameterError("a CAD solid is integrated as a solid; model=shell applies to surface meshes",
                                     parameter="model")
     integral = occ.integrate(body.solid)
