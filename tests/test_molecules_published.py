@@ -76,8 +76,9 @@ def constants_cm(atoms: Atoms) -> np.ndarray:
     return cast("np.ndarray", PLANCK / (8 * math.pi**2 * SPEED_OF_LIGHT * moments) / 100)
 
 
-def rounding_tolerance(build: Any, params: list[float], last_place: list[float], table: np.ndarray,
-                       table_place: float) -> np.ndarray:
+def rounding_tolerance(
+    build: Any, params: list[float], last_place: list[float], table: np.ndarray, table_place: float
+) -> np.ndarray:
     """Relative tolerance per constant from half a unit in each published last place."""
     base = constants_cm(build(*params))
     spread = np.zeros_like(base)
@@ -97,8 +98,7 @@ H2CO_TABLE_PLACE = 0.00001
 
 def test_formaldehyde_matches_the_cccbdb_table_to_its_precision(client: Any) -> None:
     atoms = formaldehyde(*H2CO_GEOMETRY)
-    body = {"points": [{"element": e, "position": p} for e, p in atoms], "units": "angstrom",
-            "isotopes": "abundant"}
+    body = {"points": [{"element": e, "position": p} for e, p in atoms], "units": "angstrom", "isotopes": "abundant"}
     r = client.post("/v1/analyze/points", json=body)
     assert r.status_code == 200, r.text
     doc = r.json()

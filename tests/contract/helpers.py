@@ -29,10 +29,11 @@ RHO = 1000.0  # default density [kg/m^3] (API.md)
 
 UNIT_SCALE = {"m": 1.0, "cm": 1e-2, "mm": 1e-3, "um": 1e-6, "in": 0.0254, "ft": 0.3048}
 
+
 def post_mesh(client: TestClient, filename: str, data: bytes, **params: Any) -> Any:
     q = {k: (v if isinstance(v, str) else str(v)) for k, v in params.items()}
-    return client.post("/v1/analyze/mesh", files={"file": (filename, data, "application/octet-stream")},
-                       params=q)
+    return client.post("/v1/analyze/mesh", files={"file": (filename, data, "application/octet-stream")}, params=q)
+
 
 def analyze(client: TestClient, filename: str, data: bytes | None = None, **params: Any) -> dict[str, Any]:
     if data is None:
@@ -42,6 +43,7 @@ def analyze(client: TestClient, filename: str, data: bytes | None = None, **para
     body = r.json()
     assert_no_nulls(body)
     return cast("dict[str, Any]", body)
+
 
 def assert_error(r: Any, status: int, code: str) -> dict[str, Any]:
     assert r.status_code == status, (r.status_code, r.text)
@@ -53,6 +55,7 @@ def assert_error(r: Any, status: int, code: str) -> dict[str, Any]:
     assert isinstance(err["message"], str) and err["message"].strip(), err
     assert isinstance(err["details"], dict), err
     return cast("dict[str, Any]", err)
+
 
 def assert_no_nulls(obj: Any, path: str = "$") -> None:
     if obj is None:
@@ -66,6 +69,7 @@ def assert_no_nulls(obj: Any, path: str = "$") -> None:
     elif isinstance(obj, float):
         assert math.isfinite(obj), f"non-finite number at {path}"
 
+
 def strip_elapsed(obj: Any) -> Any:
     if isinstance(obj, dict):
         return {k: strip_elapsed(v) for k, v in obj.items() if k != "elapsed_s"}
@@ -73,15 +77,29 @@ def strip_elapsed(obj: Any) -> Any:
         return [strip_elapsed(v) for v in obj]
     return obj
 
-BOX_FACES = np.array([
-    [0, 1, 3], [0, 3, 2], [4, 6, 7], [4, 7, 5],
-    [0, 4, 5], [0, 5, 1], [2, 3, 7], [2, 7, 6],
-    [0, 2, 6], [0, 6, 4], [1, 5, 7], [1, 7, 3],
-])
+
+BOX_FACES = np.array(
+    [
+        [0, 1, 3],
+        [0, 3, 2],
+        [4, 6, 7],
+        [4, 7, 5],
+        [0, 4, 5],
+        [0, 5, 1],
+        [2, 3, 7],
+        [2, 7, 6],
+        [0, 2, 6],
+        [0, 6, 4],
+        [1, 5, 7],
+        [1, 7, 3],
+    ]
+)
+
 
 def box_corners(a: float, b: float, c: float) -> np.ndarray:
     """Corners of [0,a]x[0,b]x[0,c], indexed so that BOX_FACES wind outward."""
     return np.array([[x, y, z] for x in (0, a) for y in (0, b) for z in (0, c)], dtype=np.float64)
+
 
 def obj_bytes(objects: list[tuple[str | None, np.ndarray, np.ndarray]]) -> bytes:
     """OBJ text, float64 coordinates written with repr (exact round trip)."""
@@ -94,11 +112,12 @@ def obj_bytes(objects: list[tuple[str | None, np.ndarray, np.ndarray]]) -> bytes
         base += len(v)
     return ("\n".join(lines) + "\n").encode()
 
+
 def read_stl_triangles(data: bytes) -> np.ndarray:
     (n,) = struct.unpack("<I", data[80:84])
-    rec = np.frombuffer(data[84:84 + 50 * n],
-                        dtype=[("n", "<f4", 3), ("v", "<f4", (3, 3)), ("a", "<u2")])
+    rec = np.frombuffer(data[84 : 84 + 50 * n], dtype=[("n", "<f4", 3), ("v", "<f4", (3, 3)), ("a", "<u2")])
     return rec["v"].astype(np.float64)
+
 
 def read_obj_triangles(data: bytes) -> np.ndarray:
     verts, tris = [], []
@@ -114,6 +133,7 @@ def read_obj_triangles(data: bytes) -> np.ndarray:
                 tris.append([idx[0], idx[k], idx[k + 1]])
     return cast("np.ndarray", np.asarray(verts)[np.asarray(tris)])
 
+
 def exact_mass_properties(triangles: np.ndarray, density: float = RHO) -> Any:
     """Exact rational mass, centre of mass and inertia tensor (about the COM) of the closed
     polyhedron with these triangles (divergence theorem, tetrahedra from the origin:
@@ -124,8 +144,7 @@ def exact_mass_properties(triangles: np.ndarray, density: float = RHO) -> Any:
     S2 = [[F(0)] * 3 for _ in range(3)]
     for tri in triangles:
         a, b, c = ([F(float(x)) for x in p] for p in tri)
-        det = (a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0])
-               + a[2] * (b[0] * c[1] - b[1] * c[0]))
+        det = a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0]) + a[2] * (b[0] * c[1] - b[1] * c[0])
         vol = det / 6
         s = [a[i] + b[i] + c[i] for i in range(3)]
         V += vol
@@ -142,23 +161,28 @@ def exact_mass_properties(triangles: np.ndarray, density: float = RHO) -> Any:
     inertia = [[(tr if i == j else 0) - C[i][j] for j in range(3)] for i in range(3)]
     return rho * V, com, inertia, V
 
+
 def exact_moments(inertia: list[list[Fraction]]) -> list[float]:
     with mpmath.workdps(50):
         m = mpmath.matrix([[mpmath.mpf(x.numerator) / x.denominator for x in row] for row in inertia])
         ev, _ = mpmath.eigsy(m)
         return sorted(float(ev[i]) for i in range(3))
 
+
 def exact_of(filename: str, data: bytes | None = None) -> Any:
     data = data if data is not None else (SAMPLES / filename).read_bytes()
     tris = read_stl_triangles(data) if filename.endswith(".stl") else read_obj_triangles(data)
     return exact_mass_properties(tris)
 
+
 def parallel_axis(I_com: np.ndarray, mass: float, d: np.ndarray) -> np.ndarray:
     d = np.asarray(d, float)
     return cast("np.ndarray", I_com + mass * (d @ d * np.eye(3) - np.outer(d, d)))
 
+
 def box_inertia(m: float, a: float, b: float, c: float) -> np.ndarray:
     return m / 12 * np.diag([b * b + c * c, a * a + c * c, a * a + b * b])
+
 
 def rotation(axis: Any, angle: float) -> np.ndarray:
     u = np.asarray(axis, float)
@@ -166,21 +190,27 @@ def rotation(axis: Any, angle: float) -> np.ndarray:
     K = hat(u)
     return cast("np.ndarray", np.eye(3) + math.sin(angle) * K + (1 - math.cos(angle)) * K @ K)
 
+
 def hat(w: Any) -> np.ndarray:
     return np.array([[0, -w[2], w[1]], [w[2], 0, -w[0]], [-w[1], w[0], 0]], dtype=float)
 
+
 def quat_matrix(q: Any) -> np.ndarray:
     w, x, y, z = np.asarray(q, float) / np.linalg.norm(q)
-    return np.array([
-        [1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
-        [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
-        [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)],
-    ])
+    return np.array(
+        [
+            [1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
+            [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
+            [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)],
+        ]
+    )
+
 
 def ray_kappa(moments: Any) -> float:
     I1, I2, I3 = moments
     A, B, C = 1 / I1, 1 / I2, 1 / I3
     return cast("float", (2 * B - A - C) / (A - C))
+
 
 def reference_motion(moments: Any, axes: Any, omega0: Any, times: Any) -> Any:
     """Independent torque-free motion (``tests.support.motion.euler_reference``: Euler's equations and
@@ -191,6 +221,7 @@ def reference_motion(moments: Any, axes: Any, omega0: Any, times: Any) -> Any:
     Bs = A.T @ Rs_body
     omegas = np.einsum("nij,nj->ni", Bs, Ws)
     return Ws, omegas, Bs @ A
+
 
 def check_principal(res: dict[str, Any], tensor: np.ndarray | None = None) -> None:
     p = res["principal"]
@@ -213,8 +244,10 @@ def check_principal(res: dict[str, Any], tensor: np.ndarray | None = None) -> No
         for k in range(3):  # rows are eigenvectors with the moments in the same order
             np.testing.assert_allclose(tensor @ A[k], I[k] * A[k], atol=1e-11 * scale)
 
-def check_classification(res: dict[str, Any], kind: str, shape: str | None = None,
-                         planar: bool | None = None, tolerance: float = 1e-6) -> None:
+
+def check_classification(
+    res: dict[str, Any], kind: str, shape: str | None = None, planar: bool | None = None, tolerance: float = 1e-6
+) -> None:
     c = res["classification"]
     assert c["kind"] == kind, c
     assert c["tolerance"] == tolerance
@@ -239,7 +272,8 @@ def check_classification(res: dict[str, Any], kind: str, shape: str | None = Non
     unique_axes = kind == "asymmetric_top"
     assert res["principal"]["unique_axes"] is unique_axes
 
-def thin_box_shell_inertia(a: float, b: float, c: float, sigma: float, faces: Any=("x0", "x1", "y0", "y1", "z0", "z1")) -> Any:
+
+def thin_box_shell_inertia(a: float, b: float, c: float, sigma: float, faces: Any = ("x0", "x1", "y0", "y1", "z0", "z1")) -> Any:
     """Inertia about the COM of the faces of [0,a]x[0,b]x[0,c] as laminae of areal density
     sigma (rectangle p x q: I_normal = m(p²+q²)/12, in-plane m q²/12, m p²/12)."""
     dims = np.array([a, b, c], float)
@@ -261,18 +295,22 @@ def thin_box_shell_inertia(a: float, b: float, c: float, sigma: float, faces: An
     total = sum(parallel_axis(I, m, c - com) for m, c, I in items)
     return M, com, total
 
+
 def two_cube_obj() -> bytes:
     cube = box_corners(1, 1, 1)
     return obj_bytes([("left", cube, BOX_FACES), ("right", cube + np.array([2, 0, 0]), BOX_FACES)])
 
+
 def truncated_stl() -> bytes:
     data = (SAMPLES / "box.stl").read_bytes()
-    return data[:80] + struct.pack("<I", 1000) + data[84:84 + 100]
+    return data[:80] + struct.pack("<I", 1000) + data[84 : 84 + 100]
+
 
 def post_points(client: TestClient, body: dict[str, Any] | str) -> Any:
     if isinstance(body, str):
         return client.post("/v1/analyze/points", content=body, headers={"content-type": "application/json"})
     return client.post("/v1/analyze/points", json=body)
+
 
 def points_ok(client: TestClient, body: Any) -> dict[str, Any]:
     r = post_points(client, body)
@@ -281,21 +319,28 @@ def points_ok(client: TestClient, body: Any) -> dict[str, Any]:
     assert_no_nulls(res)
     return cast("dict[str, Any]", res)
 
+
 TRIATOMIC = json.loads((SAMPLES / "triatomic.json").read_text())
+
 
 def post_precession(client: TestClient, body: Any) -> Any:
     if isinstance(body, str):
         return client.post("/v1/precession", content=body, headers={"content-type": "application/json"})
     return client.post("/v1/precession", json=body)
 
+
 def precession_ok(client: TestClient, body: Any) -> dict[str, Any]:
     r = post_precession(client, body)
     assert r.status_code == 200, r.text
     res = r.json()
     assert_no_nulls(res)
-    assert {"principal", "classification", "precession", "diagnostics"} <= set(res) <= {
-        "principal", "classification", "precession", "diagnostics", "warnings"}, set(res)
+    assert (
+        {"principal", "classification", "precession", "diagnostics"}
+        <= set(res)
+        <= {"principal", "classification", "precession", "diagnostics", "warnings"}
+    ), set(res)
     return cast("dict[str, Any]", res)
+
 
 def check_invariants(pre: dict[str, Any], I_input: np.ndarray, omega0: Any) -> None:
     w = np.asarray(omega0, float)
@@ -305,12 +350,13 @@ def check_invariants(pre: dict[str, Any], I_input: np.ndarray, omega0: Any) -> N
     assert pre["angular_momentum_magnitude"] == pytest.approx(np.linalg.norm(M), rel=1e-13, abs=1e-300)
     assert pre["kinetic_energy"] == pytest.approx(0.5 * w @ I_input @ w, rel=1e-13, abs=1e-300)
 
+
 def check_symmetric_rates(pre: dict[str, Any], I_perp: float, I_sym: float, n: Any, omega0: Any) -> None:
     """L&L §33: ω = Ω3(I3 − I1)/I1, |M|/I1, ψ̇ = |M| cos θ (1/I3 − 1/I1), cos θ = I3 Ω3/|M|."""
     W3 = float(np.asarray(n, float) @ np.asarray(omega0, float))
     W = np.asarray(omega0, float)
     W_perp2 = W @ W - W3 * W3
-    M = math.sqrt((I_sym * W3) ** 2 + I_perp ** 2 * W_perp2)
+    M = math.sqrt((I_sym * W3) ** 2 + I_perp**2 * W_perp2)
     body = W3 * (I_sym - I_perp) / I_perp
     cos_theta = I_sym * W3 / M
     assert pre["regime"] == "regular_precession"
@@ -320,7 +366,10 @@ def check_symmetric_rates(pre: dict[str, Any], I_perp: float, I_sym: float, n: A
     assert pre["nutation_angle"] == pytest.approx(math.acos(cos_theta), rel=1e-12)
     assert pre["period"] == pytest.approx(2 * math.pi / abs(body), rel=1e-12)
 
-def check_trajectory(pre: dict[str, Any], moments: Any, axes: Any, omega0: Any, duration: float, samples: int, I_input: Any, tol: float=1e-8) -> None:
+
+def check_trajectory(
+    pre: dict[str, Any], moments: Any, axes: Any, omega0: Any, duration: float, samples: int, I_input: Any, tol: float = 1e-8
+) -> None:
     tr = pre["trajectory"]
     t = np.asarray(tr["t"], float)
     assert len(t) == samples
@@ -342,8 +391,12 @@ def check_trajectory(pre: dict[str, Any], moments: Any, axes: Any, omega0: Any, 
         # omega(t) in the fixed input frame is the rotated body omega
         np.testing.assert_allclose(w[k], R @ A.T @ W[k], rtol=0, atol=max(tol, 1e-12) * wscale)  # type: ignore[call-overload]
         # M stays constant in the fixed frame: I(t) = R I0 Rᵀ
-        np.testing.assert_allclose(R @ I_input @ R.T @ w[k], M0, rtol=0,  # type: ignore[call-overload]
-                                   atol=max(tol, 1e-12) * np.linalg.norm(M0) + 1e-300)
+        np.testing.assert_allclose(
+            R @ I_input @ R.T @ w[k],
+            M0,
+            rtol=0,  # type: ignore[call-overload]
+            atol=max(tol, 1e-12) * np.linalg.norm(M0) + 1e-300,
+        )
     if moments[0] > 0:
         Wr, wr, Rr = reference_motion(moments, A, omega0, t)
         np.testing.assert_allclose(W, Wr, rtol=0, atol=tol * wscale)  # type: ignore[call-overload]
@@ -354,17 +407,24 @@ def check_trajectory(pre: dict[str, Any], moments: Any, axes: Any, omega0: Any, 
     for key in ("energy_drift", "momentum_drift"):
         assert d[key] >= 0 and math.isfinite(d[key])
 
+
 def two_box_scene() -> Any:
     import trimesh  # a writer only: the expected values below are closed formulas
 
     tf = trimesh.transformations
     scene = trimesh.Scene()
-    scene.add_geometry(trimesh.creation.box([1, 2, 3]), node_name="alpha", geom_name="g_alpha",
-                       transform=tf.translation_matrix([5, 0, 0]))
+    scene.add_geometry(
+        trimesh.creation.box([1, 2, 3]), node_name="alpha", geom_name="g_alpha", transform=tf.translation_matrix([5, 0, 0])
+    )
     rot = tf.rotation_matrix(0.5, [1, 0, 0])
-    scene.add_geometry(trimesh.creation.box([1, 1, 2]), node_name="beta", geom_name="g_beta",
-                       transform=tf.concatenate_matrices(tf.translation_matrix([0, 4, 0]), rot))
+    scene.add_geometry(
+        trimesh.creation.box([1, 1, 2]),
+        node_name="beta",
+        geom_name="g_beta",
+        transform=tf.concatenate_matrices(tf.translation_matrix([0, 4, 0]), rot),
+    )
     return scene, rot[:3, :3]
+
 
 TWO_CUBES_MOMENTS = [1500.0, 1500 + 1000 * (0.5 - 12.5 / 9) ** 2 + 8000 * (1.5 - 12.5 / 9) ** 2] * 1
 

@@ -23,7 +23,9 @@ def ndjson_lines(r: Any) -> list[dict[str, Any]]:
         assert_no_nulls(line)
     return lines
 
+
 BATCH_FILES = ["box.stl", "open_box.stl", "tetrahedron.stl", "l_bracket.stl"]
+
 
 def check_batch_lines(client: TestClient, lines: list[dict[str, Any]], params: dict[str, Any]) -> None:
     assert [line["source"]["filename"].rsplit("/", 1)[-1] for line in lines] == BATCH_FILES
@@ -39,6 +41,7 @@ def check_batch_lines(client: TestClient, lines: list[dict[str, Any]], params: d
         want["source"].pop("filename")
         assert got == want
 
+
 def test_batch_streams_one_line_per_file_in_upload_order(client: TestClient) -> None:
     files = [("files", (name, (SAMPLES / name).read_bytes(), "application/octet-stream")) for name in BATCH_FILES]
     r = client.post("/v1/batch", files=files, params={"density": "2000", "reference": "0,0,0"})
@@ -47,33 +50,38 @@ def test_batch_streams_one_line_per_file_in_upload_order(client: TestClient) -> 
     assert lines[0]["mass"] == pytest.approx(12000, rel=1e-14)
     check_batch_lines(client, lines, {"density": "2000", "reference": "0,0,0"})
 
+
 def test_batch_accepts_one_zip_of_files(client: TestClient) -> None:
     buf = io.BytesIO()
     with zipfile.ZipFile(buf, "w") as z:
         for name in BATCH_FILES:
             z.writestr(name, (SAMPLES / name).read_bytes())
     params = {"units": "mm", "omega": "0.1,2,0.1", "duration": "2", "samples": "3"}
-    r = client.post("/v1/batch", files=[("files", ("meshes.zip", buf.getvalue(), "application/zip"))],
-                    params=params)
+    r = client.post("/v1/batch", files=[("files", ("meshes.zip", buf.getvalue(), "application/zip"))], params=params)
     lines = ndjson_lines(r)
     assert len(lines) == 4
     assert lines[0]["mass"] == pytest.approx(6e-6, rel=1e-13)
     assert len(lines[0]["precession"]["trajectory"]["t"]) == 3
     check_batch_lines(client, lines, params)
 
+
 def test_batch_unsupported_and_unreadable_files_are_error_lines(client: TestClient) -> None:
-    files = [("files", ("a.xyz123", b"nothing", "application/octet-stream")),
-             ("files", ("b.stl", truncated_stl(), "application/octet-stream")),
-             ("files", ("c.stl", (SAMPLES / "box.stl").read_bytes(), "application/octet-stream"))]
+    files = [
+        ("files", ("a.xyz123", b"nothing", "application/octet-stream")),
+        ("files", ("b.stl", truncated_stl(), "application/octet-stream")),
+        ("files", ("c.stl", (SAMPLES / "box.stl").read_bytes(), "application/octet-stream")),
+    ]
     lines = ndjson_lines(client.post("/v1/batch", files=files))
     assert [line["source"]["filename"] for line in lines] == ["a.xyz123", "b.stl", "c.stl"]
     assert lines[0]["error"]["code"] == "unsupported_format"
     assert lines[1]["error"]["code"] == "unreadable_file"
     assert lines[2]["mass"] == pytest.approx(6000, rel=1e-14)
 
+
 def test_batch_with_an_invalid_parameter_is_rejected_with_the_envelope(client: TestClient) -> None:
     files = [("files", ("box.stl", (SAMPLES / "box.stl").read_bytes(), "application/octet-stream"))]
     assert_error(client.post("/v1/batch", files=files, params={"units": "parsec"}), 422, "invalid_parameter")
+
 
 def test_batch_keeps_upload_order_with_files_of_very_different_cost(client: TestClient) -> None:
     n, m = 200, 100  # a 40 000-triangle torus next to 12-triangle boxes

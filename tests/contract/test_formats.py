@@ -34,6 +34,7 @@ def test_format_parameter_overrides_the_file_name(client: TestClient) -> None:
     assert res["mass"] == pytest.approx(6000, rel=1e-14)
     assert res["source"]["format"] == "stl"
 
+
 def test_volume_mesh_cell_density_takes_precedence_and_mass_scales_it(client: TestClient) -> None:
     base = analyze(client, "two_density.vtu", density=5)
     assert base["mass"] == pytest.approx(9000, rel=1e-12)
@@ -41,27 +42,36 @@ def test_volume_mesh_cell_density_takes_precedence_and_mass_scales_it(client: Te
     np.testing.assert_allclose(base["center_of_mass"], [12.5 / 9, 0.5, 0.5], rtol=1e-12)
     scaled = analyze(client, "two_density.vtu", mass=18)
     assert scaled["mass"] == pytest.approx(18, rel=1e-12)
-    np.testing.assert_allclose(scaled["principal"]["moments"],
-                               np.array([1500, 21500 / 9, 21500 / 9]) * 18 / 9000, rtol=1e-12)
+    np.testing.assert_allclose(scaled["principal"]["moments"], np.array([1500, 21500 / 9, 21500 / 9]) * 18 / 9000, rtol=1e-12)
     np.testing.assert_allclose(scaled["center_of_mass"], [12.5 / 9, 0.5, 0.5], rtol=1e-12)
 
+
 def ply_ascii(v: np.ndarray, f: np.ndarray) -> bytes:
-    head = ["ply", "format ascii 1.0", f"element vertex {len(v)}", "property double x",
-            "property double y", "property double z", f"element face {len(f)}",
-            "property list uchar int vertex_indices", "end_header"]
+    head = [
+        "ply",
+        "format ascii 1.0",
+        f"element vertex {len(v)}",
+        "property double x",
+        "property double y",
+        "property double z",
+        f"element face {len(f)}",
+        "property list uchar int vertex_indices",
+        "end_header",
+    ]
     body = [" ".join(repr(float(x)) for x in p) for p in v] + ["3 " + " ".join(map(str, t)) for t in f]
     return ("\n".join(head + body) + "\n").encode()
+
 
 def off_ascii(v: np.ndarray, f: np.ndarray) -> bytes:
     lines = ["OFF", f"{len(v)} {len(f)} 0"] + [" ".join(repr(float(x)) for x in p) for p in v]
     lines += ["3 " + " ".join(map(str, t)) for t in f]
     return ("\n".join(lines) + "\n").encode()
 
+
 @pytest.mark.parametrize("fmt", ["ply", "off", "obj", "stl"])
 def test_surface_formats_give_the_same_box(client: TestClient, fmt: str) -> None:
     v = box_corners(1, 2, 3) + np.array([1, -1, 2])
-    writer = {"ply": ply_ascii, "off": off_ascii, "obj": lambda a, b: obj_bytes([(None, a, b)]),
-              "stl": stl_bytes}[fmt]
+    writer = {"ply": ply_ascii, "off": off_ascii, "obj": lambda a, b: obj_bytes([(None, a, b)]), "stl": stl_bytes}[fmt]
     res = analyze(client, f"box.{fmt}", writer(v, BOX_FACES))  # type: ignore[no-untyped-call]
     assert res["source"]["format"] == fmt
     assert res["mass"] == pytest.approx(6000, rel=1e-14)
@@ -69,9 +79,10 @@ def test_surface_formats_give_the_same_box(client: TestClient, fmt: str) -> None
     np.testing.assert_allclose(res["inertia_tensor"], box_inertia(6000, 1, 2, 3), rtol=0, atol=1e-12 * 6500)
     check_classification(res, "asymmetric_top")
 
+
 def check_two_box_scene(res: dict[str, Any], s: float = 1.0) -> None:
     R = rotation([1, 0, 0], 0.5)
-    ma, mb = 6000 * s ** 3, 2000 * s ** 3
+    ma, mb = 6000 * s**3, 2000 * s**3
     Ia = box_inertia(ma, s, 2 * s, 3 * s)
     Ib = R @ box_inertia(mb, s, s, 2 * s) @ R.T
     ca, cb = np.array([5.0, 0, 0]) * s, np.array([0, 4.0, 0]) * s
@@ -90,10 +101,12 @@ def check_two_box_scene(res: dict[str, Any], s: float = 1.0) -> None:
     np.testing.assert_allclose(res["inertia_tensor"], want, rtol=0, atol=1e-12 * np.trace(want))
     check_principal(res)
 
+
 def test_glb_scene_reports_parts_in_the_scene_frame(client: TestClient) -> None:
     scene, _ = two_box_scene()
     res = analyze(client, "scene.glb", scene.export(file_type="glb"))
     check_two_box_scene(res)
+
 
 def test_gltf_with_embedded_buffers_reports_parts(client: TestClient) -> None:
     scene, _ = two_box_scene()
@@ -102,11 +115,13 @@ def test_gltf_with_embedded_buffers_reports_parts(client: TestClient) -> None:
     res = analyze(client, "scene.gltf", data)
     check_two_box_scene(res)
 
+
 def test_3mf_objects_are_parts_and_explicit_units_win(client: TestClient) -> None:
     scene, _ = two_box_scene()
     data = scene.export(file_type="3mf")
     check_two_box_scene(analyze(client, "scene.3mf", data, units="m"))
     check_two_box_scene(analyze(client, "scene.3mf", data, units="cm"), s=1e-2)
+
 
 def test_3mf_default_units(client: TestClient) -> None:
     """API.md: `units` default `m`.  A 3MF file declares its own unit (millimetre here, and by the
@@ -117,6 +132,7 @@ def test_3mf_default_units(client: TestClient) -> None:
     unit = res["source"]["units"]
     assert unit in ("m", "mm")
     check_two_box_scene(res, s=UNIT_SCALE[unit])
+
 
 def kuhn_tetrahedra(origin: Any, size: Any) -> tuple[np.ndarray, np.ndarray]:
     """The cube [origin, origin + size]³ as six positively oriented tetrahedra on its diagonal."""
@@ -136,6 +152,7 @@ def kuhn_tetrahedra(origin: Any, size: Any) -> tuple[np.ndarray, np.ndarray]:
         pts += p
     return np.array(pts), np.array(cells)
 
+
 def two_cube_volume_mesh() -> Any:
     """Cubes [0,1]³ (1000 kg/m³) and [1,2]x[0,1]² (8000 kg/m³) in one tetra block."""
     pa, ca = kuhn_tetrahedra([0, 0, 0], 1.0)
@@ -144,6 +161,7 @@ def two_cube_volume_mesh() -> Any:
     cells = np.vstack([ca, cb + len(pa)])
     density = np.array([1000.0] * 6 + [8000.0] * 6)
     return points, cells, density
+
 
 @pytest.mark.parametrize("fmt", ["vtu", "vtk", "msh"])
 def test_volume_meshes_with_cell_density(client: TestClient, fmt: str, tmp_path: Path) -> None:
@@ -167,6 +185,7 @@ def test_volume_meshes_with_cell_density(client: TestClient, fmt: str, tmp_path:
     check_classification(res, "symmetric_top", "prolate")
     assert res["source"]["format"] == fmt
 
+
 def test_volume_mesh_without_density_array_uses_the_density_option(client: TestClient, tmp_path: Path) -> None:
     import meshio
 
@@ -177,6 +196,7 @@ def test_volume_mesh_without_density_array_uses_the_density_option(client: TestC
     assert res["mass"] == pytest.approx(1000, rel=1e-12)
     assert res["volume"] == pytest.approx(2, rel=1e-12)
     np.testing.assert_allclose(res["inertia_tensor"], box_inertia(1000, 2, 1, 1), rtol=0, atol=1e-12 * 500)
+
 
 def test_volume_mesh_cell_blocks_are_parts(client: TestClient, tmp_path: Path) -> None:
     import meshio
@@ -198,16 +218,23 @@ def test_volume_mesh_cell_blocks_are_parts(client: TestClient, tmp_path: Path) -
     assert res["mass"] == pytest.approx(2000, rel=1e-12)
     np.testing.assert_allclose(res["center_of_mass"], [2, 0.5, 0.5], rtol=1e-12)
 
+
 def test_obj_groups_are_parts(client: TestClient) -> None:
-    text = obj_bytes([("left", box_corners(1, 1, 1), BOX_FACES),
-                      ("right", box_corners(1, 1, 1) + np.array([2, 0, 0]), BOX_FACES)]).decode()
-    res = analyze(client, "groups.obj", text.replace("o left", "g left").replace("o right", "g right").encode(),
-                  densities=json.dumps({"right": 500}))
+    text = obj_bytes(
+        [("left", box_corners(1, 1, 1), BOX_FACES), ("right", box_corners(1, 1, 1) + np.array([2, 0, 0]), BOX_FACES)]
+    ).decode()
+    res = analyze(
+        client,
+        "groups.obj",
+        text.replace("o left", "g left").replace("o right", "g right").encode(),
+        densities=json.dumps({"right": 500}),
+    )
     parts = {p["name"]: p for p in res["parts"]}
     assert set(parts) == {"left", "right"}
     assert parts["left"]["mass"] == pytest.approx(1000, rel=1e-13)
     assert parts["right"]["mass"] == pytest.approx(500, rel=1e-13)
     assert res["mass"] == pytest.approx(1500, rel=1e-13)
+
 
 def test_pyramid_and_wedge_cells(client: TestClient, tmp_path: Path) -> None:
     """[0,1]³ as three pyramids (apex at the origin, bases on x=1, y=1, z=1) and [1,2]x[0,1]²
@@ -222,8 +249,11 @@ def test_pyramid_and_wedge_cells(client: TestClient, tmp_path: Path) -> None:
 
     apex = P([0, 0, 0])
     pyramids = []
-    for quad in ([[1, 0, 0], [1, 0, 1], [1, 1, 1], [1, 1, 0]], [[0, 1, 0], [1, 1, 0], [1, 1, 1], [0, 1, 1]],
-                 [[0, 0, 1], [0, 1, 1], [1, 1, 1], [1, 0, 1]]):
+    for quad in (
+        [[1, 0, 0], [1, 0, 1], [1, 1, 1], [1, 1, 0]],
+        [[0, 1, 0], [1, 1, 0], [1, 1, 1], [0, 1, 1]],
+        [[0, 0, 1], [0, 1, 1], [1, 1, 1], [1, 0, 1]],
+    ):
         a, b, c = (np.array(x, float) for x in quad[:3])
         ids = [P(x) for x in quad]
         if np.cross(b - a, c - a) @ (-a) < 0:  # VTK: base normal towards the apex

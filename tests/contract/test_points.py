@@ -36,6 +36,7 @@ def test_triatomic_molecule_moments_match_closed_form(client: TestClient) -> Non
     assert "volume" not in res and "density" not in res
     assert "parts" not in res and "precession" not in res and "reference_inertia" not in res
 
+
 def test_points_units_tolerance_and_reference(client: TestClient) -> None:
     body = {**TRIATOMIC, "units": "mm", "tolerance": 1e-8, "reference": [0, 1000, 0]}
     res = points_ok(client, body)
@@ -49,14 +50,15 @@ def test_points_units_tolerance_and_reference(client: TestClient) -> None:
     np.testing.assert_allclose(res["center_of_mass"], com, rtol=1e-14, atol=1e-18)
     np.testing.assert_allclose(res["inertia_tensor"], I, rtol=0, atol=1e-14 * np.trace(I))
     np.testing.assert_allclose(res["reference_inertia"]["point"], [0, 1.0, 0], rtol=1e-15)
-    np.testing.assert_allclose(res["reference_inertia"]["tensor"], parallel_axis(I, mu, com - [0, 1.0, 0]),
-                               rtol=0, atol=1e-14 * np.trace(I))
+    np.testing.assert_allclose(
+        res["reference_inertia"]["tensor"], parallel_axis(I, mu, com - [0, 1.0, 0]), rtol=0, atol=1e-14 * np.trace(I)
+    )
     assert res["classification"]["tolerance"] == 1e-8
 
+
 def test_two_point_masses_are_a_linear_rotator(client: TestClient) -> None:
-    res = points_ok(client, {"points": [{"mass": 1.0, "position": [0, 0, 0]},
-                                        {"mass": 2.0, "position": [1, 0, 0]}]})
-    I = 1 * 2 * 1 ** 2 / 3  # m1 m2 l² / (m1 + m2)
+    res = points_ok(client, {"points": [{"mass": 1.0, "position": [0, 0, 0]}, {"mass": 2.0, "position": [1, 0, 0]}]})
+    I = 1 * 2 * 1**2 / 3  # m1 m2 l² / (m1 + m2)
     moments = res["principal"]["moments"]
     assert abs(moments[0]) <= 1e-15 * I
     np.testing.assert_allclose(moments[1:], [I, I], rtol=1e-14)
@@ -65,11 +67,13 @@ def test_two_point_masses_are_a_linear_rotator(client: TestClient) -> None:
     assert abs(abs(res["classification"]["symmetry_axis"][0]) - 1) < 1e-14
     np.testing.assert_allclose(res["center_of_mass"], [2 / 3, 0, 0], rtol=1e-15)
 
+
 def test_single_point_mass_is_accepted(client: TestClient) -> None:
     res = points_ok(client, {"points": [{"mass": 2.5, "position": [1, 2, 3]}]})
     assert res["mass"] == 2.5
     np.testing.assert_allclose(res["center_of_mass"], [1, 2, 3])
     np.testing.assert_allclose(res["inertia_tensor"], np.zeros((3, 3)), atol=0)
+
 
 POINTS_ERRORS = [
     ("no points", {"points": []}),
@@ -83,15 +87,19 @@ POINTS_ERRORS = [
     ("NaN position", '{"points": [{"mass": 1.0, "position": [NaN, 0, 0]}]}'),
     ("Infinity mass", '{"points": [{"mass": Infinity, "position": [0, 0, 0]}]}'),
     ("overflowing literal", '{"points": [{"mass": 1e999, "position": [0, 0, 0]}]}'),
-    ("-Infinity omega", '{"points": [{"mass": 1, "position": [0, 0, 0]}, {"mass": 1, "position": [1, 1, 0]}],'
-                        ' "omega": [0, -Infinity, 0]}'),
+    (
+        "-Infinity omega",
+        '{"points": [{"mass": 1, "position": [0, 0, 0]}, {"mass": 1, "position": [1, 1, 0]}], "omega": [0, -Infinity, 0]}',
+    ),
     ("NaN tolerance", '{"points": [{"mass": 1, "position": [0, 0, 0]}], "tolerance": NaN}'),
     ("NaN reference", '{"points": [{"mass": 1, "position": [0, 0, 0]}], "reference": [0, NaN, 0]}'),
 ]
 
+
 @pytest.mark.parametrize("label,body", POINTS_ERRORS, ids=[c[0] for c in POINTS_ERRORS])
 def test_points_errors_are_invalid_parameter(client: TestClient, label: str, body: Any) -> None:
     assert_error(post_points(client, body), 422, "invalid_parameter")
+
 
 def test_collinear_points_along_a_diagonal_are_a_linear_rotator(client: TestClient) -> None:
     d = np.array([1.0, -2.0, 2.0]) / 3
@@ -105,6 +113,7 @@ def test_collinear_points_along_a_diagonal_are_a_linear_rotator(client: TestClie
     assert abs(res["principal"]["moments"][0]) <= 1e-14 * I
     check_classification(res, "linear_rotator", planar=True)
     assert abs(abs(np.asarray(res["classification"]["symmetry_axis"]) @ d) - 1) < 1e-13
+
 
 def test_point_masses_far_from_the_origin_keep_their_moments(client: TestClient) -> None:
     shift = np.array([1e8, -1e8, 3e7])

@@ -46,10 +46,12 @@ def ll_asymmetric_period(I: Any, Omega: Any) -> float:
         k2 = (I3 - I2) * (M2 - E2 * I1) / ((I2 - I1) * (E2 * I3 - M2))
     return 4 * float(ellipk(k2)) / rate
 
-# file, mass, centre of mass, moments, kind, shape (sample_meshes/README.md; closed formulas)
-PHI = (1 + 5 ** 0.5) / 2
 
-ICO_MASS = RHO * 5 * (3 + 5 ** 0.5) / 12
+# file, mass, centre of mass, moments, kind, shape (sample_meshes/README.md; closed formulas)
+PHI = (1 + 5**0.5) / 2
+
+ICO_MASS = RHO * 5 * (3 + 5**0.5) / 12
+
 
 def test_shell_model_integrates_a_thin_wall_of_given_thickness(client: TestClient) -> None:
     t = 1e-4  # file units (m): thin against the 1 x 2 x 3 box, so wall placement is second order
@@ -59,6 +61,7 @@ def test_shell_model_integrates_a_thin_wall_of_given_thickness(client: TestClien
     np.testing.assert_allclose(res["center_of_mass"], com, atol=1e-3)
     np.testing.assert_allclose(res["inertia_tensor"], I, rtol=0, atol=1e-3 * np.trace(I))
     assert "volume" not in res and "density" not in res, "volume, density: solids only"
+
 
 def test_precession_from_principal_moments_asymmetric_intermediate_start(client: TestClient) -> None:
     moments, omega = [1.0, 2.0, 3.0], [0.1, 1.0, 0.05]
@@ -79,11 +82,11 @@ def test_precession_from_principal_moments_asymmetric_intermediate_start(client:
     assert pre["flip_interval"] == pytest.approx(T / 2, rel=1e-10)
     check_trajectory(pre, moments, A, omega, 10.0, 41, np.diag(moments))
 
+
 @pytest.mark.parametrize("omega,branch", [([0.05, 0.3, 1.0], "near I3"), ([1.0, 0.3, 0.05], "near I1")])
 def test_asymmetric_period_both_branches_and_stable_starts(client: TestClient, omega: Any, branch: str) -> None:
     moments = [1.0, 2.0, 3.0]
-    pre = precession_ok(client, {"principal_moments": moments, "omega": omega, "duration": 6,
-                                 "samples": 13})["precession"]
+    pre = precession_ok(client, {"principal_moments": moments, "omega": omega, "duration": 6, "samples": 13})["precession"]
     assert pre["regime"] == "asymmetric"
     T = ll_asymmetric_period(moments, omega)
     assert pre["period"] == pytest.approx(T, rel=1e-10)
@@ -91,14 +94,15 @@ def test_asymmetric_period_both_branches_and_stable_starts(client: TestClient, o
     assert "flip_interval" not in pre
     check_trajectory(pre, moments, np.eye(3), omega, 6.0, 13, np.diag(moments))
 
+
 def test_asymmetric_motion_returns_to_its_start_after_one_period(client: TestClient) -> None:
     moments, omega = [1.0, 2.0, 3.0], [0.2, 0.7, 0.4]
     T = ll_asymmetric_period(moments, omega)
-    pre = precession_ok(client, {"principal_moments": moments, "omega": omega, "duration": T,
-                                 "samples": 5})["precession"]
+    pre = precession_ok(client, {"principal_moments": moments, "omega": omega, "duration": T, "samples": 5})["precession"]
     W = np.asarray(pre["trajectory"]["omega_body"])
     np.testing.assert_allclose(W[-1], W[0], atol=1e-9)
     assert not np.allclose(W[2], W[0], atol=1e-3)  # but not after half of it
+
 
 def test_separatrix_has_no_period_and_a_warning(client: TestClient) -> None:
     # 2E I2 = |M|²  <=>  I1(I1 − I2) Ω1² + I3(I3 − I2) Ω3² = 0; here Ω1 = √3 Ω3
@@ -113,14 +117,14 @@ def test_separatrix_has_no_period_and_a_warning(client: TestClient) -> None:
     assert warnings_, "a warning must say why the period is absent"
     check_invariants(pre, np.diag(moments), omega)
 
+
 def test_precession_from_a_rotated_inertia_tensor(client: TestClient) -> None:
     R = rotation([1, -1, 2], 0.9)
     moments = np.array([1.0, 2.0, 3.0])
     I = R @ np.diag(moments) @ R.T
     I = (I + I.T) / 2
     omega = [0.4, -0.3, 0.9]
-    res = precession_ok(client, {"inertia_tensor": I.tolist(), "omega": omega, "duration": 5, "samples": 11,
-                                 "tolerance": 1e-9})
+    res = precession_ok(client, {"inertia_tensor": I.tolist(), "omega": omega, "duration": 5, "samples": 11, "tolerance": 1e-9})
     check_principal(res, I)
     check_classification(res, "asymmetric_top", tolerance=1e-9)
     np.testing.assert_allclose(res["principal"]["moments"], moments, rtol=1e-13)
@@ -131,6 +135,7 @@ def test_precession_from_a_rotated_inertia_tensor(client: TestClient) -> None:
     Wb = R.T @ omega
     assert pre["period"] == pytest.approx(ll_asymmetric_period(moments, Wb), rel=1e-9)
     check_trajectory(pre, moments, A, omega, 5.0, 11, I)
+
 
 @pytest.mark.parametrize("moments,shape", [([2.0, 2.0, 3.0], "oblate"), ([1.0, 3.0, 3.0], "prolate")])
 def test_symmetric_top_rates_follow_landau_lifshitz(client: TestClient, moments: Any, shape: str | None) -> None:
@@ -145,6 +150,7 @@ def test_symmetric_top_rates_follow_landau_lifshitz(client: TestClient, moments:
     check_invariants(pre, np.diag(moments), omega)
     check_symmetric_rates(pre, I_perp, I_sym, n, omega)
     check_trajectory(pre, moments, res["principal"]["axes"], omega, 4.0, 9, np.diag(moments))
+
 
 def test_symmetric_mesh_regular_precession_in_the_input_frame(client: TestClient) -> None:
     # tetrahedron.stl: oblate, symmetry axis (1,1,1)/√3, I⊥ = 125/12, I3 = 50/3
@@ -161,6 +167,7 @@ def test_symmetric_mesh_regular_precession_in_the_input_frame(client: TestClient
     check_symmetric_rates(pre, I_perp, I_sym, n, omega)
     check_trajectory(pre, res["principal"]["moments"], res["principal"]["axes"], omega, 5.0, 6, I)
 
+
 def test_asymmetric_mesh_precession_in_the_input_frame(client: TestClient) -> None:
     omega = [0.1, 2.0, 0.1]
     res = analyze(client, "box.stl", omega="0.1,2,0.1", duration=10, samples=21)
@@ -174,6 +181,7 @@ def test_asymmetric_mesh_precession_in_the_input_frame(client: TestClient) -> No
     assert pre["stable"] is False
     assert pre["flip_interval"] == pytest.approx(T / 2, rel=1e-10)
     check_trajectory(pre, [2500, 5000, 6500], res["principal"]["axes"], omega, 10.0, 21, I)
+
 
 def test_flip_interval_is_the_time_between_reversals_of_omega2(client: TestClient) -> None:
     moments, omega = [1.0, 2.0, 3.0], [0.05, 1.0, 0.02]
@@ -189,20 +197,20 @@ def test_flip_interval_is_the_time_between_reversals_of_omega2(client: TestClien
     assert len(gaps) >= 2
     np.testing.assert_allclose(gaps, pre["flip_interval"], rtol=1e-4)
 
+
 @pytest.mark.parametrize("method", ["dop853", "rk45", "splitting"])
 def test_numerical_methods_follow_the_same_motion(client: TestClient, method: str) -> None:
     moments, omega = [1.0, 2.0, 3.0], [0.3, 0.8, 0.5]
-    res = precession_ok(client, {"principal_moments": moments, "omega": omega, "duration": 3, "samples": 7,
-                                 "method": method})
+    res = precession_ok(client, {"principal_moments": moments, "omega": omega, "duration": 3, "samples": 7, "method": method})
     pre = res["precession"]
     assert pre["regime"] == "asymmetric"
     check_invariants(pre, np.diag(moments), omega)
     # the contract states no accuracy for the integrators: a loose 1e-4 is asked
     check_trajectory(pre, moments, res["principal"]["axes"], omega, 3.0, 7, np.diag(moments), tol=1e-4)
 
+
 def test_rest(client: TestClient) -> None:
-    res = precession_ok(client, {"principal_moments": [1, 2, 3], "omega": [0, 0, 0], "duration": 1,
-                                 "samples": 3})
+    res = precession_ok(client, {"principal_moments": [1, 2, 3], "omega": [0, 0, 0], "duration": 1, "samples": 3})
     pre = res["precession"]
     assert pre["regime"] == "rest"
     assert pre["angular_momentum_magnitude"] == 0 and pre["kinetic_energy"] == 0
@@ -210,6 +218,7 @@ def test_rest(client: TestClient) -> None:
     for q in pre["trajectory"]["quaternion"]:
         np.testing.assert_allclose(quat_matrix(q), np.eye(3), atol=1e-15)
     np.testing.assert_allclose(pre["trajectory"]["omega"], np.zeros((3, 3)), atol=0)
+
 
 @pytest.mark.parametrize("axis,stable", [(0, True), (1, False), (2, True)])
 def test_permanent_rotation_about_a_principal_axis(client: TestClient, axis: Any, stable: bool) -> None:
@@ -227,12 +236,13 @@ def test_permanent_rotation_about_a_principal_axis(client: TestClient, axis: Any
         np.testing.assert_allclose(quat_matrix(q), rotation(omega, 1.5 * t), atol=1e-12)
         np.testing.assert_allclose(w, omega, atol=1e-12)
 
+
 def test_spherical_top_keeps_omega_constant(client: TestClient) -> None:
     omega = [0.3, -0.2, 0.5]
     res = analyze(client, "icosahedron.stl", omega="0.3,-0.2,0.5", duration=4, samples=5)
     pre = res["precession"]
     assert pre["regime"] == "spherical"
-    I0 = ICO_MASS * PHI ** 2 / 10  # ideal icosahedron; the float32 file is 4e-8 away
+    I0 = ICO_MASS * PHI**2 / 10  # ideal icosahedron; the float32 file is 4e-8 away
     np.testing.assert_allclose(res["inertia_tensor"], np.eye(3) * I0, rtol=0, atol=1e-7 * I0)
     check_invariants(pre, np.asarray(res["inertia_tensor"]), omega)
     w = np.linalg.norm(omega)
@@ -241,9 +251,14 @@ def test_spherical_top_keeps_omega_constant(client: TestClient) -> None:
         np.testing.assert_allclose(Wb, pre["omega_body"], atol=1e-12)
         np.testing.assert_allclose(quat_matrix(q), rotation(omega, w * t), atol=1e-12)
 
+
 def test_linear_rotator_precession(client: TestClient) -> None:
-    body = {"points": [{"mass": 1.0, "position": [0, 0, 0]}, {"mass": 2.0, "position": [1, 0, 0]}],
-            "omega": [0, 0, 2.0], "duration": 3.0, "samples": 4}
+    body = {
+        "points": [{"mass": 1.0, "position": [0, 0, 0]}, {"mass": 2.0, "position": [1, 0, 0]}],
+        "omega": [0, 0, 2.0],
+        "duration": 3.0,
+        "samples": 4,
+    }
     res = points_ok(client, body)
     pre = res["precession"]
     assert pre["regime"] == "rotator"
@@ -257,6 +272,7 @@ def test_linear_rotator_precession(client: TestClient) -> None:
         np.testing.assert_allclose(quat_matrix(q), rotation([0, 0, 1], 2 * t), atol=1e-12)
         np.testing.assert_allclose(w, [0, 0, 2], atol=1e-12)
 
+
 def test_points_precession_matches_the_mesh_contract(client: TestClient) -> None:
     body = {**TRIATOMIC, "omega": [0.2, 1.0, 0.3], "duration": 2.0, "samples": 5}
     res = points_ok(client, body)
@@ -265,11 +281,11 @@ def test_points_precession_matches_the_mesh_contract(client: TestClient) -> None
     check_invariants(pre, I, body["omega"])
     check_trajectory(pre, res["principal"]["moments"], res["principal"]["axes"], body["omega"], 2.0, 5, I)
 
+
 PRECESSION_ERRORS = [
     ("no omega", {"principal_moments": [1, 2, 3]}),
     ("no inertia", {"omega": [0, 0, 1]}),
-    ("both inertia forms", {"principal_moments": [1, 2, 3], "inertia_tensor": np.eye(3).tolist(),
-                            "omega": [0, 0, 1]}),
+    ("both inertia forms", {"principal_moments": [1, 2, 3], "inertia_tensor": np.eye(3).tolist(), "omega": [0, 0, 1]}),
     ("tensor not 3x3", {"inertia_tensor": [[1, 0], [0, 1]], "omega": [0, 0, 1]}),
     ("omega of two numbers", {"principal_moments": [1, 2, 3], "omega": [0, 1]}),
     ("unknown method", {"principal_moments": [1, 2, 3], "omega": [0, 0, 1], "method": "leapfrog"}),
@@ -277,14 +293,15 @@ PRECESSION_ERRORS = [
     ("NaN moment", '{"principal_moments": [NaN, 2, 3], "omega": [0, 0, 1]}'),
     ("Infinity in tensor", '{"inertia_tensor": [[Infinity,0,0],[0,1,0],[0,0,1]], "omega": [0, 0, 1]}'),
     ("NaN omega", '{"principal_moments": [1, 2, 3], "omega": [0, NaN, 1]}'),
-    ("Inf duration", '{"principal_moments": [1, 2, 3], "omega": [0, 0, 1], "duration": Infinity, '
-                     '"samples": 3}'),
+    ("Inf duration", '{"principal_moments": [1, 2, 3], "omega": [0, 0, 1], "duration": Infinity, "samples": 3}'),
     ("1e999 omega", '{"principal_moments": [1, 2, 3], "omega": [0, 1e999, 1]}'),
 ]
+
 
 @pytest.mark.parametrize("label,body", PRECESSION_ERRORS, ids=[c[0] for c in PRECESSION_ERRORS])
 def test_precession_errors_are_invalid_parameter(client: TestClient, label: str, body: Any) -> None:
     assert_error(post_precession(client, body), 422, "invalid_parameter")
+
 
 def test_nearly_symmetric_mesh_reports_momentum_and_energy_of_its_own_tensor(client: TestClient) -> None:
     """hex_prism.stl is symmetric only within the tolerance (moments 1.4e-8 apart).  M = I Ω and
@@ -300,14 +317,14 @@ def test_nearly_symmetric_mesh_reports_momentum_and_energy_of_its_own_tensor(cli
     check_invariants(pre, I, omega)
     check_trajectory(pre, res["principal"]["moments"], res["principal"]["axes"], omega, 20.0, 5, I, tol=1e-9)
 
+
 def test_exact_motion_over_many_periods(client: TestClient) -> None:
     moments, omega = [1.0, 2.0, 3.0], [0.3, 0.8, 0.5]
     T = ll_asymmetric_period(moments, omega)
     duration = 60 * T
-    res = precession_ok(client, {"principal_moments": moments, "omega": omega, "duration": duration,
-                                 "samples": 9})
-    check_trajectory(res["precession"], moments, res["principal"]["axes"], omega, duration, 9,
-                     np.diag(moments), tol=1e-7)
+    res = precession_ok(client, {"principal_moments": moments, "omega": omega, "duration": duration, "samples": 9})
+    check_trajectory(res["precession"], moments, res["principal"]["axes"], omega, duration, 9, np.diag(moments), tol=1e-7)
+
 
 @pytest.mark.parametrize("eps", [1e-3, -1e-3, 1e-5, -1e-5])
 def test_period_near_the_separatrix(client: TestClient, eps: float) -> None:
@@ -319,6 +336,7 @@ def test_period_near_the_separatrix(client: TestClient, eps: float) -> None:
     assert pre["stable"] is False
     assert pre["flip_interval"] == pytest.approx(T / 2, rel=1e-9)
 
+
 def test_separatrix_of_a_mesh_body(client: TestClient) -> None:
     # box.stl: I = 2500, 5000, 6500 (axes z, y, x); 2E I2 = |M|² when 2500² Ωz² = 6500·1500 Ωx²
     wx = 0.1
@@ -327,6 +345,7 @@ def test_separatrix_of_a_mesh_body(client: TestClient) -> None:
     pre = res["precession"]
     assert pre["regime"] == "asymmetric" and "period" not in pre
     assert list(res.get("warnings", [])) + list(pre.get("warnings", []))
+
 
 def test_unsorted_principal_moments_keep_the_given_frame_as_input_frame(client: TestClient) -> None:
     given = [3.0, 1.0, 2.0]
@@ -341,13 +360,13 @@ def test_unsorted_principal_moments_keep_the_given_frame_as_input_frame(client: 
     check_invariants(pre, I, omega)
     check_trajectory(pre, [1, 2, 3], res["principal"]["axes"], omega, 3.0, 4, I)
 
+
 @pytest.mark.parametrize("method", ["exact", "dop853", "rk45", "splitting"])
 def test_drift_diagnostics_are_honest(client: TestClient, method: str) -> None:
     """'diagnostics reports how well the trajectory keeps [M] and the energy': the reported drift
     is at least what the returned samples show (half of it, for definitions that differ)."""
     moments, omega = [1.0, 2.0, 3.0], [0.3, 0.8, 0.5]
-    res = precession_ok(client, {"principal_moments": moments, "omega": omega, "duration": 50, "samples": 201,
-                                 "method": method})
+    res = precession_ok(client, {"principal_moments": moments, "omega": omega, "duration": 50, "samples": 201, "method": method})
     pre = res["precession"]
     W = np.asarray(pre["trajectory"]["omega_body"])
     I = np.asarray(moments)
@@ -360,12 +379,13 @@ def test_drift_diagnostics_are_honest(client: TestClient, method: str) -> None:
     assert d["energy_drift"] >= 0.5 * seen_e - 1e-15, (d, seen_e)
     assert d["momentum_drift"] >= 0.5 * seen_m - 1e-15, (d, seen_m)
 
+
 def test_points_endpoint_accepts_the_method(client: TestClient) -> None:
     body = {**TRIATOMIC, "omega": [0.2, 1.0, 0.3], "duration": 2.0, "samples": 5, "method": "dop853"}
     res = points_ok(client, body)
     I = np.asarray(res["inertia_tensor"], float)
-    check_trajectory(res["precession"], res["principal"]["moments"], res["principal"]["axes"], body["omega"],
-                     2.0, 5, I, tol=1e-5)
+    check_trajectory(res["precession"], res["principal"]["moments"], res["principal"]["axes"], body["omega"], 2.0, 5, I, tol=1e-5)
+
 
 def test_moments_equal_only_within_tolerance_are_not_rounded_in_momentum_and_energy(client: TestClient) -> None:
     """Same as the hex_prism case through /v1/precession: M = diag(I) Ω exactly for the given moments."""

@@ -14,6 +14,7 @@ def test_healthz_reports_ok(client: TestClient) -> None:
     assert r.status_code == 200
     assert r.json() == {"status": "ok"}
 
+
 def test_formats_lists_readable_formats_and_their_capabilities(client: TestClient) -> None:
     r = client.get("/v1/formats")
     assert r.status_code == 200
