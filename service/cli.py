@@ -90,27 +90,44 @@ def _quaternion(text: str) -> tuple[float, float, float, float]:
 def add_analysis_options(p: argparse.ArgumentParser) -> None:
     """Options shared by ``analyze`` and ``batch`` (the API's query parameters)."""
     p.add_argument("--format", help="file format; inferred from the name when absent")
-    p.add_argument("--units", help="length unit of the file: m, cm, mm, um, in, ft, angstrom "
-                   "(default: the file's; angstrom for .xyz; else m)")
+    p.add_argument(
+        "--units", help="length unit of the file: m, cm, mm, um, in, ft, angstrom (default: the file's; angstrom for .xyz; else m)"
+    )
     group = p.add_mutually_exclusive_group()
     group.add_argument("--density", type=float, help="density in kg/m^3 (default 1000)")
     group.add_argument("--mass", type=float, help="total mass in kg (density is derived)")
     p.add_argument("--model", choices=MODELS, default=Model.SOLID.value, help="closed solid or thin shell")
     p.add_argument("--thickness", type=float, help="shell wall thickness, in the file's units")
     p.add_argument("--tolerance", type=float, default=DEFAULT_TOLERANCES.moment_rel, help="relative tolerance for equal moments")
-    p.add_argument("--reference", type=_triple, metavar="X,Y,Z",
-                   help="point (file units): also report the tensor about it; negative values as written: -1,0,0")
+    p.add_argument(
+        "--reference",
+        type=_triple,
+        metavar="X,Y,Z",
+        help="point (file units): also report the tensor about it; negative values as written: -1,0,0",
+    )
     p.add_argument("--densities", help="JSON file: part name -> density (kg/m^3) for files of several parts")
-    p.add_argument("--geometry", choices=("brep", "mesh"),
-                   help="CAD files: integrate the exact B-rep (default) or a tessellation of it")
-    p.add_argument("--deflection", type=float,
-                   help="CAD files: tessellate (implies --geometry mesh) with this chordal deflection relative to "
-                   "the bounding-box diagonal (default 1e-3)")
-    p.add_argument("--frame", type=_quaternion, metavar="W,X,Y,Z",
-                   help="unit quaternion carrying a named frame's axes into the file's: also report the centre of "
-                   "mass and tensors along that frame's axes")
-    p.add_argument("--isotopes", choices=("standard", "abundant"), default="standard",
-                   help="atoms named by element (.xyz): standard atomic weights or the most abundant isotope")
+    p.add_argument(
+        "--geometry", choices=("brep", "mesh"), help="CAD files: integrate the exact B-rep (default) or a tessellation of it"
+    )
+    p.add_argument(
+        "--deflection",
+        type=float,
+        help="CAD files: tessellate (implies --geometry mesh) with this chordal deflection relative to "
+        "the bounding-box diagonal (default 1e-3)",
+    )
+    p.add_argument(
+        "--frame",
+        type=_quaternion,
+        metavar="W,X,Y,Z",
+        help="unit quaternion carrying a named frame's axes into the file's: also report the centre of "
+        "mass and tensors along that frame's axes",
+    )
+    p.add_argument(
+        "--isotopes",
+        choices=("standard", "abundant"),
+        default="standard",
+        help="atoms named by element (.xyz): standard atomic weights or the most abundant isotope",
+    )
 
 
 def options_from_args(args: argparse.Namespace) -> Any:
@@ -155,18 +172,30 @@ def _parser() -> argparse.ArgumentParser:
     a = sub.add_parser("analyze", help="analyse one mesh or points file (.json/.csv/.xyz)")
     a.add_argument("file", help="mesh, volume mesh or points file (.json/.csv/.xyz); the format from its name or --format")
     add_analysis_options(a)
-    a.add_argument("--omega", type=_triple, metavar="WX,WY,WZ",
-                   help="initial angular velocity, rad/s, input frame (adds the precession section)")
+    a.add_argument(
+        "--omega",
+        type=_triple,
+        metavar="WX,WY,WZ",
+        help="initial angular velocity, rad/s, input frame (adds the precession section)",
+    )
     a.add_argument("--duration", type=float, help="seconds of motion to predict (with --omega and --samples)")
     a.add_argument("--samples", type=int, help="number of time samples of the trajectory")
-    a.add_argument("--method", default=MotionMethod.EXACT.value, choices=METHODS,
-                   help="motion method: exact (closed form / elliptic), dop853, rk45 or splitting (default exact)")
+    a.add_argument(
+        "--method",
+        default=MotionMethod.EXACT.value,
+        choices=METHODS,
+        help="motion method: exact (closed form / elliptic), dop853, rk45 or splitting (default exact)",
+    )
     a.add_argument("--json", action="store_true", help="print the API's JSON instead of a table (errors as JSON too)")
-    a.add_argument("--output-units", choices=tuple(OUTPUT_UNITS), default="si",
-                   help="units of the table: si (kg, m, kg m^2; default), kg-mm (kg mm^2), g-mm (g mm^2) or g-cm "
-                        "(g cm^2); --json stays SI")
-    a.add_argument("--export", choices=("urdf", "sdf", "mjcf"),
-                   help="print only the inertial element of a robot description format (SI units)")
+    a.add_argument(
+        "--output-units",
+        choices=tuple(OUTPUT_UNITS),
+        default="si",
+        help="units of the table: si (kg, m, kg m^2; default), kg-mm (kg mm^2), g-mm (g mm^2) or g-cm (g cm^2); --json stays SI",
+    )
+    a.add_argument(
+        "--export", choices=("urdf", "sdf", "mjcf"), help="print only the inertial element of a robot description format (SI units)"
+    )
 
     b = sub.add_parser("batch", help="analyse many files, folders or .zip archives into JSONL/CSV/Parquet")
     b.add_argument("paths", nargs="+", help="files, folders (read recursively) or .zip archives")
@@ -181,8 +210,12 @@ def _parser() -> argparse.ArgumentParser:
     s.add_argument("--host", default="127.0.0.1", help="address to listen on (default 127.0.0.1; 0.0.0.0 for all)")
     s.add_argument("--port", type=int, default=8000, help="port to listen on (default 8000)")
     s.add_argument("--workers", type=int, default=1, help="uvicorn worker processes (default 1)")
-    s.add_argument("--log-level", default="info", choices=("critical", "error", "warning", "info", "debug", "trace"),
-                   help="uvicorn's log level (default info)")
+    s.add_argument(
+        "--log-level",
+        default="info",
+        choices=("critical", "error", "warning", "info", "debug", "trace"),
+        help="uvicorn's log level (default info)",
+    )
     return parser
 
 
@@ -256,8 +289,9 @@ def _analyze(args: argparse.Namespace) -> int:
         try:
             text = json.dumps(doc, indent=2, allow_nan=False)
         except ValueError as exc:  # a non-finite number is a bug: say so, never print Infinity or NaN
-            raise InvalidParameterError("the result holds a number that is not finite, which JSON cannot carry; "
-                                        "please report the input") from exc
+            raise InvalidParameterError(
+                "the result holds a number that is not finite, which JSON cannot carry; please report the input"
+            ) from exc
         print(text)
     else:
         print(render_table(doc, args.output_units))
@@ -291,8 +325,11 @@ def _batch(args: argparse.Namespace) -> int:
             progress=not args.no_progress,
         )
     except KeyboardInterrupt:
-        print(f"\ninterrupted: the rows written so far are kept in {args.out}; run the same command with --resume "
-              "to analyse the rest", file=sys.stderr)
+        print(
+            f"\ninterrupted: the rows written so far are kept in {args.out}; run the same command with --resume "
+            "to analyse the rest",
+            file=sys.stderr,
+        )
         return EXIT_INTERRUPTED
     print(summary.as_text(), file=sys.stderr)
     return 0
@@ -306,8 +343,7 @@ def _output_folder_ready(out: str) -> bool:
     try:
         os.makedirs(folder, exist_ok=True)
     except OSError as exc:
-        print(f"error: cannot create the output folder {folder!r}: {exc.strerror}; choose another --out",
-              file=sys.stderr)
+        print(f"error: cannot create the output folder {folder!r}: {exc.strerror}; choose another --out", file=sys.stderr)
         return False
     if not os.access(folder, os.W_OK):
         print(f"error: the output folder {folder!r} is not writable; choose another --out", file=sys.stderr)
@@ -336,12 +372,16 @@ def _serve(args: argparse.Namespace) -> int:
     import uvicorn
 
     if not _port_free(args.host, args.port):
-        print(f"error: port {args.port} on {args.host} is in use or not available; stop the other server "
-              f"or choose another port with --port", file=sys.stderr)
+        print(
+            f"error: port {args.port} on {args.host} is in use or not available; stop the other server "
+            f"or choose another port with --port",
+            file=sys.stderr,
+        )
         return EXIT_ENVIRONMENT
     # the service writes its own structured access line (inertia.api.access)
-    uvicorn.run(f"{__package__}.app:app", host=args.host, port=args.port, workers=args.workers,
-                log_level=args.log_level, access_log=False)
+    uvicorn.run(
+        f"{__package__}.app:app", host=args.host, port=args.port, workers=args.workers, log_level=args.log_level, access_log=False
+    )
     return 0
 
 
@@ -390,8 +430,7 @@ def render_table(doc: dict[str, Any], output_units: str = "si") -> str:
 
     def tensor_rows(label: str, tensor: Sequence[Sequence[float]]) -> list[tuple[str, str]]:
         scale = mu * lu * lu
-        return [(label if i == 0 else "", f"{_vec([x / scale for x in row])} {inertia_unit}")
-                for i, row in enumerate(tensor)]
+        return [(label if i == 0 else "", f"{_vec([x / scale for x in row])} {inertia_unit}") for i, row in enumerate(tensor)]
 
     src = doc["source"]
     lines = [f"{src.get('filename', 'points')}  ({src['format']}, {src['kind']}, units {src['units']})"]
@@ -425,13 +464,16 @@ def render_table(doc: dict[str, Any], output_units: str = "si") -> str:
     if "parts" in doc:
         for part in doc["parts"]:
             moments = [x / (mu * lu * lu) for x in part["principal"]["moments"]]
-            rows.append((f"part {part['name']}", f"mass {_fmt(part['mass'] / mu)} {mn}, "
-                         f"moments {_vec(moments)} {inertia_unit}"))
+            rows.append((f"part {part['name']}", f"mass {_fmt(part['mass'] / mu)} {mn}, moments {_vec(moments)} {inertia_unit}"))
     diag = doc["diagnostics"]
     rows.append(("relative error", f"{diag['relative_error_estimate']:.2g}"))
     if "tessellation_error" in diag:
-        rows.append(("tessellation error", f"{diag['tessellation_error']:.2g} vs the exact B-rep "
-                     f"(deflection {doc['source'].get('deflection')})"))
+        rows.append(
+            (
+                "tessellation error",
+                f"{diag['tessellation_error']:.2g} vs the exact B-rep (deflection {doc['source'].get('deflection')})",
+            )
+        )
     rows.append(("elapsed", f"{diag['elapsed_s'] * 1e3:.2f} ms"))
     width = max(len(k) for k, _ in rows)
     lines += [f"  {k:<{width}}  {v}" for k, v in rows]
@@ -441,9 +483,14 @@ def render_table(doc: dict[str, Any], output_units: str = "si") -> str:
 
 # Motion quantities of the table with their units; momentum and energy scale with the inertia unit.
 _MOTION_UNITS = {
-    "angular_momentum_magnitude": "momentum", "kinetic_energy": "energy",
-    "body_precession_rate": "rad/s", "space_precession_rate": "rad/s", "spin_rate": "rad/s",
-    "nutation_angle": "rad", "period": "s", "flip_interval": "s",
+    "angular_momentum_magnitude": "momentum",
+    "kinetic_energy": "energy",
+    "body_precession_rate": "rad/s",
+    "space_precession_rate": "rad/s",
+    "spin_rate": "rad/s",
+    "nutation_angle": "rad",
+    "period": "s",
+    "flip_interval": "s",
 }
 
 

@@ -69,9 +69,11 @@ def _cross(u: Vec, v: Vec) -> Vec:
 
 def _det_condition(a: Vec, u: Vec, v: Vec) -> NDArray[np.float64]:
     """sum over permutations of |a_i u_j v_k|: the rounding of a . (u x v) is a few eps times this."""
-    cond: NDArray[np.float64] = (np.abs(a[0]) * (np.abs(u[1] * v[2]) + np.abs(u[2] * v[1]))
-            + np.abs(a[1]) * (np.abs(u[2] * v[0]) + np.abs(u[0] * v[2]))
-            + np.abs(a[2]) * (np.abs(u[0] * v[1]) + np.abs(u[1] * v[0])))
+    cond: NDArray[np.float64] = (
+        np.abs(a[0]) * (np.abs(u[1] * v[2]) + np.abs(u[2] * v[1]))
+        + np.abs(a[1]) * (np.abs(u[2] * v[0]) + np.abs(u[0] * v[2]))
+        + np.abs(a[2]) * (np.abs(u[0] * v[1]) + np.abs(u[1] * v[0]))
+    )
     return cond
 
 
@@ -114,8 +116,9 @@ def gather_corners(records: NDArray[np.void], cells: NDArray[np.int64]) -> list[
     return [list(rows[k]) for k in range(cells.shape[1])]
 
 
-def _block_sums(xyz: NDArray[np.void], cells: NDArray[np.int64], kind: str,
-                weight: NDArray[np.float64] | None) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+def _block_sums(
+    xyz: NDArray[np.void], cells: NDArray[np.int64], kind: str, weight: NDArray[np.float64] | None
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """Sums over one block of simplices of every row, and of their absolute values.
 
     Struct of arrays: each quantity is a contiguous (n,) row of one (10, n)
@@ -151,7 +154,7 @@ def _block_sums(xyz: NDArray[np.void], cells: NDArray[np.int64], kind: str,
     total[:_NOISE] = terms.sum(axis=1)
     total_abs[:_NOISE] = np.abs(terms, out=terms).sum(axis=1)
     total[_NOISE] = total_abs[_NOISE] = noise.sum()
-    total[_ERR:_ERR + 3] = total_abs[_ERR:_ERR + 3] = errs.sum(axis=1)
+    total[_ERR : _ERR + 3] = total_abs[_ERR : _ERR + 3] = errs.sum(axis=1)
     total[_MEASURE] = total_abs[_MEASURE] = (raw * f0).sum()
     return total, total_abs
 
@@ -180,8 +183,18 @@ def _sums_from_rows(total: NDArray[np.float64], total_abs: NDArray[np.float64], 
     for row, (i, j) in enumerate(_IJ, start=4):
         m2[i, j] = m2[j, i] = total[row]
         a2[i, j] = a2[j, i] = total_abs[row]
-    return Sums(float(total[0]), total[1:4].copy(), m2, float(total_abs[0]), a2, float(total[_NOISE]),
-                total[_ERR:_ERR + 3].copy(), float(total[_MEASURE]), n, blocks)
+    return Sums(
+        float(total[0]),
+        total[1:4].copy(),
+        m2,
+        float(total_abs[0]),
+        a2,
+        float(total[_NOISE]),
+        total[_ERR : _ERR + 3].copy(),
+        float(total[_MEASURE]),
+        n,
+        blocks,
+    )
 
 
 def point_sums(masses: NDArray[np.float64], x: NDArray[np.float64]) -> Sums:

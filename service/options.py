@@ -17,6 +17,7 @@ from .vocabulary import METHODS, MODELS, Model, MotionMethod
 
 __all__ = ["AnalysisOptions", "METHODS"]
 
+
 def _vector(name: str, value: Sequence[float] | None) -> tuple[float, float, float] | None:
     if value is None:
         return None
@@ -98,14 +99,14 @@ def _check_v11(options: AnalysisOptions) -> None:
     from .frames import frame_rotation
 
     if options.export is not None and options.export not in EXPORT_FORMATS:
-        raise InvalidParameterError(f"export must be one of {', '.join(EXPORT_FORMATS)}, got {options.export!r}",
-                                    parameter="export")
+        raise InvalidParameterError(
+            f"export must be one of {', '.join(EXPORT_FORMATS)}, got {options.export!r}", parameter="export"
+        )
     if options.frame is not None:
         q, _ = frame_rotation(options.frame)
         object.__setattr__(options, "frame", tuple(float(v) for v in q))
     if options.isotopes not in ("standard", "abundant"):
-        raise InvalidParameterError(f"isotopes must be 'standard' or 'abundant', got {options.isotopes!r}",
-                                    parameter="isotopes")
+        raise InvalidParameterError(f"isotopes must be 'standard' or 'abundant', got {options.isotopes!r}", parameter="isotopes")
     if options.mass_unit not in ("kg", "u"):
         raise InvalidParameterError(f"mass_unit must be 'kg' or 'u', got {options.mass_unit!r}", parameter="mass_unit")
 
@@ -118,7 +119,8 @@ def _check_geometry(geometry: str, deflection: float | None) -> None:
         return
     _positive("deflection", deflection)
     if not deflection < 1:
-        raise InvalidParameterError("deflection is relative to the bounding-box diagonal: give a number below 1",
-                                    parameter="deflection")
+        raise InvalidParameterError(
+            "deflection is relative to the bounding-box diagonal: give a number below 1", parameter="deflection"
+        )
     if geometry != "mesh":
         raise InvalidParameterError("deflection applies to geometry=mesh", parameter="deflection")

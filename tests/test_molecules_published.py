@@ -32,7 +32,7 @@ from __future__ import annotations
 
 import math
 import warnings
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
 import pytest
@@ -73,11 +73,12 @@ def constants_cm(atoms: Atoms) -> np.ndarray:
     x = x - (m[:, None] * x).sum(axis=0) / m.sum()
     tensor = sum(mi * (np.dot(xi, xi) * np.eye(3) - np.outer(xi, xi)) for mi, xi in zip(m, x))
     moments = np.sort(np.linalg.eigvalsh(tensor))
-    return PLANCK / (8 * math.pi**2 * SPEED_OF_LIGHT * moments) / 100
+    return cast("np.ndarray", PLANCK / (8 * math.pi**2 * SPEED_OF_LIGHT * moments) / 100)
 
 
-def rounding_tolerance(build: Any, params: list[float], last_place: list[float], table: np.ndarray,
-                       table_place: float) -> np.ndarray:
+def rounding_tolerance(
+    build: Any, params: list[float], last_place: list[float], table: np.ndarray, table_place: float
+) -> np.ndarray:
     """Relative tolerance per constant from half a unit in each published last place."""
     base = constants_cm(build(*params))
     spread = np.zeros_like(base)
@@ -85,7 +86,7 @@ def rounding_tolerance(build: Any, params: list[float], last_place: list[float],
         shifted = list(params)
         shifted[i] += place / 2
         spread += np.abs(constants_cm(build(*shifted)) - base)
-    return spread / base + (table_place / 2) / table
+    return cast("np.ndarray", spread / base + (table_place / 2) / table)
 
 
 # CCCBDB expgeom2.asp?casno=50000 (geometry: Gurvich; constants: Herzberg 1966), cm^-1
@@ -97,8 +98,7 @@ H2CO_TABLE_PLACE = 0.00001
 
 def test_formaldehyde_matches_the_cccbdb_table_to_its_precision(client: Any) -> None:
     atoms = formaldehyde(*H2CO_GEOMETRY)
-    body = {"points": [{"element": e, "position": p} for e, p in atoms], "units": "angstrom",
-            "isotopes": "abundant"}
+    body = {"points": [{"element": e, "position": p} for e, p in atoms], "units": "angstrom", "isotopes": "abundant"}
     r = client.post("/v1/analyze/points", json=body)
     assert r.status_code == 200, r.text
     doc = r.json()

@@ -62,8 +62,12 @@ def create_app(settings: Settings | None = None) -> FastAPI:
     # scheme that lets /docs "Try it out" send the key) and the 401 every /v1 route may then answer
     app.include_router(health)
     if settings.api_key:
-        key = APIKeyHeader(name="X-API-Key", scheme_name="APIKey", auto_error=False,
-                           description="the server's INERTIA_API_KEY; /healthz needs none")
+        key = APIKeyHeader(
+            name="X-API-Key",
+            scheme_name="APIKey",
+            auto_error=False,
+            description="the server's INERTIA_API_KEY; /healthz needs none",
+        )
         app.include_router(v1, dependencies=[Depends(key)], responses=error_responses(401))
     else:
         app.include_router(v1)

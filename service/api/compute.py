@@ -48,8 +48,7 @@ from ..errors import ServerBusyError, ServiceError, UnreadableFileError
 from .jobs import Job, MeshJob, run_job
 from .transport import ComputeTimeoutError
 
-__all__ = ["ComputePool", "WorkerCrashError", "memory_limit", "MEMORY_FLOOR_BYTES", "MEMORY_FACTOR",
-           "COMPRESSED_MEMORY_FACTOR"]
+__all__ = ["ComputePool", "WorkerCrashError", "memory_limit", "MEMORY_FLOOR_BYTES", "MEMORY_FACTOR", "COMPRESSED_MEMORY_FACTOR"]
 
 MIB = 1024 * 1024
 # A job may map this much more than its process did before it, plus a multiple of its upload's size.
@@ -66,6 +65,7 @@ def memory_limit(size: int, filename: str | None, cap: int) -> int:
     """Bytes a job on an upload of ``size`` bytes may add to its process's address space."""
     factor = COMPRESSED_MEMORY_FACTOR if (filename or "").lower().endswith(_COMPRESSED) else MEMORY_FACTOR
     return min(cap, MEMORY_FLOOR_BYTES + factor * size)
+
 
 _ROOT = __name__.split(".")[0]  # "inertia" when installed; the folder's name when run from a checkout
 log = logging.getLogger("inertia.api")
@@ -186,8 +186,9 @@ class _Worker:
         if not ready:
             self.kill()
             parent.close()
-            raise WorkerCrashError(f"compute process did not start within {START_TIMEOUT_S:g} s "
-                                   f"(exit code {self.process.exitcode})")
+            raise WorkerCrashError(
+                f"compute process did not start within {START_TIMEOUT_S:g} s (exit code {self.process.exitcode})"
+            )
 
     def call(self, job: Job) -> tuple[str, Any]:
         try:
@@ -211,7 +212,9 @@ def _died_on(job: MeshJob, worker: _Worker) -> UnreadableFileError:
     return UnreadableFileError(
         f"the reader stopped abnormally on this file (exit code {code}); the file may be corrupt or need more "
         f"than the {job.memory_limit_bytes or 0} bytes of memory allowed for it; check it or send a simpler one",
-        exit_code=code, limit_bytes=job.memory_limit_bytes)
+        exit_code=code,
+        limit_bytes=job.memory_limit_bytes,
+    )
 
 
 class ComputePool:
@@ -235,8 +238,7 @@ class ComputePool:
         # Made on first use, so a pool that was closed (end of a lifespan) can serve again.
         with self._lock:
             if self._executor is None:
-                self._executor = ThreadPoolExecutor(max_workers=2 * self.size + 2,
-                                                    thread_name_prefix="inertia-pipe")
+                self._executor = ThreadPoolExecutor(max_workers=2 * self.size + 2, thread_name_prefix="inertia-pipe")
             return self._executor
 
     async def warm_up(self) -> None:
@@ -254,8 +256,7 @@ class ComputePool:
         try:
             await asyncio.wait_for(slots.acquire(), self.timeout_s)
         except TimeoutError:
-            raise self._timeout("the server is busy; no compute process became free",
-                                retry_after_s=self._retry_after()) from None
+            raise self._timeout("the server is busy; no compute process became free", retry_after_s=self._retry_after()) from None
         finally:
             self._waiting -= 1
         start = time.monotonic()
@@ -269,9 +270,12 @@ class ComputePool:
         return max(1, math.ceil(self._job_s * (self._waiting + 1) / self.size))
 
     def _busy(self) -> ServerBusyError:
-        return ServerBusyError(f"the server is busy: {self.size} analyses are running and {self._waiting} are "
-                               "waiting; retry after the time in the Retry-After header",
-                               retry_after_s=self._retry_after(), waiting=self._waiting)
+        return ServerBusyError(
+            f"the server is busy: {self.size} analyses are running and {self._waiting} are "
+            "waiting; retry after the time in the Retry-After header",
+            retry_after_s=self._retry_after(),
+            waiting=self._waiting,
+        )
 
     def _slots_of(self, loop: asyncio.AbstractEventLoop) -> asyncio.Semaphore:
         # a semaphore belongs to one event loop; a server has one, test clients may make several
@@ -283,8 +287,7 @@ class ComputePool:
         loop = asyncio.get_running_loop()
         worker = await loop.run_in_executor(self._threads, self._acquire)
         try:
-            status, payload = await asyncio.wait_for(loop.run_in_executor(self._threads, worker.call, job),
-                                                     self.timeout_s)
+            status, payload = await asyncio.wait_for(loop.run_in_executor(self._threads, worker.call, job), self.timeout_s)
         except TimeoutError:
             await loop.run_in_executor(self._threads, worker.kill)
             raise self._timeout("the computation took too long and was stopped") from None
@@ -304,8 +307,11 @@ class ComputePool:
         raise WorkerCrashError(f"compute process failed:\n{payload}")
 
     def _timeout(self, what: str, **details: Any) -> ComputeTimeoutError:
-        return ComputeTimeoutError(f"{what} (limit {self.timeout_s:g} s); send a smaller input or "
-                                   "raise INERTIA_TIMEOUT_S", timeout_s=self.timeout_s, **details)
+        return ComputeTimeoutError(
+            f"{what} (limit {self.timeout_s:g} s); send a smaller input or raise INERTIA_TIMEOUT_S",
+            timeout_s=self.timeout_s,
+            **details,
+        )
 
     def _acquire(self) -> _Worker:
         with self._lock:

@@ -27,13 +27,41 @@ from ..errors import ServiceError
 __all__ = ["COLUMNS", "FLOAT_COLUMNS", "error_row", "flat_row", "row_name"]
 
 COLUMNS = (
-    "name", "format", "mass", "volume", "com_x", "com_y", "com_z",
-    "Ixx", "Iyy", "Izz", "Ixy", "Ixz", "Iyz", "I1", "I2", "I3",
-    "axis1_x", "axis1_y", "axis1_z", "axis2_x", "axis2_y", "axis2_z", "axis3_x", "axis3_y", "axis3_z",
-    "q_w", "q_x", "q_y", "q_z",
-    "class", "kappa", "warnings", "error",
+    "name",
+    "format",
+    "mass",
+    "volume",
+    "com_x",
+    "com_y",
+    "com_z",
+    "Ixx",
+    "Iyy",
+    "Izz",
+    "Ixy",
+    "Ixz",
+    "Iyz",
+    "I1",
+    "I2",
+    "I3",
+    "axis1_x",
+    "axis1_y",
+    "axis1_z",
+    "axis2_x",
+    "axis2_y",
+    "axis2_z",
+    "axis3_x",
+    "axis3_y",
+    "axis3_z",
+    "q_w",
+    "q_x",
+    "q_y",
+    "q_z",
+    "class",
+    "kappa",
+    "warnings",
+    "error",
 )
-FLOAT_COLUMNS = frozenset(COLUMNS[2:COLUMNS.index("class")]) | {"kappa"}
+FLOAT_COLUMNS = frozenset(COLUMNS[2 : COLUMNS.index("class")]) | {"kappa"}
 _AXES = tuple(f"axis{i}_{c}" for i in (1, 2, 3) for c in "xyz")
 
 # (column, row, col) of the tensor components, in COLUMNS order

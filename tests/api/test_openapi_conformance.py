@@ -46,7 +46,7 @@ def _client(settings: Settings) -> Iterator[Any]:
 
 @pytest.fixture(scope="module")
 def client() -> Iterator[Any]:
-    yield from _client(Settings(compute_processes=1))
+    yield from _client(Settings(compute_processes=1))  # type: ignore[call-arg]  # fields come from INERTIA_* variables
 
 
 @pytest.fixture(scope="module")
@@ -124,48 +124,98 @@ def _step_box() -> bytes:
 
 
 TRIATOMIC = json.loads((SAMPLES / "triatomic.json").read_text())["points"]
-WATER = [{"element": "O", "position": [0, 0, 0.1173]}, {"element": "H", "position": [0, 0.7572, -0.4692]},
-         {"element": "H", "position": [0, -0.7572, -0.4692]}]
+WATER = [
+    {"element": "O", "position": [0, 0, 0.1173]},
+    {"element": "H", "position": [0, 0.7572, -0.4692]},
+    {"element": "H", "position": [0, -0.7572, -0.4692]},
+]
 
 # (name, path, request): every section of the result model appears in at least one of these
 OK_CASES: list[tuple[str, str, Callable[[], Call]]] = [
     ("box", "/v1/analyze/mesh", lambda: mesh(BOX)),
-    ("box every option", "/v1/analyze/mesh", lambda: mesh(
-        BOX, units="mm", density=7850, reference="1,-2,3", omega="0.1,0.2,1", duration=5, samples=7,
-        export="urdf", frame="0.5,0.5,0.5,0.5")),
-    ("asymmetric top, unstable", "/v1/analyze/mesh", lambda: mesh(
-        BOX, omega="0.01,1,0.01", duration=2, samples=3, method="dop853")),
-    ("symmetric top", "/v1/analyze/mesh", lambda: mesh(
-        box_stl(1, 1, 3), omega="0.1,0,1", export="mjcf")),
-    ("shell", "/v1/analyze/mesh", lambda: mesh((SAMPLES / "open_box.stl").read_bytes(), "open_box.stl",
-                                               model="shell", thickness=0.001, export="sdf")),
-    ("volume mesh", "/v1/analyze/mesh", lambda: mesh((SAMPLES / "two_density.vtu").read_bytes(), "two.vtu",
-                                                     mass=3.0, frame="1,0,0,0", reference="0,0,0")),
-    ("scene", "/v1/analyze/mesh", lambda: mesh(_scene_glb(), "scene.glb", densities='{"a": 1000, "b": 2000}',
-                                               export="urdf", omega="0,0,1")),
-    ("cad tessellated", "/v1/analyze/mesh", lambda: mesh(_step_box(), "box.step", geometry="mesh",
-                                                         deflection=0.01)),
+    (
+        "box every option",
+        "/v1/analyze/mesh",
+        lambda: mesh(
+            BOX,
+            units="mm",
+            density=7850,
+            reference="1,-2,3",
+            omega="0.1,0.2,1",
+            duration=5,
+            samples=7,
+            export="urdf",
+            frame="0.5,0.5,0.5,0.5",
+        ),
+    ),
+    (
+        "asymmetric top, unstable",
+        "/v1/analyze/mesh",
+        lambda: mesh(BOX, omega="0.01,1,0.01", duration=2, samples=3, method="dop853"),
+    ),
+    ("symmetric top", "/v1/analyze/mesh", lambda: mesh(box_stl(1, 1, 3), omega="0.1,0,1", export="mjcf")),
+    (
+        "shell",
+        "/v1/analyze/mesh",
+        lambda: mesh((SAMPLES / "open_box.stl").read_bytes(), "open_box.stl", model="shell", thickness=0.001, export="sdf"),
+    ),
+    (
+        "volume mesh",
+        "/v1/analyze/mesh",
+        lambda: mesh((SAMPLES / "two_density.vtu").read_bytes(), "two.vtu", mass=3.0, frame="1,0,0,0", reference="0,0,0"),
+    ),
+    (
+        "scene",
+        "/v1/analyze/mesh",
+        lambda: mesh(_scene_glb(), "scene.glb", densities='{"a": 1000, "b": 2000}', export="urdf", omega="0,0,1"),
+    ),
+    ("cad tessellated", "/v1/analyze/mesh", lambda: mesh(_step_box(), "box.step", geometry="mesh", deflection=0.01)),
     ("cad brep", "/v1/analyze/mesh", lambda: mesh(_step_box(), "box.step")),
-    ("points with trajectory", "/v1/analyze/points", lambda: points(
-        {"points": TRIATOMIC, "omega": [1, 2, 3], "duration": 1.0, "samples": 3, "method": "rk45",
-         "reference": [0, 0, 0]})),
+    (
+        "points with trajectory",
+        "/v1/analyze/points",
+        lambda: points(
+            {"points": TRIATOMIC, "omega": [1, 2, 3], "duration": 1.0, "samples": 3, "method": "rk45", "reference": [0, 0, 0]}
+        ),
+    ),
     ("molecule", "/v1/analyze/points", lambda: points({"points": WATER, "units": "angstrom"})),
-    ("linear molecule", "/v1/analyze/points", lambda: points(
-        {"points": [{"element": "O", "position": [0, 0, -1.16]}, {"element": "C", "position": [0, 0, 0]},
-                    {"element": "O", "position": [0, 0, 1.16]}], "units": "angstrom", "omega": [1, 0, 0]})),
-    ("precession from a tensor", "/v1/precession", lambda: prec(
-        {"inertia_tensor": [[2, 0.1, 0], [0.1, 3, 0], [0, 0, 4]], "omega": [0.1, 0, 1], "duration": 3.0,
-         "samples": 4})),
-    ("precession from moments", "/v1/precession", lambda: prec(
-        {"principal_moments": [1, 2, 3], "omega": [0.01, 1, 0.01], "method": "splitting", "duration": 2.0,
-         "samples": 3})),
+    (
+        "linear molecule",
+        "/v1/analyze/points",
+        lambda: points(
+            {
+                "points": [
+                    {"element": "O", "position": [0, 0, -1.16]},
+                    {"element": "C", "position": [0, 0, 0]},
+                    {"element": "O", "position": [0, 0, 1.16]},
+                ],
+                "units": "angstrom",
+                "omega": [1, 0, 0],
+            }
+        ),
+    ),
+    (
+        "precession from a tensor",
+        "/v1/precession",
+        lambda: prec(
+            {"inertia_tensor": [[2, 0.1, 0], [0.1, 3, 0], [0, 0, 4]], "omega": [0.1, 0, 1], "duration": 3.0, "samples": 4}
+        ),
+    ),
+    (
+        "precession from moments",
+        "/v1/precession",
+        lambda: prec(
+            {"principal_moments": [1, 2, 3], "omega": [0.01, 1, 0.01], "method": "splitting", "duration": 2.0, "samples": 3}
+        ),
+    ),
     ("precession at rest", "/v1/precession", lambda: prec({"principal_moments": [1, 1, 1], "omega": [0, 0, 0]})),
 ]
 
 
 @pytest.mark.parametrize(("name", "path", "request_"), OK_CASES, ids=[c[0] for c in OK_CASES])
-def test_every_result_validates_against_the_schema(client: Any, spec: dict[str, Any], name: str, path: str,
-                                                    request_: Callable[[], Call]) -> None:
+def test_every_result_validates_against_the_schema(
+    client: Any, spec: dict[str, Any], name: str, path: str, request_: Callable[[], Call]
+) -> None:
     response = request_()(client)
     assert response.status_code == 200, response.text
     check(spec, "post", path, response)
@@ -226,30 +276,46 @@ def test_batch_lines_validate_as_results_or_envelopes(client: Any, spec: dict[st
 # (expected status, code, settings, path, request)
 ERROR_CASES: list[tuple[int, str, dict[str, Any], str, Call]] = [
     (401, "unauthorized", {"api_key": "s3cret"}, "/v1/analyze/mesh", mesh(BOX)),
-    (401, "unauthorized", {"api_key": "s3cret"}, "/v1/precession", prec({"principal_moments": [1, 2, 3],
-                                                                         "omega": [0, 0, 1]})),
+    (401, "unauthorized", {"api_key": "s3cret"}, "/v1/precession", prec({"principal_moments": [1, 2, 3], "omega": [0, 0, 1]})),
     (413, "payload_too_large", {"max_upload_bytes": 1000}, "/v1/analyze/mesh", mesh(box_stl(1, 2, 3) * 3)),
-    (413, "payload_too_large", {"max_upload_bytes": 1000}, "/v1/analyze/points",
-     points({"points": [{"mass": 1.0, "position": [i, 0, 0]} for i in range(100)]})),
+    (
+        413,
+        "payload_too_large",
+        {"max_upload_bytes": 1000},
+        "/v1/analyze/points",
+        points({"points": [{"mass": 1.0, "position": [i, 0, 0]} for i in range(100)]}),
+    ),
     (415, "unsupported_format", {}, "/v1/analyze/mesh", mesh(BOX, "part.dwg")),
     (422, "invalid_parameter", {}, "/v1/analyze/mesh", mesh(BOX, density=-1)),
     (422, "invalid_parameter", {}, "/v1/analyze/mesh", mesh(BOX, density=1, mass=2)),
     (422, "invalid_parameter", {}, "/v1/analyze/mesh", mesh(BOX, omega="0,0,1", duration=1, samples=10**9)),
     (422, "not_watertight", {}, "/v1/analyze/mesh", mesh(OPEN)),
     (422, "invalid_parameter", {}, "/v1/analyze/points", points({"points": []})),
-    (422, "invalid_inertia", {}, "/v1/analyze/points", points({"points": [{"mass": 1.0, "position": [0, 0, 0]}],
-                                                               "export": "urdf"})),
+    (
+        422,
+        "invalid_inertia",
+        {},
+        "/v1/analyze/points",
+        points({"points": [{"mass": 1.0, "position": [0, 0, 0]}], "export": "urdf"}),
+    ),
     (422, "invalid_parameter", {}, "/v1/precession", prec({"principal_moments": [1, 2, 3]})),
-    (422, "invalid_parameter", {}, "/v1/batch", lambda c: c.post("/v1/batch", params={"units": "parsec"},
-                                                                 files=[("files", ("a.stl", BOX))])),
+    (
+        422,
+        "invalid_parameter",
+        {},
+        "/v1/batch",
+        lambda c: c.post("/v1/batch", params={"units": "parsec"}, files=[("files", ("a.stl", BOX))]),
+    ),
     (503, "timeout", {"timeout_s": 0.05}, "/v1/analyze/mesh", mesh(torus_stl(500, 500))),
 ]
 
 
-@pytest.mark.parametrize(("status", "code", "settings", "path", "request_"), ERROR_CASES,
-                         ids=[f"{c[0]}-{c[1]}-{c[3]}" for c in ERROR_CASES])
-def test_every_error_status_validates_against_the_schema(status: int, code: str, settings: dict[str, Any],
-                                                         path: str, request_: Call) -> None:
+@pytest.mark.parametrize(
+    ("status", "code", "settings", "path", "request_"), ERROR_CASES, ids=[f"{c[0]}-{c[1]}-{c[3]}" for c in ERROR_CASES]
+)
+def test_every_error_status_validates_against_the_schema(
+    status: int, code: str, settings: dict[str, Any], path: str, request_: Call
+) -> None:
     for c in _client(Settings(compute_processes=1, **settings)):
         app_spec = c.get("/openapi.json").json()
         response = request_(c)
@@ -265,17 +331,20 @@ def test_an_internal_error_validates_against_the_schema(monkeypatch: pytest.Monk
         raise RuntimeError("a bug")
 
     monkeypatch.setattr(routes, "_small_or_pooled", broken)
-    for c in _client(Settings(compute_processes=1)):
+    for c in _client(Settings(compute_processes=1)):  # type: ignore[call-arg]  # fields come from INERTIA_* variables
         response = prec({"principal_moments": [1, 2, 3], "omega": [0, 0, 1]})(c)
         assert response.status_code == 500
-        assert check(c.get("/openapi.json").json(), "post", "/v1/precession", response)["error"]["code"] == \
-            "internal_error"
+        assert check(c.get("/openapi.json").json(), "post", "/v1/precession", response)["error"]["code"] == "internal_error"
 
 
 def test_every_error_status_is_documented_with_the_envelope_and_valid_examples(spec: dict[str, Any]) -> None:
     envelope = _schema_ref(spec, "ErrorOut")
-    expected = {"/v1/analyze/mesh": {413, 415, 422, 500, 503}, "/v1/analyze/points": {413, 422, 500, 503},
-                "/v1/precession": {413, 422, 500, 503}, "/v1/batch": {413, 422, 500, 503}}
+    expected = {
+        "/v1/analyze/mesh": {413, 415, 422, 500, 503},
+        "/v1/analyze/points": {413, 422, 500, 503},
+        "/v1/precession": {413, 422, 500, 503},
+        "/v1/batch": {413, 422, 500, 503},
+    }
     for path, statuses in expected.items():
         responses = spec["paths"][path]["post"]["responses"]
         assert statuses <= {int(s) for s in responses}, path
@@ -296,7 +365,7 @@ def test_every_error_status_is_documented_with_the_envelope_and_valid_examples(s
 
 
 def test_the_api_key_scheme_is_documented_where_a_key_is_required() -> None:
-    for c in _client(Settings(compute_processes=1, api_key="s3cret")):
+    for c in _client(Settings(compute_processes=1, api_key="s3cret")):  # type: ignore[call-arg]  # fields come from INERTIA_* variables
         spec = c.get("/openapi.json").json()
     schemes = spec["components"]["securitySchemes"]
     described = [{k: s[k] for k in ("type", "in", "name")} for s in schemes.values()]
@@ -331,8 +400,9 @@ with TestClient(create_app(Settings(compute_processes=1))) as c:
                       "at": ask(limit), "past": ask(limit + 1)}))
 """
     full = {k: v for k, v in os.environ.items() if not k.startswith("INERTIA_")}
-    out = subprocess.run([sys.executable, "-c", script], env={**full, **env}, capture_output=True, text=True,
-                         timeout=300, check=True)
+    out = subprocess.run(
+        [sys.executable, "-c", script], env={**full, **env}, capture_output=True, text=True, timeout=300, check=True
+    )
     result: dict[str, Any] = json.loads(out.stdout.strip().splitlines()[-1])
     return result
 
@@ -348,7 +418,11 @@ def test_one_samples_limit_in_schema_validation_and_docs(env: dict[str, str], li
 
 def test_a_bad_samples_limit_stops_the_server_with_a_sentence() -> None:
     full = {k: v for k, v in os.environ.items() if not k.startswith("INERTIA_")}
-    out = subprocess.run([sys.executable, "-c", "import inertia.api.schemas"], capture_output=True, text=True,
-                         env={**full, "INERTIA_MAX_SAMPLES": "lots"}, timeout=300)
+    out = subprocess.run(
+        [sys.executable, "-c", "import inertia.api.schemas"],
+        capture_output=True,
+        text=True,
+        env={**full, "INERTIA_MAX_SAMPLES": "lots"},
+        timeout=300,
+    )
     assert out.returncode != 0 and "INERTIA_MAX_SAMPLES must be a whole number" in out.stderr
-

@@ -15,11 +15,13 @@ from fastapi.testclient import TestClient
 from inertia.api.jobs import PointsJob, run_job
 from inertia.api.schemas import AnalysisOut, PointsRequest
 
-TRIANGLE = [{"mass": 1.0, "position": [0, 0, 0]}, {"mass": 2.0, "position": [1, 0, 0]},
-            {"mass": 1.0, "position": [0, 1, 0]}]
+TRIANGLE = [{"mass": 1.0, "position": [0, 0, 0]}, {"mass": 2.0, "position": [1, 0, 0]}, {"mass": 1.0, "position": [0, 1, 0]}]
 LINE = [{"mass": 1.0, "position": [0, 0, 0]}, {"mass": 3.0, "position": [0, 0, 2.5]}]
-WATER = [{"element": "O", "position": [0, 0, 0]}, {"element": "H", "position": [0.757, 0.586, 0]},
-         {"element": "H", "position": [-0.757, 0.586, 0]}]
+WATER = [
+    {"element": "O", "position": [0, 0, 0]},
+    {"element": "H", "position": [0.757, 0.586, 0]},
+    {"element": "H", "position": [-0.757, 0.586, 0]},
+]
 
 BODIES: list[dict[str, Any]] = [
     {"points": TRIANGLE},

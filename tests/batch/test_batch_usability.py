@@ -24,8 +24,10 @@ BOX = ROOT / "sample_meshes" / "box.stl"
 
 
 def inertia(*args: str, **kwargs: object) -> subprocess.CompletedProcess[str]:
-    return subprocess.run([sys.executable, "-m", "inertia", "batch", *args], capture_output=True, text=True,
-                          timeout=300, **kwargs)  # type: ignore[call-overload]
+    run: subprocess.CompletedProcess[str] = subprocess.run(  # type: ignore[call-overload]
+        [sys.executable, "-m", "inertia", "batch", *args], capture_output=True, text=True, timeout=300, **kwargs
+    )
+    return run
 
 
 def test_a_missing_output_folder_is_made(tmp_path: Path) -> None:
@@ -52,11 +54,13 @@ def test_flat_rows_carry_the_principal_axes_and_quaternion(tmp_path: Path) -> No
     assert np.abs(axes) == pytest.approx(np.array([[0, 0, 1], [0, 1, 0], [1, 0, 0]]), abs=1e-15)
     assert np.linalg.det(axes) == pytest.approx(1.0, abs=1e-15)
     w, x, y, z = (float(row[f"q_{c}"]) for c in "wxyz")
-    rotation = np.array([  # the quaternion's matrix, written out: it carries principal vectors to the input frame
-        [1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
-        [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
-        [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)],
-    ])
+    rotation = np.array(
+        [  # the quaternion's matrix, written out: it carries principal vectors to the input frame
+            [1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
+            [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
+            [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)],
+        ]
+    )
     assert rotation == pytest.approx(axes.T, abs=1e-15)
 
 
@@ -67,9 +71,13 @@ def test_ctrl_c_keeps_the_rows_and_says_how_to_resume(tmp_path: Path) -> None:
     for i in range(400):
         shutil.copy(BOX, folder / f"part{i:04d}.stl")
     out = tmp_path / "rows.jsonl"
-    proc = subprocess.Popen([sys.executable, "-m", "inertia", "batch", str(folder), "--out", str(out), "--workers", "2",
-                             "--no-progress"], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-                            start_new_session=True)
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "inertia", "batch", str(folder), "--out", str(out), "--workers", "2", "--no-progress"],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        start_new_session=True,
+    )
     deadline = time.monotonic() + 120
     while time.monotonic() < deadline and (not out.exists() or out.stat().st_size == 0):
         time.sleep(0.05)

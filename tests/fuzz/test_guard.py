@@ -50,8 +50,14 @@ ATTACKS = {
 }
 
 HONEST = {
-    "abaqus": H.abaqus(), "vtu": H.vtu(), "gltf": H.gltf(), "glb": H.glb(), "3mf": H.threemf(),
-    "ply": H.ply(), "ply ascii": H.ply(binary=False), "off": H.off(),
+    "abaqus": H.abaqus(),
+    "vtu": H.vtu(),
+    "gltf": H.gltf(),
+    "glb": H.glb(),
+    "3mf": H.threemf(),
+    "ply": H.ply(),
+    "ply ascii": H.ply(binary=False),
+    "off": H.off(),
 }
 
 

@@ -34,7 +34,11 @@ class LiveServer:
         self.log = open(ROOT / ".pytest_cache" / f"{log_name}-{self.port}.log", "w+b")  # noqa: SIM115  (open until stop())
         self.process = subprocess.Popen(
             [sys.executable, "-m", "inertia", "serve", "--host", "127.0.0.1", "--port", str(self.port)],
-            cwd=ROOT, env=full_env, stdout=self.log, stderr=subprocess.STDOUT)
+            cwd=ROOT,
+            env=full_env,
+            stdout=self.log,
+            stderr=subprocess.STDOUT,
+        )
         try:
             self._wait_ready(startup_s)
         except BaseException:
