@@ -89,9 +89,25 @@ def uv_sphere(nlat: int, nlon: int) -> tuple[np.ndarray, np.ndarray]:
     return v, np.vstack([north, bands, bottom])
 
 
-BOX = (np.array([[(k & 1), (k >> 1) & 1, (k >> 2) & 1] for k in range(8)], dtype=float),
-       np.array([[0, 2, 1], [1, 2, 3], [4, 5, 6], [5, 7, 6], [0, 1, 4], [1, 5, 4],
-                 [2, 6, 3], [3, 6, 7], [0, 4, 2], [2, 4, 6], [1, 3, 5], [3, 7, 5]]))
+BOX = (
+    np.array([[(k & 1), (k >> 1) & 1, (k >> 2) & 1] for k in range(8)], dtype=float),
+    np.array(
+        [
+            [0, 2, 1],
+            [1, 2, 3],
+            [4, 5, 6],
+            [5, 7, 6],
+            [0, 1, 4],
+            [1, 5, 4],
+            [2, 6, 3],
+            [3, 6, 7],
+            [0, 4, 2],
+            [2, 4, 6],
+            [1, 3, 5],
+            [3, 7, 5],
+        ]
+    ),
+)
 
 
 def write_stl(path: Path, triangles: np.ndarray) -> None:
@@ -102,8 +118,7 @@ def write_stl(path: Path, triangles: np.ndarray) -> None:
         fh.write(rec.tobytes())
 
 
-def generate(folder: Path, count: int, shape: Callable[[np.random.Generator], tuple[np.ndarray, np.ndarray]],
-             seed: int) -> int:
+def generate(folder: Path, count: int, shape: Callable[[np.random.Generator], tuple[np.ndarray, np.ndarray]], seed: int) -> int:
     """``count`` STL files of random scale and offset; returns the number of triangles."""
     folder.mkdir(parents=True)
     rng = np.random.default_rng(seed)
@@ -186,8 +201,7 @@ print(len(files))
 def whole_process(script: str, file_list: Path, count: int) -> float:
     """Wall s of ``python -c script file_list`` from launch to exit."""
     t0 = time.perf_counter()
-    done = subprocess.run([sys.executable, "-c", script, str(file_list)], cwd=ROOT, capture_output=True, text=True,
-                          check=False)
+    done = subprocess.run([sys.executable, "-c", script, str(file_list)], cwd=ROOT, capture_output=True, text=True, check=False)
     wall = time.perf_counter() - t0
     if done.returncode != 0:
         raise RuntimeError(f"loop process failed (exit {done.returncode}):\n{done.stderr}")
@@ -210,8 +224,7 @@ def check_rows(out: Path, files: list[Path]) -> None:
 def cli_run(folder: Path, out: Path, workers: int, files: list[Path]) -> float:
     """Wall s of the real ``inertia batch`` command in a fresh process, from launch to exit."""
     out.unlink(missing_ok=True)
-    command = [sys.executable, "-m", "inertia", "batch", str(folder), "--out", str(out), "--workers", str(workers),
-               "--no-progress"]
+    command = [sys.executable, "-m", "inertia", "batch", str(folder), "--out", str(out), "--workers", str(workers), "--no-progress"]
     t0 = time.perf_counter()
     done = subprocess.run(command, cwd=ROOT, capture_output=True, text=True, check=False)
     wall = time.perf_counter() - t0
@@ -231,8 +244,10 @@ def available_cores(processes: int = 2, seconds: float = 1.0) -> float:
     busy session elsewhere cuts it towards 1.0, whatever the number of our
     processes: parallel speed-ups are then capped.
     """
-    procs = [subprocess.Popen([sys.executable, "-c", SPIN.format(s=seconds)], stdout=subprocess.PIPE, text=True)
-             for _ in range(processes)]
+    procs = [
+        subprocess.Popen([sys.executable, "-c", SPIN.format(s=seconds)], stdout=subprocess.PIPE, text=True)
+        for _ in range(processes)
+    ]
     cpu = sum(float(p.communicate()[0]) for p in procs)
     return cpu / seconds
 
@@ -309,8 +324,18 @@ def _child(folder: str, out: str, workers: int) -> None:
         sampler.join()
         client.close()
         cluster.close()
-    print(json.dumps({"run_s": run_s, "samples": log.samples, "peaks": log.peaks, "worker_cpu_s": worker_cpu,
-                      "client_cpu_s": client_cpu, "passes": passes}))
+    print(
+        json.dumps(
+            {
+                "run_s": run_s,
+                "samples": log.samples,
+                "peaks": log.peaks,
+                "worker_cpu_s": worker_cpu,
+                "client_cpu_s": client_cpu,
+                "passes": passes,
+            }
+        )
+    )
 
 
 @dataclass
@@ -333,8 +358,13 @@ def instrumented_run(folder: Path, out: Path, workers: int, files: list[Path]) -
     """Memory and CPU of ``run_batch(client=...)`` on a local cluster started first, in a fresh process."""
     out.unlink(missing_ok=True)
     t0 = time.perf_counter()
-    done = subprocess.run([sys.executable, "-m", "benchmarks.batch", "--child", str(folder), str(out), str(workers)],
-                          cwd=ROOT, capture_output=True, text=True, check=False)
+    done = subprocess.run(
+        [sys.executable, "-m", "benchmarks.batch", "--child", str(folder), str(out), str(workers)],
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
+        check=False,
+    )
     wall = time.perf_counter() - t0
     if done.returncode != 0:
         raise RuntimeError(f"instrumented batch failed:\n{done.stderr}")
@@ -377,9 +407,13 @@ def _ratio(x: float) -> str:
 
 
 def memory_table(rows: list[Row]) -> list[str]:
-    lines = [(f"| data set | worker | RSS, first sample (MiB) | RSS max, pass 1 (MiB) | RSS max, pass {MEMORY_PASSES} (MiB) "
-              f"| change, pass 1 to {MEMORY_PASSES} (MiB) | median (MiB) | peak RSS, ru_maxrss (MiB) | samples |"),
-             "|---|---|---:|---:|---:|---:|---:|---:|---:|"]
+    lines = [
+        (
+            f"| data set | worker | RSS, first sample (MiB) | RSS max, pass 1 (MiB) | RSS max, pass {MEMORY_PASSES} (MiB) "
+            f"| change, pass 1 to {MEMORY_PASSES} (MiB) | median (MiB) | peak RSS, ru_maxrss (MiB) | samples |"
+        ),
+        "|---|---|---:|---:|---:|---:|---:|---:|---:|",
+    ]
     for row in rows:
         log = row.instrumented.memory
         if not log.samples or not log.passes:
@@ -391,9 +425,11 @@ def memory_table(rows: list[Row]) -> list[str]:
             first = [r for t, r in series if a0 <= t <= a1] or [series[0][1]]
             last = [r for t, r in series if b0 <= t <= b1] or [series[-1][1]]
             change = (max(last) - max(first)) / 2**20
-            lines.append(f"| {row.dataset} | {k + 1} | {_mb(series[0][1])} | {_mb(max(first))} | {_mb(max(last))} | "
-                         f"{change:+.1f} | {_mb(statistics.median(r for _, r in series))} | "
-                         f"{_mb(log.peaks.get(worker, 0))} | {len(series)} |")
+            lines.append(
+                f"| {row.dataset} | {k + 1} | {_mb(series[0][1])} | {_mb(max(first))} | {_mb(max(last))} | "
+                f"{change:+.1f} | {_mb(statistics.median(r for _, r in series))} | "
+                f"{_mb(log.peaks.get(worker, 0))} | {len(series)} |"
+            )
     return lines
 
 
@@ -414,8 +450,7 @@ def _verdict(row: Row, workers: int, quick: bool) -> list[str]:
         f"- both sides without start-up: `run_batch` on an already-started cluster (the instrumented run, best "
         f"{row.steady_s:.2f} s) against trimesh's in-process loop: **{_ratio(steady)}x**, {met(steady)};",
         f"- the command with all its start-up against trimesh's in-process loop without its import: "
-        f"**{_ratio(inproc)}x**, {met(inproc)}."
-        + (" Quick run: too few files to judge." if quick else ""),
+        f"**{_ratio(inproc)}x**, {met(inproc)}." + (" Quick run: too few files to judge." if quick else ""),
         "",
     ]
 
@@ -432,31 +467,39 @@ def cpu_table(rows: list[Row], workers: int) -> list[str]:
         f"{workers} cores, the batch's worker CPU and the client's (a separate process, on the same cores)",
         "counted together.",
         "",
-        ("| data set | trimesh loop (ms/file) | analyze loop (ms/file) | batch workers (ms/file) "
-        f"| batch client + scheduler (ms/file) | batch files/s bound on {workers} free cores |"),
+        (
+            "| data set | trimesh loop (ms/file) | analyze loop (ms/file) | batch workers (ms/file) "
+            f"| batch client + scheduler (ms/file) | batch files/s bound on {workers} free cores |"
+        ),
         "|---|---:|---:|---:|---:|---:|",
     ]
     for row in rows:
         per = 1e3 / row.files
         inst = row.instrumented
         total = (inst.worker_cpu_s + inst.client_cpu_s) / row.files
-        lines.append(f"| {row.dataset} | {row.trimesh_cpu_s * per:.2f} | {row.analyze_cpu_s * per:.2f} | "
-                     f"{inst.worker_cpu_s * per:.2f} | {inst.client_cpu_s * per:.2f} | {workers / total:,.1f} |")
+        lines.append(
+            f"| {row.dataset} | {row.trimesh_cpu_s * per:.2f} | {row.analyze_cpu_s * per:.2f} | "
+            f"{inst.worker_cpu_s * per:.2f} | {inst.client_cpu_s * per:.2f} | {workers / total:,.1f} |"
+        )
     return [*lines, ""]
 
 
 def _notes(rows: list[Row], workers: int, loads: list[float]) -> list[str]:
     out = ["### Notes", ""]
     if loads and min(loads) < 0.9 * workers:
-        out.append(f"- **The machine was shared** (as few as {min(loads):.2f} cores available to this run): with "
-                   "the kernel's autogroup scheduling another busy session caps this run's CPU share whatever the "
-                   "number of workers, so the batch figures understate the speed-up; rerun on an idle machine.")
+        out.append(
+            f"- **The machine was shared** (as few as {min(loads):.2f} cores available to this run): with "
+            "the kernel's autogroup scheduling another busy session caps this run's CPU share whatever the "
+            "number of workers, so the batch figures understate the speed-up; rerun on an idle machine."
+        )
     for row in rows:
         pipeline = row.trimesh_s / row.analyze_s
         scaling = row.analyze_s / row.instrumented.run_s
-        out.append(f"- {row.dataset}: in-process, our serial pipeline runs at {pipeline:.2f}x the trimesh loop; in "
-                   f"the instrumented run, `run_batch` on the already-started {workers} workers runs at "
-                   f"{scaling:.2f}x the serial pipeline in-process.")
+        out.append(
+            f"- {row.dataset}: in-process, our serial pipeline runs at {pipeline:.2f}x the trimesh loop; in "
+            f"the instrumented run, `run_batch` on the already-started {workers} workers runs at "
+            f"{scaling:.2f}x the serial pipeline in-process."
+        )
     out += [
         "- The trimesh loop is the baseline the issue names; `trimesh.load` also merges vertices and checks",
         "  the mesh, while our pipeline reads STL with its own reader and integrates exactly (two passes,",
@@ -471,20 +514,26 @@ def _notes(rows: list[Row], workers: int, loads: list[float]) -> list[str]:
 
 def throughput_table(rows: list[Row], workers: int) -> list[str]:
     lines = [
-        ("| data set | files | triangles | input (MB) | contender | wall (s) | files/s | triangles/s "
-         "| vs trimesh loop, whole process | vs trimesh loop, in-process |"),
+        (
+            "| data set | files | triangles | input (MB) | contender | wall (s) | files/s | triangles/s "
+            "| vs trimesh loop, whole process | vs trimesh loop, in-process |"
+        ),
         "|---|---:|---:|---:|---|---:|---:|---:|---:|---:|",
     ]
     for row in rows:
-        for name, secs, whole in (("trimesh loop, in-process", row.trimesh_s, False),
-                                  ("trimesh loop, whole process", row.trimesh_proc_s, True),
-                                  ("analyze loop, in-process", row.analyze_s, False),
-                                  ("analyze loop, whole process", row.analyze_proc_s, True),
-                                  (f"inertia batch, {workers} workers, whole process", row.batch_s, True)):
+        for name, secs, whole in (
+            ("trimesh loop, in-process", row.trimesh_s, False),
+            ("trimesh loop, whole process", row.trimesh_proc_s, True),
+            ("analyze loop, in-process", row.analyze_s, False),
+            ("analyze loop, whole process", row.analyze_proc_s, True),
+            (f"inertia batch, {workers} workers, whole process", row.batch_s, True),
+        ):
             vs_whole = f"{_ratio(row.trimesh_proc_s / secs)}x" if whole else ""
-            lines.append(f"| {row.dataset}: {row.description} | {row.files:,} | {row.triangles:,} | "
-                         f"{row.megabytes:.0f} | {name} | {secs:.2f} | {row.files / secs:,.1f} | "
-                         f"{row.triangles / secs:,.0f} | {vs_whole} | {_ratio(row.trimesh_s / secs)}x |")
+            lines.append(
+                f"| {row.dataset}: {row.description} | {row.files:,} | {row.triangles:,} | "
+                f"{row.megabytes:.0f} | {name} | {secs:.2f} | {row.files / secs:,.1f} | "
+                f"{row.triangles / secs:,.0f} | {vs_whole} | {_ratio(row.trimesh_s / secs)}x |"
+            )
     return lines
 
 
@@ -495,12 +544,14 @@ def render(rows: list[Row], workers: int, quick: bool, command: str, loads: list
     lines = [
         "## Throughput",
         "",
-        (f"Measured by `{command}` on {_today()}: {_cpu_model()}, {os.cpu_count()} cores, Python "
-        f"{platform.python_version()}, dask {dask.__version__}, trimesh {trimesh.__version__}. "
-        "Cores this run could use, probed before each round by two busy processes (2.00 = an idle 2-core "
-        f"machine): {', '.join(f'{x:.2f}' for x in loads)}. {rounds} interleaved rounds per data set "
-        f"({max(1, rounds // 3)} for the large one), every contender in each round, their order rotated from "
-        "round to round; each figure is the best of the rounds."),
+        (
+            f"Measured by `{command}` on {_today()}: {_cpu_model()}, {os.cpu_count()} cores, Python "
+            f"{platform.python_version()}, dask {dask.__version__}, trimesh {trimesh.__version__}. "
+            "Cores this run could use, probed before each round by two busy processes (2.00 = an idle 2-core "
+            f"machine): {', '.join(f'{x:.2f}' for x in loads)}. {rounds} interleaved rounds per data set "
+            f"({max(1, rounds // 3)} for the large one), every contender in each round, their order rotated from "
+            "round to round; each figure is the best of the rounds."
+        ),
         "All contenders read the same binary STL files, from the page cache, in the same run.",
         "",
         "- **trimesh loop**: `trimesh.load(path).mass_properties` per file, one process, one after the other.",
@@ -510,8 +561,10 @@ def render(rows: list[Row], workers: int, quick: bool, command: str, loads: list
         "- **analyze loop**: `inertia.pipeline.analyze(path).as_dict()` per file, serially: our pipeline",
         "  without Dask (separates the pipeline's own cost from the scaling), timed the same two ways",
         "  (the whole process imports `inertia.pipeline`).",
-        (f"- **inertia batch**: the real command, `python -m inertia batch DIR --out rows.jsonl --workers {workers} "
-         "--no-progress`,"),
+        (
+            f"- **inertia batch**: the real command, `python -m inertia batch DIR --out rows.jsonl --workers {workers} "
+            "--no-progress`,"
+        ),
         "  in a fresh process from launch to exit: interpreter, imports, the forkserver the workers fork from,",
         f"  the start of a `LocalCluster` of {workers} single-threaded workers (in the background while the",
         "  command analyses the first small files itself) and shutdown are all included. Every run's output",
@@ -527,9 +580,13 @@ def render(rows: list[Row], workers: int, quick: bool, command: str, loads: list
         "cluster: a fresh process starts the local cluster (`inertia.batch.runner.connect`), then calls",
         "`run_batch(client=...)` on it while a second client samples the workers' memory. That path has no",
         "head start (the cluster is up before the first file), so it is not a split of the command's wall",
-        "time above; in it, interpreter, imports, cluster start-up and shutdown took " +
-        ", ".join(f"{r.dataset} {r.instrumented.startup_s:.1f} s of {r.instrumented.wall_s:.1f} s "
-                  f"({r.instrumented.startup_s / r.instrumented.wall_s:.0%})" for r in rows) + ".",
+        "time above; in it, interpreter, imports, cluster start-up and shutdown took "
+        + ", ".join(
+            f"{r.dataset} {r.instrumented.startup_s:.1f} s of {r.instrumented.wall_s:.1f} s "
+            f"({r.instrumented.startup_s / r.instrumented.wall_s:.0%})"
+            for r in rows
+        )
+        + ".",
         "",
     ]
     small = next((r for r in rows if r.dataset == "small"), None)
@@ -565,7 +622,7 @@ def write_section(path: Path, text: str) -> None:
     section = f"{START}\n{text.rstrip()}\n{END}"
     old = path.read_text() if path.exists() else ""
     if START in old and END in old:
-        new = old[: old.index(START)] + section + old[old.index(END) + len(END):]
+        new = old[: old.index(START)] + section + old[old.index(END) + len(END) :]
     else:
         new = old + ("\n" if old else "") + section + "\n"
     path.parent.mkdir(parents=True, exist_ok=True)
@@ -591,8 +648,9 @@ def _today() -> str:
 # rounds
 
 
-def measure(name: str, folder: Path, files: list[Path], work: Path, workers: int, rounds: int,
-            loads: list[float]) -> dict[str, Any]:
+def measure(
+    name: str, folder: Path, files: list[Path], work: Path, workers: int, rounds: int, loads: list[float]
+) -> dict[str, Any]:
     """Interleaved rounds over one data set, every contender in each, their order rotated; the best of each."""
     file_list = work / f"{name}.files"
     file_list.write_text("".join(f"{p}\n" for p in files), encoding="utf-8")
@@ -621,10 +679,13 @@ def measure(name: str, folder: Path, files: list[Path], work: Path, workers: int
                 best[key] = got[key]
         best["steady"] = min(best.get("steady", math.inf), got["instrumented"].run_s)
         inst = got["instrumented"]
-        print(f"[{name}] round {r + 1}/{rounds}: trimesh {got['trimesh'][0]:.2f} s in-process, "
-              f"{got['trimesh_proc']:.2f} s whole; analyze {got['analyze'][0]:.2f} s in-process, "
-              f"{got['analyze_proc']:.2f} s whole; batch command {got['batch']:.2f} s; instrumented "
-              f"{inst.wall_s:.2f} s (run_batch {inst.run_s:.2f} s); cores available {load:.2f}", file=sys.stderr)
+        print(
+            f"[{name}] round {r + 1}/{rounds}: trimesh {got['trimesh'][0]:.2f} s in-process, "
+            f"{got['trimesh_proc']:.2f} s whole; analyze {got['analyze'][0]:.2f} s in-process, "
+            f"{got['analyze_proc']:.2f} s whole; batch command {got['batch']:.2f} s; instrumented "
+            f"{inst.wall_s:.2f} s (run_batch {inst.run_s:.2f} s); cores available {load:.2f}",
+            file=sys.stderr,
+        )
     return best
 
 
@@ -632,12 +693,16 @@ def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="python -m benchmarks.batch", description=__doc__.split("\n")[0])
     parser.add_argument("--quick", action="store_true", help="200 small files and 4 of 180k triangles")
     parser.add_argument("--workers", type=int, default=2, help="local worker processes (default 2)")
-    parser.add_argument("--doc", type=Path, default=DOC,
-                        help=f"Markdown file whose benchmark section is replaced (default {DOC.relative_to(ROOT)})")
+    parser.add_argument(
+        "--doc", type=Path, default=DOC, help=f"Markdown file whose benchmark section is replaced (default {DOC.relative_to(ROOT)})"
+    )
     parser.add_argument("--out", type=Path, dest="doc", help=argparse.SUPPRESS)  # the former name of --doc
-    parser.add_argument("--rounds", type=int, default=ROUNDS,
-                        help=f"interleaved rounds (default {ROUNDS}; the large set: a third); the best time of "
-                             "each contender counts")
+    parser.add_argument(
+        "--rounds",
+        type=int,
+        default=ROUNDS,
+        help=f"interleaved rounds (default {ROUNDS}; the large set: a third); the best time of each contender counts",
+    )
     parser.add_argument("--repeat", type=int, dest="rounds", help=argparse.SUPPRESS)  # the former name of --rounds
     parser.add_argument("--only", choices=("tiny", "small", "large"), action="append", help="run only these sets")
     parser.add_argument("--child", nargs=3, metavar=("FOLDER", "OUT", "WORKERS"), help=argparse.SUPPRESS)
@@ -647,9 +712,12 @@ def main(argv: list[str] | None = None) -> int:
         return 0
     if args.rounds < 1:
         parser.error("--rounds must be at least 1")
-    command = "python -m benchmarks.batch" + (" --quick" if args.quick else "") + (
-        f" --workers {args.workers}" if args.workers != 2 else "") + (
-        f" --rounds {args.rounds}" if args.rounds != ROUNDS else "")
+    command = (
+        "python -m benchmarks.batch"
+        + (" --quick" if args.quick else "")
+        + (f" --workers {args.workers}" if args.workers != 2 else "")
+        + (f" --rounds {args.rounds}" if args.rounds != ROUNDS else "")
+    )
     work = Path(tempfile.mkdtemp(prefix="inertia-batch-bench-"))
     rows: list[Row] = []
     loads: list[float] = []
@@ -662,13 +730,30 @@ def main(argv: list[str] | None = None) -> int:
             triangles = generate(folder, count, shape, seed)
             files = sorted(folder.glob("*.stl"))
             megabytes = sum(p.stat().st_size for p in files) / 1e6
-            print(f"[{name}] generated {count} files, {triangles:,} triangles, {megabytes:.0f} MB in "
-                  f"{time.perf_counter() - t:.1f} s", file=sys.stderr)
+            print(
+                f"[{name}] generated {count} files, {triangles:,} triangles, {megabytes:.0f} MB in {time.perf_counter() - t:.1f} s",
+                file=sys.stderr,
+            )
             rounds = args.rounds if name != "large" else max(1, args.rounds // 3)
             best = measure(name, folder, files, work, args.workers, rounds, loads)
-            rows.append(Row(name, count, triangles, description, megabytes, best["trimesh"][0], best["trimesh_proc"],
-                            best["analyze"][0], best["analyze_proc"], best["batch"], best["trimesh"][1],
-                            best["analyze"][1], best["instrumented"], best["steady"]))
+            rows.append(
+                Row(
+                    name,
+                    count,
+                    triangles,
+                    description,
+                    megabytes,
+                    best["trimesh"][0],
+                    best["trimesh_proc"],
+                    best["analyze"][0],
+                    best["analyze_proc"],
+                    best["batch"],
+                    best["trimesh"][1],
+                    best["analyze"][1],
+                    best["instrumented"],
+                    best["steady"],
+                )
+            )
             shutil.rmtree(folder)
     finally:
         shutil.rmtree(work, ignore_errors=True)

@@ -156,8 +156,10 @@ def rows_for(name: str, shape: Any, reference: tuple[float, list[float]] | None,
         options = AnalysisOptions(geometry="mesh", deflection=deflection)
         doc, t = _timed(lambda o=options: analyze(data, filename=f"{name}.step", options=o).as_dict(), repeat)
         em, ei = _errors(doc, mass, moments)
-        rows.append(f"| {name} | {deflection:g} | {doc['source']['triangles']:,} | {em:.1e} | {ei:.1e} | "
-                    f"{doc['diagnostics']['tessellation_error']:.1e} | {t * 1e3:.0f} |")
+        rows.append(
+            f"| {name} | {deflection:g} | {doc['source']['triangles']:,} | {em:.1e} | {ei:.1e} | "
+            f"{doc['diagnostics']['tessellation_error']:.1e} | {t * 1e3:.0f} |"
+        )
         print(rows[-1], flush=True)
     return rows
 

@@ -11,15 +11,28 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["BOX_FACES", "box", "prism", "icosahedron", "l_bracket", "triangles_stl_bytes", "stl_bytes", "write_stl",
-           "write_obj"]
+__all__ = ["BOX_FACES", "box", "prism", "icosahedron", "l_bracket", "triangles_stl_bytes", "stl_bytes", "write_stl", "write_obj"]
 
-BOX_FACES = np.array([[0, 2, 1], [1, 2, 3], [4, 5, 6], [5, 7, 6], [0, 1, 4], [1, 5, 4],
-                      [2, 6, 3], [3, 6, 7], [0, 4, 2], [2, 4, 6], [1, 3, 5], [3, 7, 5]])
+BOX_FACES = np.array(
+    [
+        [0, 2, 1],
+        [1, 2, 3],
+        [4, 5, 6],
+        [5, 7, 6],
+        [0, 1, 4],
+        [1, 5, 4],
+        [2, 6, 3],
+        [3, 6, 7],
+        [0, 4, 2],
+        [2, 4, 6],
+        [1, 3, 5],
+        [3, 7, 5],
+    ]
+)
 """Outward winding of the eight corners of ``box``: vertex k has bits (x, y, z) = (k&1, k&2, k&4)."""
 
 
-def box(a: float, b: float, c: float, origin: Any=(0.0, 0.0, 0.0)) -> tuple[np.ndarray, np.ndarray]:
+def box(a: float, b: float, c: float, origin: Any = (0.0, 0.0, 0.0)) -> tuple[np.ndarray, np.ndarray]:
     """Axis-aligned box with outward winding; vertex k has bits (x, y, z) = (k&1, k&2, k&4)."""
     o = np.asarray(origin, dtype=float)
     v = np.array([[(k & 1) * a, ((k >> 1) & 1) * b, ((k >> 2) & 1) * c] for k in range(8)]) + o

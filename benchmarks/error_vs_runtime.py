@@ -190,8 +190,10 @@ def run_all() -> tuple[list[Run], dict[float, float]]:
             if horizon == 1e3:
                 cost_at_1e3[key] = run.seconds
             runs.append(run)
-            print(f"  {method:9s} {setting:12s} {run.seconds:9.4f} s  dW {run.omega_error:.1e}"
-                  f"  dR {run.attitude_error:.1e}", file=sys.stderr)
+            print(
+                f"  {method:9s} {setting:12s} {run.seconds:9.4f} s  dW {run.omega_error:.1e}  dR {run.attitude_error:.1e}",
+                file=sys.stderr,
+            )
         per_sample[horizon] = exact_cost_per_sample(horizon)
     return runs, per_sample
 
@@ -210,11 +212,42 @@ def _split(step: float, problem: RigidProblem):  # type: ignore[no-untyped-def]
 def icosphere(level: int) -> tuple[np.ndarray, np.ndarray]:
     """Unit icosphere: the icosahedron with each triangle split in 4, ``level`` times, vertices on the sphere."""
     g = (1 + 5**0.5) / 2
-    v = [(-1, g, 0), (1, g, 0), (-1, -g, 0), (1, -g, 0), (0, -1, g), (0, 1, g), (0, -1, -g), (0, 1, -g),
-         (g, 0, -1), (g, 0, 1), (-g, 0, -1), (-g, 0, 1)]
-    faces = [(0, 11, 5), (0, 5, 1), (0, 1, 7), (0, 7, 10), (0, 10, 11), (1, 5, 9), (5, 11, 4), (11, 10, 2),
-             (10, 7, 6), (7, 1, 8), (3, 9, 4), (3, 4, 2), (3, 2, 6), (3, 6, 8), (3, 8, 9), (4, 9, 5), (2, 4, 11),
-             (6, 2, 10), (8, 6, 7), (9, 8, 1)]
+    v = [
+        (-1, g, 0),
+        (1, g, 0),
+        (-1, -g, 0),
+        (1, -g, 0),
+        (0, -1, g),
+        (0, 1, g),
+        (0, -1, -g),
+        (0, 1, -g),
+        (g, 0, -1),
+        (g, 0, 1),
+        (-g, 0, -1),
+        (-g, 0, 1),
+    ]
+    faces = [
+        (0, 11, 5),
+        (0, 5, 1),
+        (0, 1, 7),
+        (0, 7, 10),
+        (0, 10, 11),
+        (1, 5, 9),
+        (5, 11, 4),
+        (11, 10, 2),
+        (10, 7, 6),
+        (7, 1, 8),
+        (3, 9, 4),
+        (3, 4, 2),
+        (3, 2, 6),
+        (3, 6, 8),
+        (3, 8, 9),
+        (4, 9, 5),
+        (2, 4, 11),
+        (6, 2, 10),
+        (8, 6, 7),
+        (9, 8, 1),
+    ]
     verts = [np.array(p, float) / np.linalg.norm(p) for p in v]
     for _ in range(level):
         cache: dict[tuple[int, int], int] = {}
@@ -300,8 +333,10 @@ def plot(runs: list[Run], meshes: list[tuple[str, int, float, float]]) -> None:
     colours = {"exact": "k", "dop853": "tab:blue", "rk45": "tab:orange", "splitting": "tab:green"}
     markers = {10.0: "o", 1e3: "s", 1e5: "^"}
     floor = 1e-17
-    for ax, attr, title in ((axes[0], "omega_error", "max |Omega - ref| / |Omega0|"),
-                            (axes[1], "attitude_error", "max |R - R_ref| (matrix entries)")):
+    for ax, attr, title in (
+        (axes[0], "omega_error", "max |Omega - ref| / |Omega0|"),
+        (axes[1], "attitude_error", "max |R - R_ref| (matrix entries)"),
+    ):
         for method in colours:
             for horizon in HORIZONS:
                 pts = [(r.seconds, max(getattr(r, attr), floor)) for r in runs if r.method == method and r.horizon == horizon]

@@ -26,8 +26,7 @@ import mpmath
 import numpy as np
 from numpy.typing import ArrayLike
 
-__all__ = ["exact_solid", "exact_tetrahedra", "exact_points", "exact_eigenvalues", "exact_moments",
-           "relative_error", "to_mpf"]
+__all__ = ["exact_solid", "exact_tetrahedra", "exact_points", "exact_eigenvalues", "exact_moments", "relative_error", "to_mpf"]
 
 Tensor = list[list[Fraction]]
 DIGITS = 50  # mp.dps for eigenvalues: the smallest moment of a 1e-6 needle is 1e-12 of the largest
@@ -66,8 +65,9 @@ def _moments_to_tensor(m0: Fraction, m1: list[Fraction], m2: Tensor) -> tuple[li
 BLOCK = 1 << 18  # cells per block: bounds the object-array temporaries to ~100 MB
 
 
-def _integer_sums(points: np.ndarray, cells: np.ndarray, weights: np.ndarray | None,
-                  signed: bool) -> tuple[int, list[int], list[list[int]]]:
+def _integer_sums(
+    points: np.ndarray, cells: np.ndarray, weights: np.ndarray | None, signed: bool
+) -> tuple[int, list[int], list[list[int]]]:
     """6 V, 24 int x, 120 int x x^T (times 2**(3e), 2**(4e), 2**(5e)) as exact integers."""
     p = [points[cells[:, k]] for k in range(cells.shape[1])]
     if cells.shape[1] == 3:  # surface triangle + apex at the (integer) origin
@@ -75,8 +75,11 @@ def _integer_sums(points: np.ndarray, cells: np.ndarray, weights: np.ndarray | N
     else:  # tetrahedron p0..p3: edges from p0
         verts = p
         a, b, c = p[1] - p[0], p[2] - p[0], p[3] - p[0]
-    det = (a[:, 0] * (b[:, 1] * c[:, 2] - b[:, 2] * c[:, 1]) - a[:, 1] * (b[:, 0] * c[:, 2] - b[:, 2] * c[:, 0])
-           + a[:, 2] * (b[:, 0] * c[:, 1] - b[:, 1] * c[:, 0]))
+    det = (
+        a[:, 0] * (b[:, 1] * c[:, 2] - b[:, 2] * c[:, 1])
+        - a[:, 1] * (b[:, 0] * c[:, 2] - b[:, 2] * c[:, 0])
+        + a[:, 2] * (b[:, 0] * c[:, 1] - b[:, 1] * c[:, 0])
+    )
     if not signed:
         det = np.abs(det)
     if weights is not None:
@@ -93,13 +96,14 @@ def _integer_sums(points: np.ndarray, cells: np.ndarray, weights: np.ndarray | N
     return int(det.sum()), m1, m2
 
 
-def _integrate(points: np.ndarray, e: int, cells: np.ndarray, weights: tuple[np.ndarray, int] | None,
-               signed: bool) -> tuple[Fraction, list[Fraction], Tensor]:
+def _integrate(
+    points: np.ndarray, e: int, cells: np.ndarray, weights: tuple[np.ndarray, int] | None, signed: bool
+) -> tuple[Fraction, list[Fraction], Tensor]:
     """int dm, int x dm, int x x^T dm over simplices (apex at the origin for surfaces)."""
     d0, d1, d2 = 0, [0] * 3, [[0] * 3 for _ in range(3)]
     for start in range(0, len(cells), BLOCK):
-        w = None if weights is None else weights[0][start:start + BLOCK]
-        b0, b1, b2 = _integer_sums(points, cells[start:start + BLOCK], w, signed)
+        w = None if weights is None else weights[0][start : start + BLOCK]
+        b0, b1, b2 = _integer_sums(points, cells[start : start + BLOCK], w, signed)
         d0 += b0
         d1 = [x + y for x, y in zip(d1, b1)]
         d2 = [[x + y for x, y in zip(r1, r2)] for r1, r2 in zip(d2, b2)]
@@ -126,8 +130,9 @@ def exact_solid(vertices: ArrayLike, faces: ArrayLike) -> tuple[Fraction, list[F
     return m0, [c + o for c, o in zip(com, origin)], tensor
 
 
-def exact_tetrahedra(points: ArrayLike, tets: ArrayLike,
-                     density: ArrayLike | None = None) -> tuple[Fraction, list[Fraction], Tensor]:
+def exact_tetrahedra(
+    points: ArrayLike, tets: ArrayLike, density: ArrayLike | None = None
+) -> tuple[Fraction, list[Fraction], Tensor]:
     """Mass (volume if ``density`` is None), centre of mass and inertia tensor about it
     of a set of tetrahedra with per-cell densities, exactly."""
     pts, e, origin = _local(points)

@@ -159,8 +159,7 @@ def measure_processes(path: Path, triangles: int, repeat: int) -> dict[str, dict
         if tool == "numpy-stl" and triangles >= NO_NUMPY_STL:
             out[tool] = {"skipped": "not run (its exact mass path takes minutes from 1e6 triangles)"}
         elif available_memory() < need + MEMORY_MARGIN:
-            out[tool] = {"skipped": f"not run: needs ~{need / 2**30:.1f} GiB, "
-                                    f"{available_memory() / 2**30:.1f} GiB available"}
+            out[tool] = {"skipped": f"not run: needs ~{need / 2**30:.1f} GiB, {available_memory() / 2**30:.1f} GiB available"}
         else:
             out[tool] = {"walls": [], "rss": [], "cpu": []}
     for r in range(repeat):
@@ -200,15 +199,19 @@ def stage_breakdown(path: Path, warmup: Path) -> dict[str, float]:
                 return fn(*args, **kwargs)
             finally:
                 times[name() if callable(name) else name] += time.perf_counter() - start
+
         return wrapper
 
     def pass_name() -> str:
         passes[0] += 1
         return f"integration pass {passes[0]}"
 
-    patches = [(stl, "read_stl_file", "read STL + float32 weld"),
-               (solid, "surface_topology", "edge topology (watertight check)"),
-               (solid, "_orient_outward", "outward orientation"), (mass._Geometry, "sums", pass_name)]
+    patches = [
+        (stl, "read_stl_file", "read STL + float32 weld"),
+        (solid, "surface_topology", "edge topology (watertight check)"),
+        (solid, "_orient_outward", "outward orientation"),
+        (mass._Geometry, "sums", pass_name),
+    ]
     saved = [(obj, attr, getattr(obj, attr)) for obj, attr, _ in patches]
     try:
         for obj, attr, name in patches:
@@ -244,11 +247,16 @@ def machine_info() -> dict[str, str]:
     except (OSError, ValueError, IndexError):
         pass
     versions = {name: importlib.metadata.version(name) for name in ("numpy", "trimesh", "numpy-stl")}
-    return {"CPU": cpu, "cores (os.cpu_count)": str(os.cpu_count()), "memory": mem,
-            "OS": platform.platform(), "Python": platform.python_version(),
-            **{k: v for k, v in versions.items()},
-            "OPENBLAS_CORETYPE": os.environ.get("OPENBLAS_CORETYPE", "(unset)"),
-            "load average at the end (1, 5, 15 min)": ", ".join(f"{x:.2f}" for x in os.getloadavg())}
+    return {
+        "CPU": cpu,
+        "cores (os.cpu_count)": str(os.cpu_count()),
+        "memory": mem,
+        "OS": platform.platform(),
+        "Python": platform.python_version(),
+        **{k: v for k, v in versions.items()},
+        "OPENBLAS_CORETYPE": os.environ.get("OPENBLAS_CORETYPE", "(unset)"),
+        "load average at the end (1, 5, 15 min)": ", ".join(f"{x:.2f}" for x in os.getloadavg()),
+    }
 
 
 def _rel(a: np.ndarray, b: np.ndarray) -> float:
@@ -262,31 +270,36 @@ def _cell(r: dict[str, Any], key: str, fmt: str, scale: float = 1.0) -> str:
 def report(results: dict[str, dict[str, Any]], stages: dict[str, dict[str, float]], command: str) -> str:
     mb = 1e6
     tools = ("inertia", "trimesh", "numpy-stl")
-    lines = ["# Performance: load + mass properties of binary STL", "",
-             f"Regenerate with `{command}` from the repository root (written by `benchmarks/mass.py`).", "",
-             "Bodies: closed tori (R = 3, r = 1) as binary STL, two triangles per grid quad.  Whole processes:",
-             "`inertia analyze FILE --json` (load, float32 weld, watertight and winding checks, exact",
-             "multi-pass integration, JSON) against a script that imports trimesh, loads the file and reads",
-             "`mass_properties` and `is_watertight`, and one that runs numpy-stl's `Mesh.from_file` +",
-             "`get_mass_properties`.  Rounds are interleaved (the tools' order alternates); wall time, CPU time",
-             "(user + system) and peak RSS (GNU time's maximum resident set of the tool's own process) are the",
-             "best of the runs shown, and *spread* is the slowest run over the fastest, a measure of how much",
-             "the shared machine disturbed the run. numpy-stl runs only up to 1e5 triangles",
-             "(its exact mass path takes minutes).", "",
-             "## Whole process", "",
-             "| triangles | file MB | inertia s | inertia CPU s | trimesh s | trimesh CPU s | numpy-stl s "
-             "| trimesh / inertia (wall) | trimesh / inertia (CPU) | numpy-stl / inertia "
-             "| inertia peak MB | x file | trimesh peak MB | x file | numpy-stl peak MB | runs (ours, trimesh, numpy-stl) "
-             "| spread (ours, trimesh) |",
-             "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
+    lines = [
+        "# Performance: load + mass properties of binary STL",
+        "",
+        f"Regenerate with `{command}` from the repository root (written by `benchmarks/mass.py`).",
+        "",
+        "Bodies: closed tori (R = 3, r = 1) as binary STL, two triangles per grid quad.  Whole processes:",
+        "`inertia analyze FILE --json` (load, float32 weld, watertight and winding checks, exact",
+        "multi-pass integration, JSON) against a script that imports trimesh, loads the file and reads",
+        "`mass_properties` and `is_watertight`, and one that runs numpy-stl's `Mesh.from_file` +",
+        "`get_mass_properties`.  Rounds are interleaved (the tools' order alternates); wall time, CPU time",
+        "(user + system) and peak RSS (GNU time's maximum resident set of the tool's own process) are the",
+        "best of the runs shown, and *spread* is the slowest run over the fastest, a measure of how much",
+        "the shared machine disturbed the run. numpy-stl runs only up to 1e5 triangles",
+        "(its exact mass path takes minutes).",
+        "",
+        "## Whole process",
+        "",
+        "| triangles | file MB | inertia s | inertia CPU s | trimesh s | trimesh CPU s | numpy-stl s "
+        "| trimesh / inertia (wall) | trimesh / inertia (CPU) | numpy-stl / inertia "
+        "| inertia peak MB | x file | trimesh peak MB | x file | numpy-stl peak MB | runs (ours, trimesh, numpy-stl) "
+        "| spread (ours, trimesh) |",
+        "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|",
+    ]
     skipped: list[str] = []
     for r in results.values():
         size = r["file_bytes"]
         ours, tm, ns = (r[k] for k in tools)
         runs = ", ".join(str(r[k].get("runs", 0)) for k in tools)
         ratio = f"{tm['wall'] / ours['wall']:.2f}x" if "skipped" not in tm and "skipped" not in ours else "skipped"
-        cpu_ratio = (f"{tm['cpu_s'] / ours['cpu_s']:.2f}x" if "skipped" not in tm and "skipped" not in ours
-                     else "skipped")
+        cpu_ratio = f"{tm['cpu_s'] / ours['cpu_s']:.2f}x" if "skipped" not in tm and "skipped" not in ours else "skipped"
         ns_ratio = f"{ns['wall'] / ours['wall']:.1f}x" if "skipped" not in ns and "skipped" not in ours else "skipped"
         spread = ", ".join(f"{max(x['walls']) / min(x['walls']):.2f}" if "skipped" not in x else "-" for x in (ours, tm))
         lines.append(
@@ -294,13 +307,17 @@ def report(results: dict[str, dict[str, Any]], stages: dict[str, dict[str, float
             f"| {_cell(tm, 'wall', '.3f')} | {_cell(tm, 'cpu_s', '.2f')} | {_cell(ns, 'wall', '.2f')} "
             f"| {ratio} | {cpu_ratio} | {ns_ratio} "
             f"| {_cell(ours, 'rss', '.0f', mb)} | {_cell(ours, 'rss', '.2f', size)} | {_cell(tm, 'rss', '.0f', mb)} "
-            f"| {_cell(tm, 'rss', '.2f', size)} | {_cell(ns, 'rss', '.0f', mb)} | {runs} | {spread} |")
+            f"| {_cell(tm, 'rss', '.2f', size)} | {_cell(ns, 'rss', '.0f', mb)} | {runs} | {spread} |"
+        )
         skipped += [f"- {r['triangles']:,} triangles, {k}: {r[k]['skipped']}" for k in tools if "skipped" in r[k]]
     lines += [""]
     if skipped:
         lines += ["Not run:", "", *skipped, ""]
-    lines += ["Targets: at least 5x faster than trimesh at 1e6 triangles and 4x at 5e6, whole processes; peak memory "
-              "at most 3x the file size.", ""]
+    lines += [
+        "Targets: at least 5x faster than trimesh at 1e6 triangles and 4x at 5e6, whole processes; peak memory "
+        "at most 3x the file size.",
+        "",
+    ]
     lines += ["## Where our time goes (in process, one `pipeline.analyze`, seconds)", ""]
     names: list[str] = []
     for st in stages.values():
@@ -309,23 +326,34 @@ def report(results: dict[str, dict[str, Any]], stages: dict[str, dict[str, float
     for n in names:
         lines.append(f"| {n} | " + " | ".join(f"{st.get(n, 0.0):.4f}" for st in stages.values()) + " |")
     lines += ["", "The whole-process time also holds interpreter start-up and imports (~0.1 s).", ""]
-    lines += ["## Accuracy (principal moments per unit density)", "",
-              "No closed form exists for the tessellated torus, so the tools are compared with each other;",
-              "`inertia` also reports its own rounding-error bound.", "",
-              "| triangles | inertia moments | max rel. diff trimesh | max rel. diff numpy-stl | inertia error estimate |",
-              "|---|---|---|---|---|"]
+    lines += [
+        "## Accuracy (principal moments per unit density)",
+        "",
+        "No closed form exists for the tessellated torus, so the tools are compared with each other;",
+        "`inertia` also reports its own rounding-error bound.",
+        "",
+        "| triangles | inertia moments | max rel. diff trimesh | max rel. diff numpy-stl | inertia error estimate |",
+        "|---|---|---|---|---|",
+    ]
     for r in results.values():
         if "skipped" in r["inertia"]:
             continue
         ours = r["inertia"]["moments"]
-        diffs = [f"{_rel(r[k]['moments'], ours):.1e}" if "skipped" not in r[k] else "not run"
-                 for k in ("trimesh", "numpy-stl")]
-        lines.append(f"| {r['triangles']:,} | {', '.join(f'{x:.12g}' for x in ours)} "
-                     f"| {diffs[0]} | {diffs[1]} | {r['inertia']['estimate']:.1e} |")
-    lines += ["", "## Machine", "",
-              "Wall times are only comparable within one run: a load average above the core count means",
-              "other work shared the CPUs, which slows every tool (peak memory is unaffected).", "",
-              *[f"- {k}: {v}" for k, v in machine_info().items()], ""]
+        diffs = [f"{_rel(r[k]['moments'], ours):.1e}" if "skipped" not in r[k] else "not run" for k in ("trimesh", "numpy-stl")]
+        lines.append(
+            f"| {r['triangles']:,} | {', '.join(f'{x:.12g}' for x in ours)} "
+            f"| {diffs[0]} | {diffs[1]} | {r['inertia']['estimate']:.1e} |"
+        )
+    lines += [
+        "",
+        "## Machine",
+        "",
+        "Wall times are only comparable within one run: a load average above the core count means",
+        "other work shared the CPUs, which slows every tool (peak memory is unaffected).",
+        "",
+        *[f"- {k}: {v}" for k, v in machine_info().items()],
+        "",
+    ]
     return "\n".join(lines)
 
 
@@ -351,13 +379,22 @@ def main(argv: list[str] | None = None) -> int:
             results[label] = r
             if "skipped" not in r["inertia"]:
                 stages[label] = stage_breakdown(path, warmup)
-            print("  " + ", ".join(f"{k} {r[k]['wall']:.3f} s {r[k]['rss'] / 1e6:.0f} MB" if "skipped" not in r[k]
-                                   else f"{k} skipped" for k in ("inertia", "trimesh", "numpy-stl")),
-                  file=sys.stderr, flush=True)
+            print(
+                "  "
+                + ", ".join(
+                    f"{k} {r[k]['wall']:.3f} s {r[k]['rss'] / 1e6:.0f} MB" if "skipped" not in r[k] else f"{k} skipped"
+                    for k in ("inertia", "trimesh", "numpy-stl")
+                ),
+                file=sys.stderr,
+                flush=True,
+            )
             path.unlink()
-    command = "python -m benchmarks.mass" + (" --quick" if args.quick and not args.sizes else "") \
-        + (f" --sizes {' '.join(args.sizes)}" if args.sizes else "") \
+    command = (
+        "python -m benchmarks.mass"
+        + (" --quick" if args.quick and not args.sizes else "")
+        + (f" --sizes {' '.join(args.sizes)}" if args.sizes else "")
         + (f" --repeat {args.repeat}" if args.repeat != 3 else "")
+    )
     text = report(results, stages, command)
     if args.out == "-":
         print(text)

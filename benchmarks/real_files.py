@@ -63,8 +63,12 @@ EXPECTED: dict[str, tuple[str, Any, tuple[str, ...], str]] = {
     "grouped_obj/negative_indices.obj": (READ, "exact", (), "relative (negative) face indices"),
     "gltf_multi/rgb_cube_with_primitives.gltf": (READ, "exact", (), "one cube split into three open primitives"),
     "gltf_multi/nested.glb": (READ, "exact", (), "node hierarchy with scales"),
-    "gltf_multi/TestScene.gltf": (REFUSE, OPEN, ("TestScene.bin",),
-                                  ".gltf with its .bin in one upload; its scene holds an open plane"),
+    "gltf_multi/TestScene.gltf": (
+        REFUSE,
+        OPEN,
+        ("TestScene.bin",),
+        ".gltf with its .bin in one upload; its scene holds an open plane",
+    ),
     "3mf/box.3mf": (READ, "exact", (), "core"),
     "3mf/cylinder.3mf": (READ, "exact", (), "core"),
     "3mf/multiple_cylinders.3mf": (READ, "exact", (), "core, several build items"),
@@ -81,12 +85,20 @@ EXPECTED: dict[str, tuple[str, Any, tuple[str, ...], str]] = {
 for _p in sorted((REAL / "3mf" / "mustpass").glob("*.3mf")):
     EXPECTED[f"3mf/mustpass/{_p.name}"] = (READ, "exact", (), "3MF Consortium MUSTPASS")
 for _p in sorted((REAL / "3mf" / "mustfail").glob("*.3mf")):
-    EXPECTED[f"3mf/mustfail/{_p.name}"] = (REFUSE, ("unreadable_file", "external_reference", "not_watertight",
-                                                    "unsupported_format"), (), "3MF Consortium MUSTFAIL")
+    EXPECTED[f"3mf/mustfail/{_p.name}"] = (
+        REFUSE,
+        ("unreadable_file", "external_reference", "not_watertight", "unsupported_format"),
+        (),
+        "3MF Consortium MUSTFAIL",
+    )
 # MUSTFAIL 3.4.1a (an unprefixed metadata name outside the well-known list) contradicts MUSTPASS 3.4.1c
 # (which must ignore such a name): metadata never changes the solid, so both are read, and this is said
 EXPECTED["3mf/mustfail/MUSTFAIL_Chapter3.4.1a_MissingMetadataName.3mf"] = (
-    READ, "exact", (), "MUSTFAIL contradicted by MUSTPASS 3.4.1c: read, metadata ignored")
+    READ,
+    "exact",
+    (),
+    "MUSTFAIL contradicted by MUSTPASS 3.4.1c: read, metadata ignored",
+)
 # other folders may state their own expectations in an expected.json beside their files:
 #   {"file": {"expect": "read" | "refuse", "codes": [...], "volume": V, "rtol": r, "companions": [...], "note": "..."}}
 # ("volume" in file units for unit density: a reference computed elsewhere, e.g. by VTK, named in the README)
@@ -94,11 +106,19 @@ for _manifest in sorted(REAL.glob("*/expected.json")):
     for _name, _entry in json.loads(_manifest.read_text()).items():
         _rel = f"{_manifest.parent.name}/{_name}"
         if _entry.get("expect") == REFUSE:
-            EXPECTED[_rel] = (REFUSE, tuple(_entry.get("codes", INVALID)), tuple(_entry.get("companions", ())),
-                              _entry.get("note", ""))
+            EXPECTED[_rel] = (
+                REFUSE,
+                tuple(_entry.get("codes", INVALID)),
+                tuple(_entry.get("companions", ())),
+                _entry.get("note", ""),
+            )
         else:
-            EXPECTED[_rel] = (READ, {"volume": float(_entry["volume"]), "rtol": float(_entry.get("rtol", TOL))},
-                              tuple(_entry.get("companions", ())), _entry.get("note", ""))
+            EXPECTED[_rel] = (
+                READ,
+                {"volume": float(_entry["volume"]), "rtol": float(_entry.get("rtol", TOL))},
+                tuple(_entry.get("companions", ())),
+                _entry.get("note", ""),
+            )
 # references computed by another program, beside the files: {"file": {"volume": V, "inertia_unit_density": 3x3, ...}}
 # (e.g. quadratic/gmsh_reference.json, Gmsh's own integration), compared to REFERENCE_TOL
 REFERENCE_TOL = 1e-10
@@ -106,8 +126,17 @@ for _refs in sorted(REAL.glob("*/*reference*.json")):
     for _name, _entry in json.loads(_refs.read_text()).items():
         _rel = f"{_refs.parent.name}/{_name}"
         if _rel not in EXPECTED and isinstance(_entry, dict) and "volume" in _entry:
-            EXPECTED[_rel] = (READ, {"volume": float(_entry["volume"]), "rtol": REFERENCE_TOL,
-                                     "tensor": _entry.get("inertia_unit_density"), "source": _refs.name}, (), "")
+            EXPECTED[_rel] = (
+                READ,
+                {
+                    "volume": float(_entry["volume"]),
+                    "rtol": REFERENCE_TOL,
+                    "tensor": _entry.get("inertia_unit_density"),
+                    "source": _refs.name,
+                },
+                (),
+                "",
+            )
 # any other model file is still read and counted ("no reference") so that nothing in the folder goes unrun
 _COMPANION = {".bin", ".node", ".json", ".md", ".png", ".txt"}
 for _path in sorted(REAL.glob("*/*")):
@@ -244,16 +273,25 @@ def render(rows: list[Row], elapsed: float) -> str:
     ]
     for fmt in sorted(by_fmt):
         c = by_fmt[fmt]
-        lines.append(f"| {fmt} | {c['read right']} | {c['read, no reference']} | {c['refused']} | {c['wrong']} | "
-                     f"{c['crashed']} |")
+        lines.append(f"| {fmt} | {c['read right']} | {c['read, no reference']} | {c['refused']} | {c['wrong']} | {c['crashed']} |")
     total = {o: sum(c[o] for c in by_fmt.values()) for o in outcomes}
-    lines.append(f"| **all** | **{total['read right']}** | **{total['read, no reference']}** | **{total['refused']}** | "
-                 f"**{total['wrong']}** | "
-                 f"**{total['crashed']}** |")
-    lines += ["", f"{len(rows)} files in {elapsed:.1f} s.", "",
-              "Known deviation: MUSTFAIL 3.4.1a (a metadata name outside the well-known list) is read, because "
-              "MUSTPASS 3.4.1c requires such a name to be ignored; metadata never changes the solid.", "",
-              "## Every file", "", "| file | outcome | what came back | reference |", "| --- | --- | --- | --- |"]
+    lines.append(
+        f"| **all** | **{total['read right']}** | **{total['read, no reference']}** | **{total['refused']}** | "
+        f"**{total['wrong']}** | "
+        f"**{total['crashed']}** |"
+    )
+    lines += [
+        "",
+        f"{len(rows)} files in {elapsed:.1f} s.",
+        "",
+        "Known deviation: MUSTFAIL 3.4.1a (a metadata name outside the well-known list) is read, because "
+        "MUSTPASS 3.4.1c requires such a name to be ignored; metadata never changes the solid.",
+        "",
+        "## Every file",
+        "",
+        "| file | outcome | what came back | reference |",
+        "| --- | --- | --- | --- |",
+    ]
     for r in rows:
         detail = r.detail.replace("|", "\\|").replace("\n", " ")
         lines.append(f"| `{r.path}` | {r.outcome} | {detail} | {r.reference} |")

@@ -183,8 +183,7 @@ def check_rows(out: Path, count: int) -> None:
     rows = [json.loads(line) for line in out.read_text(encoding="utf-8").splitlines() if line.strip()]
     errors = [row for row in rows if "error" in row]
     if len(rows) != count or errors:
-        raise RuntimeError(f"{out}: {len(rows)} rows for {count} files, {len(errors)} errors "
-                           f"{errors[:1]}")
+        raise RuntimeError(f"{out}: {len(rows)} rows for {count} files, {len(errors)} errors {errors[:1]}")
 
 
 def timed(cmd: list[str], extra_roots: list[int] | None = None) -> Run:
@@ -212,8 +211,9 @@ def loop_run(script: str, file_list: Path, count: int) -> Run:
 
 def command_run(folder: Path, out: Path, count: int, workers: int) -> Run:
     out.unlink(missing_ok=True)
-    run = timed([sys.executable, "-m", "inertia", "batch", str(folder), "--out", str(out), "--workers", str(workers),
-                 "--no-progress"])
+    run = timed(
+        [sys.executable, "-m", "inertia", "batch", str(folder), "--out", str(out), "--workers", str(workers), "--no-progress"]
+    )
     check_rows(out, count)
     return run
 
@@ -239,10 +239,27 @@ class Cluster:
         self.workers = workers
         scheduler_file = work / f"scheduler-{workers}-{time.monotonic_ns()}.json"
         self.scheduler = subprocess.Popen(
-            [sys.executable, "-m", "dask", "scheduler", "--host", "127.0.0.1", "--port", "0",
-             "--dashboard-address", ":0", "--scheduler-file", str(scheduler_file),
-             "--idle-timeout", f"{CLUSTER_LIFETIME_S}s"],
-            cwd=ROOT, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True)
+            [
+                sys.executable,
+                "-m",
+                "dask",
+                "scheduler",
+                "--host",
+                "127.0.0.1",
+                "--port",
+                "0",
+                "--dashboard-address",
+                ":0",
+                "--scheduler-file",
+                str(scheduler_file),
+                "--idle-timeout",
+                f"{CLUSTER_LIFETIME_S}s",
+            ],
+            cwd=ROOT,
+            stdout=subprocess.DEVNULL,
+            stderr=subprocess.DEVNULL,
+            start_new_session=True,
+        )
         deadline = time.monotonic() + 120
         while not scheduler_file.exists():
             if time.monotonic() > deadline or self.scheduler.poll() is not None:
@@ -253,10 +270,30 @@ class Cluster:
         self.address = json.loads(scheduler_file.read_text())["address"]
         env = dict(os.environ, OMP_NUM_THREADS="1", MKL_NUM_THREADS="1", OPENBLAS_NUM_THREADS="1")
         self.worker = subprocess.Popen(
-            [sys.executable, "-m", "dask", "worker", self.address, "--nworkers", str(workers), "--nthreads", "1",
-             "--no-dashboard", "--lifetime", f"{CLUSTER_LIFETIME_S}s", "--memory-limit", "0",
-             "--preload", "inertia.batch.tasks"],
-            cwd=ROOT, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, env=env, start_new_session=True)
+            [
+                sys.executable,
+                "-m",
+                "dask",
+                "worker",
+                self.address,
+                "--nworkers",
+                str(workers),
+                "--nthreads",
+                "1",
+                "--no-dashboard",
+                "--lifetime",
+                f"{CLUSTER_LIFETIME_S}s",
+                "--memory-limit",
+                "0",
+                "--preload",
+                "inertia.batch.tasks",
+            ],
+            cwd=ROOT,
+            stdout=subprocess.DEVNULL,
+            stderr=subprocess.DEVNULL,
+            env=env,
+            start_new_session=True,
+        )
         self._wait_for_workers(deadline)
 
     def _wait_for_workers(self, deadline: float) -> None:
@@ -289,8 +326,10 @@ class Cluster:
 
 def cluster_run(cluster: Cluster, folder: Path, out: Path, count: int) -> Run:
     out.unlink(missing_ok=True)
-    run = timed([sys.executable, "-m", "inertia", "batch", str(folder), "--out", str(out), "--scheduler",
-                 cluster.address, "--no-progress"], extra_roots=cluster.roots)
+    run = timed(
+        [sys.executable, "-m", "inertia", "batch", str(folder), "--out", str(out), "--scheduler", cluster.address, "--no-progress"],
+        extra_roots=cluster.roots,
+    )
     check_rows(out, count)
     # the cluster's processes: peak among its workers (the scheduler is a root of its own tree, excluded)
     return run
@@ -344,8 +383,9 @@ print(json.dumps({"wall_s": w, "client_cpu_s": c, "tasks": tasks}))
 
 
 def overhead_pool(workers: int, tasks: int) -> dict[str, Any]:
-    done = subprocess.run([sys.executable, "-c", OVERHEAD_POOL_SCRIPT, str(workers), str(tasks)], cwd=ROOT,
-                          capture_output=True, text=True, check=True)
+    done = subprocess.run(
+        [sys.executable, "-c", OVERHEAD_POOL_SCRIPT, str(workers), str(tasks)], cwd=ROOT, capture_output=True, text=True, check=True
+    )
     return dict(json.loads(done.stdout.splitlines()[-1]))
 
 
@@ -353,8 +393,13 @@ def overhead_dask(cluster: Cluster, tasks: int) -> dict[str, Any]:
     log = TreeLog()
     log.sample(cluster.roots)
     with sampled([], log, cluster.roots):
-        done = subprocess.run([sys.executable, "-c", OVERHEAD_DASK_SCRIPT, cluster.address, str(tasks)], cwd=ROOT,
-                              capture_output=True, text=True, check=True)
+        done = subprocess.run(
+            [sys.executable, "-c", OVERHEAD_DASK_SCRIPT, cluster.address, str(tasks)],
+            cwd=ROOT,
+            capture_output=True,
+            text=True,
+            check=True,
+        )
     got = dict(json.loads(done.stdout.splitlines()[-1]))
     got["cluster_cpu_s"] = log.cpu()
     return got
@@ -379,8 +424,13 @@ def _machine() -> dict[str, str]:
             versions[pkg] = md.version(pkg)
         except md.PackageNotFoundError:
             versions[pkg] = "not installed"
-    return {"cpu": model, "cores": str(os.cpu_count()), "usable": str(len(os.sched_getaffinity(0))),
-            "python": platform.python_version(), **versions}
+    return {
+        "cpu": model,
+        "cores": str(os.cpu_count()),
+        "usable": str(len(os.sched_getaffinity(0))),
+        "python": platform.python_version(),
+        **versions,
+    }
 
 
 def _f(x: float, digits: int = 2) -> str:
@@ -400,8 +450,7 @@ def _table(res: SetResult, workers: list[int]) -> list[str]:
     base = res.runs[("analyze loop", 1)].wall_s
     trimesh = res.runs[("trimesh loop", 1)].wall_s
     lines = [
-        f"### {res.name}: {res.count:,} files of {res.triangles // res.count:,} triangles "
-        f"({res.megabytes:,.0f} MB)",
+        f"### {res.name}: {res.count:,} files of {res.triangles // res.count:,} triangles ({res.megabytes:,.0f} MB)",
         "",
         "| contender | workers | wall (s) | files/s | triangles/s | speed-up vs analyze loop | parallel efficiency | "
         "vs trimesh loop | CPU, all processes (s) | CPU, command process (s) | peak RSS per worker (MiB) |",
@@ -416,7 +465,8 @@ def _table(res: SetResult, workers: list[int]) -> list[str]:
             f"| {label} | {n if not serial else 'serial'} | {_f(run.wall_s)} | {_f(res.count / run.wall_s, 1)} | "
             f"{res.triangles / run.wall_s:,.0f} | {speed:.2f}x | {eff} | {trimesh / run.wall_s:.2f}x | "
             f"{_f(run.cpu_s)} | {_f(run.client_cpu_s)} | "
-            f"{'' if serial else f'{run.peak_worker_bytes / 2**20:,.0f}'} |")
+            f"{'' if serial else f'{run.peak_worker_bytes / 2**20:,.0f}'} |"
+        )
     return [*lines, ""]
 
 
@@ -429,13 +479,25 @@ def predict(res: SetResult, starts: dict[int, Run], target: int = 16) -> dict[st
     # at most their CPU added up; here, on a shared machine, its wall time mostly measures waiting for a core
     start = min(starts[max(n for n in starts if n <= target)].cpu_s, starts[max(n for n in starts if n <= target)].wall_s)
     wall = start + max((work - client) / target, client)
-    return {"start_s": start, "work_s": work, "client_s": client, "wall_s": wall,
-            "speedup_vs_analyze": res.runs[("analyze loop", 1)].wall_s / wall,
-            "vs_trimesh": res.runs[("trimesh loop", 1)].wall_s / wall}
+    return {
+        "start_s": start,
+        "work_s": work,
+        "client_s": client,
+        "wall_s": wall,
+        "speedup_vs_analyze": res.runs[("analyze loop", 1)].wall_s / wall,
+        "vs_trimesh": res.runs[("trimesh loop", 1)].wall_s / wall,
+    }
 
 
-def render(results: list[SetResult], workers: list[int], overheads: dict[str, dict[str, Any]],
-           starts: dict[int, Run], loads: list[float], rounds: int, command: str) -> str:
+def render(
+    results: list[SetResult],
+    workers: list[int],
+    overheads: dict[str, dict[str, Any]],
+    starts: dict[int, Run],
+    loads: list[float],
+    rounds: int,
+    command: str,
+) -> str:
     m = _machine()
     lines = [
         f"Regenerate: `{command}` (from the repository root; needs the `batch` extra, trimesh and psutil).",
@@ -467,40 +529,52 @@ def render(results: list[SetResult], workers: list[int], overheads: dict[str, di
             f"- **process pool** ({pool['workers']} workers): {pool['tasks']:,} empty tasks in "
             f"{pool['wall_s']:.3f} s: **{pool['wall_s'] / pool['tasks'] * 1e3:.3f} ms per task** of wall time, "
             f"{pool['client_cpu_s'] / pool['tasks'] * 1e3:.3f} ms of the client's CPU per task; a pool's start "
-            f"and stop with {pool['workers']} workers (forks from the running forkserver): {pool['start_s']:.3f} s.")
+            f"and stop with {pool['workers']} workers (forks from the running forkserver): {pool['start_s']:.3f} s."
+        )
     dask = overheads.get("dask")
     if dask:
         lines.append(
             f"- **Dask cluster** ({dask['workers']} workers): {dask['tasks']:,} empty tasks in {dask['wall_s']:.3f} s: "
             f"**{dask['wall_s'] / dask['tasks'] * 1e3:.3f} ms per task** of wall time, "
             f"{dask['client_cpu_s'] / dask['tasks'] * 1e3:.3f} ms of the client's CPU and "
-            f"{dask['cluster_cpu_s'] / dask['tasks'] * 1e3:.3f} ms of the scheduler's and workers' CPU per task.")
+            f"{dask['cluster_cpu_s'] / dask['tasks'] * 1e3:.3f} ms of the scheduler's and workers' CPU per task."
+        )
     lines += [""]
-    lines += ["## Start-up", "",
-              "The command on N files of 12 triangles with N workers (interpreter, imports, forkserver, N "
-              "workers forked, shutdown):", "",
-              "| workers | wall (s) | CPU, all processes (s) | CPU, command process (s) |", "|---:|---:|---:|---:|"]
+    lines += [
+        "## Start-up",
+        "",
+        "The command on N files of 12 triangles with N workers (interpreter, imports, forkserver, N workers forked, shutdown):",
+        "",
+        "| workers | wall (s) | CPU, all processes (s) | CPU, command process (s) |",
+        "|---:|---:|---:|---:|",
+    ]
     lines += [f"| {n} | {r.wall_s:.2f} | {r.cpu_s:.2f} | {r.client_cpu_s:.2f} |" for n, r in sorted(starts.items())]
     lines.append("")
     if 1 in starts:
-        lines += ["## What this predicts for 16 cores", "",
-                  "CPU times are what a busy machine distorts least, so the prediction is built from them: "
-                  "W = the CPU of all processes of the 1-worker command on the set minus that of its start-up run "
-                  "(the files' own work, per-task costs included), C = the part of it in the command's own "
-                  "process (receiving and writing rows, progress), which does not divide among workers, "
-                  "S(16) = the start-up run with 16 workers measured here: the CPU of all its processes (on free "
-                  "cores its wall time is at most that; on a shared machine its wall time measures the wait for "
-                  "a core). On 16 free cores: T(16) = S(16) + max((W - C) / 16, C).", "",
-                  "| data set | S(16) (s) | W (s) | C (s) | predicted T(16) (s) | predicted files/s | "
-                  "predicted speed-up vs analyze loop | predicted vs trimesh loop |",
-                  "|---|---:|---:|---:|---:|---:|---:|---:|"]
+        lines += [
+            "## What this predicts for 16 cores",
+            "",
+            "CPU times are what a busy machine distorts least, so the prediction is built from them: "
+            "W = the CPU of all processes of the 1-worker command on the set minus that of its start-up run "
+            "(the files' own work, per-task costs included), C = the part of it in the command's own "
+            "process (receiving and writing rows, progress), which does not divide among workers, "
+            "S(16) = the start-up run with 16 workers measured here: the CPU of all its processes (on free "
+            "cores its wall time is at most that; on a shared machine its wall time measures the wait for "
+            "a core). On 16 free cores: T(16) = S(16) + max((W - C) / 16, C).",
+            "",
+            "| data set | S(16) (s) | W (s) | C (s) | predicted T(16) (s) | predicted files/s | "
+            "predicted speed-up vs analyze loop | predicted vs trimesh loop |",
+            "|---|---:|---:|---:|---:|---:|---:|---:|",
+        ]
         for res in results:
             if ("inertia batch", 1) not in res.runs:
                 continue
             p = predict(res, starts)
-            lines.append(f"| {res.name} | {p['start_s']:.2f} | {p['work_s']:.2f} | {p['client_s']:.2f} | "
-                         f"{p['wall_s']:.2f} | {res.count / p['wall_s']:,.0f} | {p['speedup_vs_analyze']:.1f}x | "
-                         f"{p['vs_trimesh']:.1f}x |")
+            lines.append(
+                f"| {res.name} | {p['start_s']:.2f} | {p['work_s']:.2f} | {p['client_s']:.2f} | "
+                f"{p['wall_s']:.2f} | {res.count / p['wall_s']:,.0f} | {p['speedup_vs_analyze']:.1f}x | "
+                f"{p['vs_trimesh']:.1f}x |"
+            )
         lines.append("")
     return "\n".join(lines)
 
@@ -519,8 +593,9 @@ def parse_sets(text: str) -> list[tuple[str, int, int]]:
 
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="python -m benchmarks.scale", description=__doc__.split("\n")[0])
-    parser.add_argument("--workers", default=None,
-                        help="comma-separated worker counts (default: 1, 2, 4, ... up to the core count)")
+    parser.add_argument(
+        "--workers", default=None, help="comma-separated worker counts (default: 1, 2, 4, ... up to the core count)"
+    )
     parser.add_argument("--sets", default=DEFAULT_SETS, help=f"NAME=FILESxTRIANGLES,... (default {DEFAULT_SETS})")
     parser.add_argument("--rounds", type=int, default=2, help="interleaved rounds; the best of each counts")
     parser.add_argument("--quick", action="store_true", help=f"sets {QUICK_SETS}, one round")
@@ -528,17 +603,21 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--out", type=Path, default=DOC, help="report file ('-' for stdout)")
     args = parser.parse_args(argv)
     cores = os.cpu_count() or 1
-    workers = ([int(x) for x in args.workers.split(",")] if args.workers
-               else [n for n in (1, 2, 4, 8, 16, 32, 64) if n <= cores])
+    workers = [int(x) for x in args.workers.split(",")] if args.workers else [n for n in (1, 2, 4, 8, 16, 32, 64) if n <= cores]
     if 1 not in workers:
         workers = [1, *workers]
     sets = parse_sets(QUICK_SETS if args.quick and args.sets == DEFAULT_SETS else args.sets)
     rounds = 1 if args.quick else args.rounds
     command = "python -m benchmarks.scale" + " ".join(
-        ["", *(["--workers", args.workers] if args.workers else []),
-         *(["--sets", args.sets] if args.sets != DEFAULT_SETS else []),
-         *(["--rounds", str(args.rounds)] if args.rounds != 2 and not args.quick else []),
-         *(["--quick"] if args.quick else []), *(["--no-cluster"] if args.no_cluster else [])])
+        [
+            "",
+            *(["--workers", args.workers] if args.workers else []),
+            *(["--sets", args.sets] if args.sets != DEFAULT_SETS else []),
+            *(["--rounds", str(args.rounds)] if args.rounds != 2 and not args.quick else []),
+            *(["--quick"] if args.quick else []),
+            *(["--no-cluster"] if args.no_cluster else []),
+        ]
+    )
     local_n = max(n for n in workers if n <= cores)
     work = Path(tempfile.mkdtemp(prefix="inertia-scale-"))
     results: list[SetResult] = []
@@ -572,9 +651,11 @@ def main(argv: list[str] | None = None) -> int:
                 k = (r * 3) % len(plan)
                 for key, fn in plan[k:] + plan[:k]:
                     run = fn()
-                    print(f"[{name}] round {r + 1}: {key[0]} x{key[1]}: {run.wall_s:.2f} s, CPU {run.cpu_s:.2f} s "
-                          f"(command {run.client_cpu_s:.2f} s), peak worker {run.peak_worker_bytes / 2**20:.0f} MiB",
-                          file=sys.stderr)
+                    print(
+                        f"[{name}] round {r + 1}: {key[0]} x{key[1]}: {run.wall_s:.2f} s, CPU {run.cpu_s:.2f} s "
+                        f"(command {run.client_cpu_s:.2f} s), peak worker {run.peak_worker_bytes / 2**20:.0f} MiB",
+                        file=sys.stderr,
+                    )
                     if key not in best or run.wall_s < best[key].wall_s:
                         best[key] = run
             ordered = {key: best[key] for key, _ in plan}
@@ -591,8 +672,9 @@ def main(argv: list[str] | None = None) -> int:
     return 0
 
 
-def _plan(workers: list[int], local_n: int, cluster: bool, work: Path, folder: Path, file_list: Path, out: Path,
-          count: int) -> list[tuple[tuple[str, int], Any]]:
+def _plan(
+    workers: list[int], local_n: int, cluster: bool, work: Path, folder: Path, file_list: Path, out: Path, count: int
+) -> list[tuple[tuple[str, int], Any]]:
     plan: list[tuple[tuple[str, int], Any]] = [
         (("trimesh loop", 1), lambda: loop_run(TRIMESH_SCRIPT, file_list, count)),
         (("analyze loop", 1), lambda: loop_run(ANALYZE_SCRIPT, file_list, count)),

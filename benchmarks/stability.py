@@ -45,10 +45,28 @@ from inertia.principal import principal_frame
 
 ROOT = Path(__file__).resolve().parents[1]
 
-__all__ = ["GENERIC", "BOUND_EXACT", "BOUND_THIN", "BOUND_INVARIANT", "box", "uv_sphere", "prism",
-           "two_material_boxes", "log_uniform_points", "MeshCase", "geometry_cases", "measure_mesh",
-           "MotionCase", "motion_cases", "measure_motion", "tessellation_rows", "near_symmetric_flip",
-           "point_case", "two_material_case", "main"]
+__all__ = [
+    "GENERIC",
+    "BOUND_EXACT",
+    "BOUND_THIN",
+    "BOUND_INVARIANT",
+    "box",
+    "uv_sphere",
+    "prism",
+    "two_material_boxes",
+    "log_uniform_points",
+    "MeshCase",
+    "geometry_cases",
+    "measure_mesh",
+    "MotionCase",
+    "motion_cases",
+    "measure_motion",
+    "tessellation_rows",
+    "near_symmetric_flip",
+    "point_case",
+    "two_material_case",
+    "main",
+]
 
 Array = NDArray[np.float64]
 
@@ -85,8 +103,14 @@ def uv_sphere(n_lat: int, n_lon: int, radius: float = 1.0) -> tuple[Array, NDArr
     """Latitude-longitude sphere: 2 n_lon (n_lat - 1) triangles, single-vertex poles."""
     theta = np.pi * np.arange(1, n_lat) / n_lat
     phi = 2 * np.pi * np.arange(n_lon) / n_lon
-    ring = np.stack([np.outer(np.sin(theta), np.cos(phi)), np.outer(np.sin(theta), np.sin(phi)),
-                     np.repeat(np.cos(theta)[:, None], n_lon, axis=1)], axis=-1).reshape(-1, 3)
+    ring = np.stack(
+        [
+            np.outer(np.sin(theta), np.cos(phi)),
+            np.outer(np.sin(theta), np.sin(phi)),
+            np.repeat(np.cos(theta)[:, None], n_lon, axis=1),
+        ],
+        axis=-1,
+    ).reshape(-1, 3)
     v = radius * np.vstack([[0.0, 0.0, 1.0], ring, [0.0, 0.0, -1.0]])
     south = len(v) - 1
     idx = 1 + np.arange((n_lat - 1) * n_lon).reshape(n_lat - 1, n_lon)
@@ -194,6 +218,7 @@ def numpy_stl_moments(v: Array, f: NDArray[np.int64]) -> Array | str:
 
 def mujoco_moments(parts: Sequence[tuple[Array, NDArray[np.int64], float]]) -> Array | str:
     """Principal moments of one MuJoCo body made of mesh geoms (vertices, faces, density)."""
+
     def run() -> Array:
         import mujoco
 
@@ -273,9 +298,11 @@ def measure_mesh(case: MeshCase, exact: Sequence[mpmath.mpf] | None = None) -> R
     errors = moment_errors(ours, exact) if finite else [math.inf] * 3
     peers: dict[str, float | str] = {}
     peer_s: dict[str, float] = {}
-    runners = {"trimesh": lambda: trimesh_moments(case.vertices, case.faces),
-               "numpy-stl": lambda: numpy_stl_moments(case.vertices, case.faces),
-               "mujoco": lambda: mujoco_moments([(case.vertices, case.faces, 1.0)])}
+    runners = {
+        "trimesh": lambda: trimesh_moments(case.vertices, case.faces),
+        "numpy-stl": lambda: numpy_stl_moments(case.vertices, case.faces),
+        "mujoco": lambda: mujoco_moments([(case.vertices, case.faces, 1.0)]),
+    }
     for name, run in runners.items():
         if name not in case.peers:
             continue
@@ -285,9 +312,21 @@ def measure_mesh(case: MeshCase, exact: Sequence[mpmath.mpf] | None = None) -> R
         peers[name] = result if isinstance(result, str) else _worst(moment_errors(result, exact), bounds)
     estimate = float(props.relative_error_estimate)
     passed = finite and all(e <= b for e, b in zip(errors, bounds)) and all(e <= estimate for e in errors)
-    return Row("geometry", case.name, _fmt_moments(exact), _worst(errors, bounds), estimate, peers, max(bounds),
-               _bound_text(case.thin), passed, estimate <= max(bounds), case.note, time.perf_counter() - start,
-               {"errors": errors, "ours_s": ours_s, "peer_s": peer_s})
+    return Row(
+        "geometry",
+        case.name,
+        _fmt_moments(exact),
+        _worst(errors, bounds),
+        estimate,
+        peers,
+        max(bounds),
+        _bound_text(case.thin),
+        passed,
+        estimate <= max(bounds),
+        case.note,
+        time.perf_counter() - start,
+        {"errors": errors, "ours_s": ours_s, "peer_s": peer_s},
+    )
 
 
 def _fmt_moments(exact: Sequence[mpmath.mpf]) -> str:
@@ -309,8 +348,7 @@ def geometry_cases(quick: bool) -> list[MeshCase]:
         cases.append(MeshCase(f"needle 1 x {thin:.0e} x {thin:.0e}, rotated", v, BOX_FACES, thin=True))
     cases.append(MeshCase("plate 1 x 1 x 1e-6, rotated", placed(box(1, 1, 1e-6)[0]), BOX_FACES, thin=True))
     for scale in (1e-9, 1e9):
-        cases.append(MeshCase(f"box 1x2x3 m x {scale:.0e}, rotated", placed(box(scale, 2 * scale, 3 * scale)[0]),
-                              BOX_FACES))
+        cases.append(MeshCase(f"box 1x2x3 m x {scale:.0e}, rotated", placed(box(scale, 2 * scale, 3 * scale)[0]), BOX_FACES))
     return cases
 
 
@@ -322,8 +360,18 @@ def summation_cases(quick: bool) -> list[tuple[int, MeshCase]]:
         v, f = sphere_with_triangles(n)
         peers = ("trimesh", "numpy-stl", "mujoco") if n <= 1_000_000 else ("trimesh",)
         note = "" if n <= 1_000_000 else "numpy-stl and MuJoCo not run at 1e7 (see notes)"
-        out.append((n, MeshCase(f"UV sphere {len(f):.2g} triangles, rotated, offset 100 r",
-                                placed(v, offset=100.0 * DIRECTION), f, peers=peers, note=note)))
+        out.append(
+            (
+                n,
+                MeshCase(
+                    f"UV sphere {len(f):.2g} triangles, rotated, offset 100 r",
+                    placed(v, offset=100.0 * DIRECTION),
+                    f,
+                    peers=peers,
+                    note=note,
+                ),
+            )
+        )
     return out
 
 
@@ -338,7 +386,7 @@ def two_material_case(ratio: float = 1e6, offset: float = 1e3) -> Row:
     errors = moment_errors(props.principal_moments, exact)
     parts = []
     for k in (0, 1):
-        sel = tets[6 * k: 6 * k + 6]
+        sel = tets[6 * k : 6 * k + 6]
         parts.append((pts, boundary_faces(sel, pts), float(rho[6 * k])))
     mj = mujoco_moments(parts)
     peers: dict[str, float | str] = {
@@ -349,10 +397,21 @@ def two_material_case(ratio: float = 1e6, offset: float = 1e3) -> Row:
     estimate = float(props.relative_error_estimate)
     worst = max(errors)
     passed = all(np.isfinite(errors)) and worst <= BOUND_EXACT and worst <= estimate
-    return Row("geometry", f"two materials, densities 1 and {ratio:.0e}, rotated, offset {offset:.0e} sizes",
-               _fmt_moments(exact), worst, estimate, peers, BOUND_EXACT, "1e-12", passed,
-               estimate <= BOUND_EXACT, "VolumeBody cell_density; MuJoCo: two mesh geoms",
-               time.perf_counter() - start, {"errors": errors})
+    return Row(
+        "geometry",
+        f"two materials, densities 1 and {ratio:.0e}, rotated, offset {offset:.0e} sizes",
+        _fmt_moments(exact),
+        worst,
+        estimate,
+        peers,
+        BOUND_EXACT,
+        "1e-12",
+        passed,
+        estimate <= BOUND_EXACT,
+        "VolumeBody cell_density; MuJoCo: two mesh geoms",
+        time.perf_counter() - start,
+        {"errors": errors},
+    )
 
 
 def point_case(n: int) -> Row:
@@ -369,10 +428,21 @@ def point_case(n: int) -> Row:
     worst = max(errors)
     passed = all(np.isfinite(errors)) and worst <= BOUND_EXACT and worst <= estimate
     peers: dict[str, float | str] = {k: "n/a: meshes only" for k in ("trimesh", "numpy-stl", "mujoco")}
-    return Row("geometry", f"{n:.0e} point masses, 1e-12 .. 1e12 kg", _fmt_moments(exact), worst, estimate, peers,
-               BOUND_EXACT, "1e-12", passed, estimate <= BOUND_EXACT,
-               f"naive float64 (sum about origin, then shift): {naive_err:.1e}", time.perf_counter() - start,
-               {"errors": errors})
+    return Row(
+        "geometry",
+        f"{n:.0e} point masses, 1e-12 .. 1e12 kg",
+        _fmt_moments(exact),
+        worst,
+        estimate,
+        peers,
+        BOUND_EXACT,
+        "1e-12",
+        passed,
+        estimate <= BOUND_EXACT,
+        f"naive float64 (sum about origin, then shift): {naive_err:.1e}",
+        time.perf_counter() - start,
+        {"errors": errors},
+    )
 
 
 def _naive_points(masses: Array, x: Array) -> Array:
@@ -403,12 +473,23 @@ def near_symmetric_flip(eps: float = 1e-9) -> dict[str, object]:
     below = classify(frame, tolerance=flip * (1 - 1e-2)).rotor
     above = classify(frame, tolerance=flip * (1 + 1e-2)).rotor
     peers: dict[str, float | str] = {}
-    for name, result in (("trimesh", trimesh_moments(v, BOX_FACES)), ("numpy-stl", numpy_stl_moments(v, BOX_FACES)),
-                         ("mujoco", mujoco_moments([(v, BOX_FACES, 1.0)]))):
+    for name, result in (
+        ("trimesh", trimesh_moments(v, BOX_FACES)),
+        ("numpy-stl", numpy_stl_moments(v, BOX_FACES)),
+        ("mujoco", mujoco_moments([(v, BOX_FACES, 1.0)])),
+    ):
         peers[name] = result if isinstance(result, str) else abs((result[2] - result[0]) / result[2] - flip) / flip
-    return {"flip": flip, "pair": pair, "ours_flip": ours_flip, "flip_error": abs(ours_flip - flip) / flip,
-            "below": below, "above": above, "peers": peers, "estimate": float(props.relative_error_estimate),
-            "passed": below is RotorClass.SYMMETRIC_PROLATE and above is RotorClass.SPHERICAL}
+    return {
+        "flip": flip,
+        "pair": pair,
+        "ours_flip": ours_flip,
+        "flip_error": abs(ours_flip - flip) / flip,
+        "below": below,
+        "above": above,
+        "peers": peers,
+        "estimate": float(props.relative_error_estimate),
+        "passed": below is RotorClass.SYMMETRIC_PROLATE and above is RotorClass.SPHERICAL,
+    }
 
 
 def smallest_true_tolerance(moments: Array, true: RotorClass) -> float:
@@ -437,12 +518,26 @@ def tessellation_rows() -> list[dict[str, object]]:
     specs: list[tuple[str, Array, NDArray[np.int64], RotorClass, str]] = []
     for n_lat in (8, 16, 32, 64, 128):
         v, f = uv_sphere(n_lat, 2 * n_lat)
-        specs.append((f"UV sphere {n_lat} x {2 * n_lat} ({len(f)} tri)", v, f, RotorClass.SPHERICAL,
-                      f"(pi/{2 * n_lat})^2 / 3 = {(math.pi / (2 * n_lat)) ** 2 / 3:.1e}"))
+        specs.append(
+            (
+                f"UV sphere {n_lat} x {2 * n_lat} ({len(f)} tri)",
+                v,
+                f,
+                RotorClass.SPHERICAL,
+                f"(pi/{2 * n_lat})^2 / 3 = {(math.pi / (2 * n_lat)) ** 2 / 3:.1e}",
+            )
+        )
     for n in (16, 32, 64, 128):
         v, f = prism(n, 1.0, math.sqrt(3.0))
-        specs.append((f"{n}-gon cylinder, h = sqrt(3) r (ideal: spherical)", v, f, RotorClass.SPHERICAL,
-                      f"(pi/{n})^2 / 3 = {(math.pi / n) ** 2 / 3:.1e}"))
+        specs.append(
+            (
+                f"{n}-gon cylinder, h = sqrt(3) r (ideal: spherical)",
+                v,
+                f,
+                RotorClass.SPHERICAL,
+                f"(pi/{n})^2 / 3 = {(math.pi / n) ** 2 / 3:.1e}",
+            )
+        )
     v, f = prism(32, 1.0, 2.0)
     specs.append(("32-gon cylinder, h = 2 r (ideal: prolate... oblate)", v, f, RotorClass.SYMMETRIC_PROLATE, ""))
     for name, v, f, true, scale in specs:
@@ -451,14 +546,24 @@ def tessellation_rows() -> list[dict[str, object]]:
         props = mass_properties(MeshBody(v, f), density=1.0)
         ours = np.sort(props.principal_moments)
         with mpmath.workdps(50):
-            spread = float((exact[2] - exact[0]) / exact[2]) if true is RotorClass.SPHERICAL else \
-                float(min(exact[1] - exact[0], exact[2] - exact[1]) / exact[2])
+            spread = (
+                float((exact[2] - exact[0]) / exact[2])
+                if true is RotorClass.SPHERICAL
+                else float(min(exact[1] - exact[0], exact[2] - exact[1]) / exact[2])
+            )
         if true is not RotorClass.SPHERICAL:
             true = RotorClass.SYMMETRIC_PROLATE if exact[1] - exact[0] > exact[2] - exact[1] else RotorClass.SYMMETRIC_OBLATE
-        rows.append({"case": name.replace("(ideal: prolate... oblate)", f"(ideal: {true.value})"), "spread": spread,
-                     "scale": scale, "true": true, "tol_ours": smallest_true_tolerance(ours, true),
-                     "tol_exact_moments": smallest_true_tolerance(np.array([float(x) for x in exact]), true),
-                     "default_ok": classify(principal_frame(props)).rotor is true})
+        rows.append(
+            {
+                "case": name.replace("(ideal: prolate... oblate)", f"(ideal: {true.value})"),
+                "spread": spread,
+                "scale": scale,
+                "true": true,
+                "tol_ours": smallest_true_tolerance(ours, true),
+                "tol_exact_moments": smallest_true_tolerance(np.array([float(x) for x in exact]), true),
+                "default_ok": classify(principal_frame(props)).rotor is true,
+            }
+        )
     return rows
 
 
@@ -481,16 +586,24 @@ def motion_cases() -> list[MotionCase]:
     for eps, side in ((1e-12, "above"), (-1e-12, "below")):
         # I1 (I1 - I2) w1^2 + I3 (I3 - I2) w3^2 = M^2 - 2 E I2 = eps M^2, with w2 = 0.5, w3 = 1
         m2 = 3.0 + 4 * 0.25 + 9.0 + 0.0
-        cases.append(MotionCase(f"separatrix, M^2 - 2EI2 = {eps:+.0e} M^2 ({side})", i,
-                                (math.sqrt(3.0 - eps * m2), 0.5, 1.0)))
+        cases.append(MotionCase(f"separatrix, M^2 - 2EI2 = {eps:+.0e} M^2 ({side})", i, (math.sqrt(3.0 - eps * m2), 0.5, 1.0)))
     cases += [
         MotionCase("1e-9 off the intermediate axis", i, (1e-9, 1.0, 1e-9)),
-        MotionCase("nearly linear I = (1e-9, 1, 1)", (1e-9, 1.0, 1.0), (0.3, 1.0, 0.5), tolerance=1e-12,
-                   note="tolerance 1e-12: modelled as the prolate top it is (at 1e-6 it is a linear rotator)"),
-        MotionCase("nearly symmetric I = (1, 1, 1 + 1e-12)", (1.0, 1.0, 1.0 + 1e-12), (0.6, 0.3, 0.8),
-                   tolerance=1e-15, note="tolerance 1e-15: modelled as the oblate top it is"),
-        MotionCase("‖Ω‖ = 1e6, slow asymmetry I = (1, 1 + 1e-6, 2)", (1.0, 1.0 + 1e-6, 2.0),
-                   (6e5, 3e5, 7.4e5), tolerance=1e-9),
+        MotionCase(
+            "nearly linear I = (1e-9, 1, 1)",
+            (1e-9, 1.0, 1.0),
+            (0.3, 1.0, 0.5),
+            tolerance=1e-12,
+            note="tolerance 1e-12: modelled as the prolate top it is (at 1e-6 it is a linear rotator)",
+        ),
+        MotionCase(
+            "nearly symmetric I = (1, 1, 1 + 1e-12)",
+            (1.0, 1.0, 1.0 + 1e-12),
+            (0.6, 0.3, 0.8),
+            tolerance=1e-15,
+            note="tolerance 1e-15: modelled as the oblate top it is",
+        ),
+        MotionCase("‖Ω‖ = 1e6, slow asymmetry I = (1, 1 + 1e-6, 2)", (1.0, 1.0 + 1e-6, 2.0), (6e5, 3e5, 7.4e5), tolerance=1e-9),
         MotionCase("moments x 1e-30", (1e-30, 2e-30, 3e-30), (0.6, 0.3, 0.8)),
         MotionCase("moments x 1e30", (1e30, 2e30, 3e30), (0.6, 0.3, 0.8)),
     ]
@@ -520,9 +633,15 @@ def scipy_motion(moments: Array, omega: Array, t: Array) -> tuple[Array, Array]:
 
     def rhs(_: float, y: Sequence[float]) -> list[float]:
         w1, w2, w3, q0, q1, q2, q3 = y
-        return [a * w2 * w3, b * w3 * w1, c * w1 * w2,  # quaternion: dq/dt = q (0, Omega_body) / 2
-                0.5 * (-q1 * w1 - q2 * w2 - q3 * w3), 0.5 * (q0 * w1 + q2 * w3 - q3 * w2),
-                0.5 * (q0 * w2 + q3 * w1 - q1 * w3), 0.5 * (q0 * w3 + q1 * w2 - q2 * w1)]
+        return [
+            a * w2 * w3,
+            b * w3 * w1,
+            c * w1 * w2,  # quaternion: dq/dt = q (0, Omega_body) / 2
+            0.5 * (-q1 * w1 - q2 * w2 - q3 * w3),
+            0.5 * (q0 * w1 + q2 * w3 - q3 * w2),
+            0.5 * (q0 * w2 + q3 * w1 - q1 * w3),
+            0.5 * (q0 * w3 + q1 * w2 - q2 * w1),
+        ]
 
     atol = 1e-15  # one scalar for Omega and q (dop853 takes a scalar); rtol decides for |Omega| >~ 1
     solver = ode(rhs).set_integrator("dop853", rtol=SCIPY_RTOL, atol=atol, nsteps=10**9)
@@ -574,13 +693,19 @@ def _elliptic_reference(I: list[mpmath.mpf], w: list[mpmath.mpf], t: Array) -> A
     d, c = (2, 0) if E2 * I[1] < M2 else (0, 2)
     i1, i2, i3 = I
     if d == 2:
-        amp = [mpmath.sqrt((E2 * i3 - M2) / (i1 * (i3 - i1))), mpmath.sqrt((E2 * i3 - M2) / (i2 * (i3 - i2))),
-               mpmath.sqrt((M2 - E2 * i1) / (i3 * (i3 - i1)))]
+        amp = [
+            mpmath.sqrt((E2 * i3 - M2) / (i1 * (i3 - i1))),
+            mpmath.sqrt((E2 * i3 - M2) / (i2 * (i3 - i2))),
+            mpmath.sqrt((M2 - E2 * i1) / (i3 * (i3 - i1))),
+        ]
         rate = mpmath.sqrt((i3 - i2) * (M2 - E2 * i1) / (i1 * i2 * i3))
         m = (i2 - i1) * (E2 * i3 - M2) / ((i3 - i2) * (M2 - E2 * i1))
     else:
-        amp = [mpmath.sqrt((E2 * i3 - M2) / (i1 * (i3 - i1))), mpmath.sqrt((M2 - E2 * i1) / (i2 * (i2 - i1))),
-               mpmath.sqrt((M2 - E2 * i1) / (i3 * (i3 - i1)))]
+        amp = [
+            mpmath.sqrt((E2 * i3 - M2) / (i1 * (i3 - i1))),
+            mpmath.sqrt((M2 - E2 * i1) / (i2 * (i2 - i1))),
+            mpmath.sqrt((M2 - E2 * i1) / (i3 * (i3 - i1))),
+        ]
         rate = mpmath.sqrt((i2 - i1) * (E2 * i3 - M2) / (i1 * i2 * i3))
         m = (i3 - i2) * (M2 - E2 * i1) / ((i2 - i1) * (E2 * i3 - M2))
     sd = 1 if w[d] > 0 else -1
@@ -607,21 +732,20 @@ def _elliptic_reference(I: list[mpmath.mpf], w: list[mpmath.mpf], t: Array) -> A
     return np.array([[float(x) for x in at(tau0 + rate * mpmath.mpf(float(tt)))] for tt in t])
 
 
-def measure_motion(case: MotionCase, samples: int = 2001, reference_samples: int = 41,
-                   run_scipy: bool = True) -> dict[str, object]:
+def measure_motion(case: MotionCase, samples: int = 2001, reference_samples: int = 41, run_scipy: bool = True) -> dict[str, object]:
     """Invariant drift of our exact method (and scipy DOP853) over 1e5 time units; Omega error vs mpmath."""
     from inertia.pipeline import precession
 
     start = time.perf_counter()
-    result = precession(case.omega, principal_moments=case.moments, tolerance=case.tolerance,
-                        duration=HORIZON, samples=samples, method="exact")
+    result = precession(
+        case.omega, principal_moments=case.moments, tolerance=case.tolerance, duration=HORIZON, samples=samples, method="exact"
+    )
     traj = result.motion.trajectory
     assert traj is not None
     frame = result.frame
     moments = np.asarray(frame.moments)
     effective = _effective_moments(moments, motion_rotor(frame, result.classification))
-    e_drift, m_drift = invariant_drift(effective, np.asarray(traj.omega_body), np.asarray(traj.quaternion),
-                                       np.asarray(frame.axes))
+    e_drift, m_drift = invariant_drift(effective, np.asarray(traj.omega_body), np.asarray(traj.quaternion), np.asarray(frame.axes))
     finite = all(np.all(np.isfinite(np.asarray(a))) for a in (traj.omega_body, traj.quaternion, traj.omega))
     omega_body0 = np.asarray(frame.axes) @ np.asarray(case.omega)
     pick = np.linspace(0, samples - 1, reference_samples).astype(int)
@@ -629,8 +753,13 @@ def measure_motion(case: MotionCase, samples: int = 2001, reference_samples: int
     scale = float(np.linalg.norm(omega_body0))
     ours_err = float(np.max(np.linalg.norm(np.asarray(traj.omega_body)[pick] - ref, axis=1)) / scale)
     out: dict[str, object] = {
-        "case": case.name, "note": case.note, "regime": result.motion.regime.value,
-        "energy_drift": e_drift, "momentum_drift": m_drift, "omega_error": ours_err, "finite": finite,
+        "case": case.name,
+        "note": case.note,
+        "regime": result.motion.regime.value,
+        "energy_drift": e_drift,
+        "momentum_drift": m_drift,
+        "omega_error": ours_err,
+        "finite": finite,
         "service_drift": (result.motion.diagnostics.energy_drift, result.motion.diagnostics.momentum_drift),
         "passed": finite and e_drift <= BOUND_INVARIANT and m_drift <= BOUND_INVARIANT,
     }
@@ -659,8 +788,13 @@ def _scipy_cell(case: MotionCase, moments: Array, omega_body0: Array, frame: obj
     pick = np.linspace(0, len(t) - 1, 41).astype(int)
     ref = reference_omega(moments, omega_body0, t[pick])  # type: ignore[arg-type]
     err = float(np.max(np.linalg.norm(w[pick] - ref, axis=1)) / rate)
-    return {"energy_drift": e_drift, "momentum_drift": m_drift, "omega_error": err, "horizon": horizon,
-            "seconds": time.perf_counter() - start}
+    return {
+        "energy_drift": e_drift,
+        "momentum_drift": m_drift,
+        "omega_error": err,
+        "horizon": horizon,
+        "seconds": time.perf_counter() - start,
+    }
 
 
 # -- report -----------------------------------------------------------------------------------
@@ -689,18 +823,32 @@ def _mark(row: Row) -> str:
 
 
 def geometry_table(rows: list[Row]) -> list[str]:
-    lines = ["| case | exact principal moments (unit density) | ours rel. err | our estimate | trimesh | "
-             "numpy-stl | MuJoCo | bound | pass |", "|---|---|---|---|---|---|---|---|---|"]
+    lines = [
+        "| case | exact principal moments (unit density) | ours rel. err | our estimate | trimesh | "
+        "numpy-stl | MuJoCo | bound | pass |",
+        "|---|---|---|---|---|---|---|---|---|",
+    ]
     for r in rows:
         peers = [_cell(r.peers.get(k, "—")) for k in ("trimesh", "numpy-stl", "mujoco")]
         case = r.case + (f" ({r.note})" if r.note else "")
-        lines.append(f"| {case} | {r.exact} | {_cell(r.ours)} | {_cell(r.estimate)} | " + " | ".join(peers)
-                     + f" | {r.bound_text} | {_mark(r)} |")
+        lines.append(
+            f"| {case} | {r.exact} | {_cell(r.ours)} | {_cell(r.estimate)} | "
+            + " | ".join(peers)
+            + f" | {r.bound_text} | {_mark(r)} |"
+        )
     return lines
 
 
-def render(geometry: list[Row], growth: list[Row], flip: dict[str, object], tess: list[dict[str, object]],
-           motion: list[dict[str, object]], quick: bool, elapsed: float, timings: dict[str, tuple[float, float]]) -> str:
+def render(
+    geometry: list[Row],
+    growth: list[Row],
+    flip: dict[str, object],
+    tess: list[dict[str, object]],
+    motion: list[dict[str, object]],
+    quick: bool,
+    elapsed: float,
+    timings: dict[str, tuple[float, float]],
+) -> str:
     failures = [r for r in geometry + growth if not r.passed] + [m for m in motion if not m["passed"]]
     over = [r for r in geometry + growth if r.passed and not r.estimate_ok]
     out = [
@@ -713,8 +861,12 @@ def render(geometry: list[Row], growth: list[Row], flip: dict[str, object], tess
         "",
         f"**Summary:** {len(geometry) + len(growth) + len(motion) + 1} rows; "
         + (f"{len(failures)} fail their bound" if failures else "every row meets its bound")
-        + (f"; {len(over)} row(s) meet it but our `relative_error_estimate` is above the API's promised 1e-12 "
-           "(marked pass\\*, see the note under the table)" if over else "")
+        + (
+            f"; {len(over)} row(s) meet it but our `relative_error_estimate` is above the API's promised 1e-12 "
+            "(marked pass\\*, see the note under the table)"
+            if over
+            else ""
+        )
         + ". No NaN or infinity from the service anywhere in the battery.",
         "",
         "Errors are relative, per principal moment against its own exact value; a cell shows the worst moment "
@@ -732,10 +884,10 @@ def render(geometry: list[Row], growth: list[Row], flip: dict[str, object], tess
     out += [
         "",
         "Wall time per row, ours / whole row (exact reference + all tools): "
-        + ", ".join(f"{k}: {a:.1f} s / {b:.1f} s" for k, (a, b) in timings.items()) + ". "
+        + ", ".join(f"{k}: {a:.1f} s / {b:.1f} s" for k, (a, b) in timings.items())
+        + ". "
         + "Peers on the largest mesh they ran: "
-        + ", ".join(f"{k} {v:.1f} s" for r in growth[-2:-1]
-                    for k, v in r.extra.get("peer_s", {}).items())  # type: ignore[attr-defined]
+        + ", ".join(f"{k} {v:.1f} s" for r in growth[-2:-1] for k, v in r.extra.get("peer_s", {}).items())  # type: ignore[attr-defined]
         + f" ({growth[-2].case.split(',')[0] if len(growth) > 1 else '-'}). "
         "numpy-stl and MuJoCo are not run at 1e7 triangles: at ten times those times "
         "the report would no longer regenerate in a few minutes; trimesh and ours are.",
@@ -759,13 +911,20 @@ def render(geometry: list[Row], growth: list[Row], flip: dict[str, object], tess
         "",
     ]
     out += _flip_lines(flip)
-    out += ["", "### Tessellation noise against the tolerance", "",
-            "| body (rotated) | true class | spread of moments that should be equal | chord-error scale | "
-            "smallest tolerance giving the true class | default 1e-6 gives it |", "|---|---|---|---|---|---|"]
+    out += [
+        "",
+        "### Tessellation noise against the tolerance",
+        "",
+        "| body (rotated) | true class | spread of moments that should be equal | chord-error scale | "
+        "smallest tolerance giving the true class | default 1e-6 gives it |",
+        "|---|---|---|---|---|---|",
+    ]
     for t in tess:
-        out.append(f"| {t['case']} | {t['true'].value} | {_cell(t['spread'])} | {t['scale'] or '—'} | "  # type: ignore[arg-type, attr-defined]
-                   f"{_tol(t['tol_ours'])} (exact moments: {_tol(t['tol_exact_moments'])}) | "
-                   f"{'yes' if t['default_ok'] else 'no'} |")
+        out.append(
+            f"| {t['case']} | {t['true'].value} | {_cell(t['spread'])} | {t['scale'] or '—'} | "  # type: ignore[arg-type, attr-defined]
+            f"{_tol(t['tol_ours'])} (exact moments: {_tol(t['tol_exact_moments'])}) | "
+            f"{'yes' if t['default_ok'] else 'no'} |"
+        )
     out += ["", *TOLERANCE_ADVICE, "", "## Motion (each over 1e5 time units)", ""]
     out += _motion_lines(motion)
     if failures:
@@ -774,8 +933,9 @@ def render(geometry: list[Row], growth: list[Row], flip: dict[str, object], tess
             if isinstance(r, Row):
                 out.append(f"- {r.case}: error {r.ours:.2e}, estimate {r.estimate:.2e}, bound {r.bound_text}")
             else:
-                out.append(f"- motion {r['case']}: energy drift {r['energy_drift']:.2e}, |M| drift "
-                           f"{r['momentum_drift']:.2e}, bound 1e-12")
+                out.append(
+                    f"- motion {r['case']}: energy drift {r['energy_drift']:.2e}, |M| drift {r['momentum_drift']:.2e}, bound 1e-12"
+                )
     return "\n".join(out) + "\n"
 
 
@@ -804,7 +964,8 @@ def _flip_lines(flip: dict[str, object]) -> list[str]:
         f"| box 1 x 1 x (1 + 1e-9), rotated | {flip['flip']:.6e} | {_cell(flip['flip_error'])} | "  # type: ignore[arg-type]
         + " | ".join(_cell(peers[k]) for k in ("trimesh", "numpy-stl", "mujoco"))
         + f" | {flip['below'].value} / {flip['above'].value} | "  # type: ignore[attr-defined]
-        + ("pass" if flip["passed"] else "**FAIL**") + " |",
+        + ("pass" if flip["passed"] else "**FAIL**")
+        + " |",
         "",
         f"The equal pair differs by {flip['pair']:.1e} of I3 (rounding of the rotated vertices), so the class "
         "is prolate symmetric for tolerances from there up to the flip, spherical above it. Peer columns are "
@@ -813,8 +974,11 @@ def _flip_lines(flip: dict[str, object]) -> list[str]:
 
 
 def _motion_lines(motion: list[dict[str, object]]) -> list[str]:
-    lines = ["| case | regime | ours (exact): E drift | \\|M\\| drift | Omega err | scipy DOP853 rtol 1e-12: "
-             "E drift | \\|M\\| drift | Omega err | bound (ours) | pass |", "|---|---|---|---|---|---|---|---|---|---|"]
+    lines = [
+        "| case | regime | ours (exact): E drift | \\|M\\| drift | Omega err | scipy DOP853 rtol 1e-12: "
+        "E drift | \\|M\\| drift | Omega err | bound (ours) | pass |",
+        "|---|---|---|---|---|---|---|---|---|---|",
+    ]
     for m in motion:
         s = m["scipy"]
         assert isinstance(s, dict)
@@ -824,9 +988,10 @@ def _motion_lines(motion: list[dict[str, object]]) -> list[str]:
             horizon = "" if s["horizon"] == HORIZON else f" (over {s['horizon']:.0e} s = 1e5 rad)"
             sc = [_cell(s["energy_drift"]) + horizon, _cell(s["momentum_drift"]), _cell(s["omega_error"])]
         case = str(m["case"]) + (f" ({m['note']})" if m["note"] else "")
-        lines.append(f"| {case} | {m['regime']} | {_cell(m['energy_drift'])} | {_cell(m['momentum_drift'])} | "  # type: ignore[arg-type]
-                     f"{_cell(m['omega_error'])} | " + " | ".join(sc)  # type: ignore[arg-type]
-                     + f" | 1e-12 | {'pass' if m['passed'] else '**FAIL**'} |")
+        lines.append(
+            f"| {case} | {m['regime']} | {_cell(m['energy_drift'])} | {_cell(m['momentum_drift'])} | "  # type: ignore[arg-type]
+            f"{_cell(m['omega_error'])} | " + " | ".join(sc) + f" | 1e-12 | {'pass' if m['passed'] else '**FAIL**'} |"  # type: ignore[arg-type]
+        )
     lines += [
         "",
         "Drifts are max over 2001 samples of |E(t) - E(0)|/E(0) and |M(t) - M(0)|/|M(0)| with M in the fixed "
@@ -876,10 +1041,13 @@ def tensor_estimate_row(cases: int = 20) -> dict[str, object]:
             total += 1
             if exponent == -12.0:
                 at_12 = max(at_12, res.relative_error_estimate)
-    return {"case": f"tensor input (/v1/precession), rotated, I1/I3 = 1 .. 1e-12 ({total} tensors)",
-            "ours": f"worst error / estimate {worst_ratio:.2g}; estimate at 1e-12: {at_12:.1e}",
-            "before": f"fixed estimate 1.8e-15 under-stated {fixed_under} of {total}",
-            "bound": "error <= estimate", "passed": worst_ratio <= 1.0}
+    return {
+        "case": f"tensor input (/v1/precession), rotated, I1/I3 = 1 .. 1e-12 ({total} tensors)",
+        "ours": f"worst error / estimate {worst_ratio:.2g}; estimate at 1e-12: {at_12:.1e}",
+        "before": f"fixed estimate 1.8e-15 under-stated {fixed_under} of {total}",
+        "bound": "error <= estimate",
+        "passed": worst_ratio <= 1.0,
+    }
 
 
 def nearly_symmetric_row(cases: int = 20) -> dict[str, object]:
@@ -905,18 +1073,24 @@ def nearly_symmetric_row(cases: int = 20) -> dict[str, object]:
             worst[duration] = max(worst[duration], err / (eps * (1 + speed * duration)))
             departed = float(np.max(np.linalg.norm(reference_omega(ideal, omega, t) - ref, axis=1))) / speed  # type: ignore[arg-type]
             ideal_worst[duration] = max(ideal_worst[duration], departed)
-    return {"case": f"nearly symmetric tops, gaps 1e-13 .. 5e-7 (labelled symmetric at tolerance 1e-6), {cases} tops",
-            "ours": "; ".join(f"T = {d:g}: Omega error {w:.2g} eps per radian" for d, w in worst.items()),
-            "before": "; ".join(f"T = {d:g}: idealised top off by {w:.1e}" for d, w in ideal_worst.items()),
-            "bound": "8 eps per radian turned", "passed": max(worst.values()) <= 8.0}
+    return {
+        "case": f"nearly symmetric tops, gaps 1e-13 .. 5e-7 (labelled symmetric at tolerance 1e-6), {cases} tops",
+        "ours": "; ".join(f"T = {d:g}: Omega error {w:.2g} eps per radian" for d, w in worst.items()),
+        "before": "; ".join(f"T = {d:g}: idealised top off by {w:.1e}" for d, w in ideal_worst.items()),
+        "bound": "8 eps per radian turned",
+        "passed": max(worst.values()) <= 8.0,
+    }
 
 
 def _binary_stl(vertices: Array, faces: NDArray[np.int64]) -> bytes:
     import struct
 
     records = vertices[faces].astype(np.float32)
-    return (b"\0" * 80 + struct.pack("<I", len(faces))
-            + b"".join(struct.pack("<12fH", 0.0, 0.0, 0.0, *tri.ravel(), 0) for tri in records))
+    return (
+        b"\0" * 80
+        + struct.pack("<I", len(faces))
+        + b"".join(struct.pack("<12fH", 0.0, 0.0, 0.0, *tri.ravel(), 0) for tri in records)
+    )
 
 
 def float32_rows() -> list[dict[str, object]]:
@@ -924,8 +1098,22 @@ def float32_rows() -> list[dict[str, object]]:
     from inertia import analyze
     from inertia.errors import ServiceError
 
-    faces = np.array([[0, 1, 3], [0, 3, 2], [4, 6, 7], [4, 7, 5], [0, 4, 5], [0, 5, 1],
-                      [2, 3, 7], [2, 7, 6], [0, 2, 6], [0, 6, 4], [1, 5, 7], [1, 7, 3]])
+    faces = np.array(
+        [
+            [0, 1, 3],
+            [0, 3, 2],
+            [4, 6, 7],
+            [4, 7, 5],
+            [0, 4, 5],
+            [0, 5, 1],
+            [2, 3, 7],
+            [2, 7, 6],
+            [0, 2, 6],
+            [0, 6, 4],
+            [1, 5, 7],
+            [1, 7, 3],
+        ]
+    )
     cells, worst, first_refused = [], 0.0, None
     for exponent in range(9):
         v = F32_BOX @ GENERIC.T + 10.0**exponent * DIRECTION
@@ -940,12 +1128,16 @@ def float32_rows() -> list[dict[str, object]]:
         errs = moment_errors(np.sort(res.props.principal_moments) / 1000.0, exact)
         worst = max(worst, max(errs) / res.props.relative_error_estimate)
         cells.append(f"1e{exponent}: ok")
-    rows = [{"case": "float32 STL, rotated 1 x 0.5 x 0.2 box at offsets 1 .. 1e8",
-             "ours": f"{', '.join(cells)}; worst error / estimate where answered {worst:.2g}",
-             "before": "answered at every offset until all triangles collapse (1e8), e.g. at 1e7, "
-                       "where one float32 step (1 unit) is five times the 0.2 wall",
-             "bound": "refused once float32 steps reach the wall; exact otherwise",
-             "passed": worst <= 1.0 and first_refused is not None and first_refused <= 7}]
+    rows = [
+        {
+            "case": "float32 STL, rotated 1 x 0.5 x 0.2 box at offsets 1 .. 1e8",
+            "ours": f"{', '.join(cells)}; worst error / estimate where answered {worst:.2g}",
+            "before": "answered at every offset until all triangles collapse (1e8), e.g. at 1e7, "
+            "where one float32 step (1 unit) is five times the 0.2 wall",
+            "bound": "refused once float32 steps reach the wall; exact otherwise",
+            "passed": worst <= 1.0 and first_refused is not None and first_refused <= 7,
+        }
+    ]
     rng = np.random.default_rng(0)
     verts: list[Array] = []
     shell_faces: list[list[int]] = []
@@ -960,22 +1152,34 @@ def float32_rows() -> list[dict[str, object]]:
         outcome, ok = f"answered: mass {res.props.mass:.3g} kg", False
     except ServiceError as exc:
         outcome, ok = f"refused: {exc.code}", exc.code in ("insufficient_precision", "zero_volume")
-    rows.append({"case": "189 flat (zero-volume) shells, float32, 1e4 from the origin",
-                 "ours": outcome, "before": "answered: 15.3 kg after flipping 89 shells",
-                 "bound": "refused", "passed": ok})
+    rows.append(
+        {
+            "case": "189 flat (zero-volume) shells, float32, 1e4 from the origin",
+            "ours": outcome,
+            "before": "answered: 15.3 kg after flipping 89 shells",
+            "bound": "refused",
+            "passed": ok,
+        }
+    )
     return rows
 
 
 def honest_lines(rows: list[dict[str, object]]) -> list[str]:
-    lines = ["## Honest numbers (issue 12)", "",
-             "Written by `python -m benchmarks.stability` with the whole report, or alone (about 15 s, the rest "
-             "of the report kept) by `python -m benchmarks.stability --honest-only`.", "",
-             "Tensor input's estimate from its conditioning; the motion of the moments given (the tolerance only "
-             "labels); no answer made of float32 rounding. References: mpmath (`eigsy` at 50 digits, the L&L "
-             "closed forms at 40 digits), exact rational integration of the stored float32 polyhedron. The bounds are "
-             "also asserted by `tests/test_tensor_estimate.py`, `tests/motion/test_nearly_symmetric.py` and "
-             "`tests/test_resolution.py`.", "",
-             "| case | ours | before this change | bound | pass |", "|---|---|---|---|---|"]
+    lines = [
+        "## Honest numbers (issue 12)",
+        "",
+        "Written by `python -m benchmarks.stability` with the whole report, or alone (about 15 s, the rest "
+        "of the report kept) by `python -m benchmarks.stability --honest-only`.",
+        "",
+        "Tensor input's estimate from its conditioning; the motion of the moments given (the tolerance only "
+        "labels); no answer made of float32 rounding. References: mpmath (`eigsy` at 50 digits, the L&L "
+        "closed forms at 40 digits), exact rational integration of the stored float32 polyhedron. The bounds are "
+        "also asserted by `tests/test_tensor_estimate.py`, `tests/motion/test_nearly_symmetric.py` and "
+        "`tests/test_resolution.py`.",
+        "",
+        "| case | ours | before this change | bound | pass |",
+        "|---|---|---|---|---|",
+    ]
     for r in rows:
         lines.append(f"| {r['case']} | {r['ours']} | {r['before']} | {r['bound']} | {'pass' if r['passed'] else 'FAIL'} |")
     return lines
@@ -985,8 +1189,11 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="skip the 1e6/1e7 meshes and points and scipy runs")
     parser.add_argument("--output", type=Path, default=ROOT / "docs" / "stability.md")
-    parser.add_argument("--honest-only", action="store_true",
-                        help="compute only the 'Honest numbers' section (~15 s) and replace it in an existing report")
+    parser.add_argument(
+        "--honest-only",
+        action="store_true",
+        help="compute only the 'Honest numbers' section (~15 s) and replace it in an existing report",
+    )
     args = parser.parse_args(argv)
     started = time.perf_counter()
     if args.honest_only:

@@ -21,13 +21,22 @@ if TYPE_CHECKING:
 # Names are imported on first use (PEP 562), so ``import inertia`` and the CLI
 # start without numpy: ``inertia batch`` starts its workers' forkserver first.
 _HOME = {
-    "Classification": "classification", "RotorClass": "classification", "classify": "classification",
+    "Classification": "classification",
+    "RotorClass": "classification",
+    "classify": "classification",
     "ServiceError": "errors",
-    "Loaded": "load", "load_body": "load",
-    "InertiaTensor": "mass", "MassProperties": "mass", "mass_properties": "mass",
-    "AnalysisOptions": "pipeline", "AnalysisResult": "pipeline", "analyze": "pipeline",
-    "analyze_points": "pipeline", "precession": "pipeline",
-    "PrincipalFrame": "principal", "principal_frame": "principal",
+    "Loaded": "load",
+    "load_body": "load",
+    "InertiaTensor": "mass",
+    "MassProperties": "mass",
+    "mass_properties": "mass",
+    "AnalysisOptions": "pipeline",
+    "AnalysisResult": "pipeline",
+    "analyze": "pipeline",
+    "analyze_points": "pipeline",
+    "precession": "pipeline",
+    "PrincipalFrame": "principal",
+    "principal_frame": "principal",
     "Tolerances": "tolerances",
 }
 

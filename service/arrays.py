@@ -19,7 +19,7 @@ __all__ = ["frozen_array", "freeze_fields"]
 def frozen_array(value: Any, shape: tuple[int, ...] | None = None) -> NDArray[np.float64]:
     """A read-only float64 copy of ``value``; ``shape`` checks its trailing dimensions."""
     arr = np.array(value, dtype=np.float64)
-    if shape is not None and arr.shape[arr.ndim - len(shape):] != shape:
+    if shape is not None and arr.shape[arr.ndim - len(shape) :] != shape:
         raise ValueError(f"expected trailing shape {shape}, got {arr.shape}")
     arr.flags.writeable = False
     return arr

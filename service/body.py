@@ -27,9 +27,7 @@ def _frozen(arr: ArrayLike, dtype: type[np.generic]) -> NDArray[Any]:
 def _check_finite(name: str, arr: NDArray[np.float64]) -> None:
     if not np.all(np.isfinite(arr)):
         bad = int(np.count_nonzero(~np.isfinite(arr)))
-        raise InvalidParameterError(
-            f"{name} contain {bad} non-finite value(s) (NaN or infinity); fix the input", field=name
-        )
+        raise InvalidParameterError(f"{name} contain {bad} non-finite value(s) (NaN or infinity); fix the input", field=name)
 
 
 @dataclass(frozen=True, slots=True)

@@ -61,8 +61,15 @@ __all__ = ["CELL_NODES", "CellRule", "cell_rule", "cell_sums", "combined", "tang
 
 # nodes per cell type (meshio's names)
 CELL_NODES = {
-    "tetra10": 10, "hexahedron": 8, "hexahedron20": 20, "hexahedron27": 27,
-    "wedge": 6, "wedge15": 15, "wedge18": 18, "pyramid": 5, "pyramid13": 13,
+    "tetra10": 10,
+    "hexahedron": 8,
+    "hexahedron20": 20,
+    "hexahedron27": 27,
+    "wedge": 6,
+    "wedge15": 15,
+    "wedge18": 18,
+    "pyramid": 5,
+    "pyramid13": 13,
 }
 # VTK's voxel numbers its corners x fastest, then y, then z; a hexahedron goes round each face
 VOXEL_TO_HEXAHEDRON = np.array([0, 1, 3, 2, 4, 5, 7, 6])
@@ -80,8 +87,9 @@ _WEDGE_EDGES = [(0, 1), (1, 2), (2, 0), (3, 4), (4, 5), (5, 3), (0, 3), (1, 4), 
 _WEDGE_FACES = ((0, 1, 4, 3), (1, 2, 5, 4), (2, 0, 3, 5))
 
 
-def _with_midpoints(corners: list[tuple[int, int, int]], edges: list[tuple[int, int]],
-                    faces: tuple[tuple[int, ...], ...] = (), centre: bool = False) -> NDArray[np.float64]:
+def _with_midpoints(
+    corners: list[tuple[int, int, int]], edges: list[tuple[int, int]], faces: tuple[tuple[int, ...], ...] = (), centre: bool = False
+) -> NDArray[np.float64]:
     c = np.array(corners, dtype=np.float64)
     rows = [c, *(0.5 * (c[[a]] + c[[b]]) for a, b in edges), *(c[list(f)].mean(axis=0, keepdims=True) for f in faces)]
     if centre:
@@ -166,8 +174,9 @@ def _pyramid13(xi: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np
         gs = -3 * sa + 2 * ra * sa * r - sa * t + 2 * ra * sa * r * t
         gt = 2 - ra * r - sa * s + 2 * ra * sa * r * s
         cols.append(-a * b * c * g / 16)
-        grads.append((-(ra * b * c * g + a * b * c * gr) / 16, -(a * sa * c * g + a * b * c * gs) / 16,
-                      -(-a * b * g + a * b * c * gt) / 16))
+        grads.append(
+            (-(ra * b * c * g + a * b * c * gr) / 16, -(a * sa * c * g + a * b * c * gs) / 16, -(-a * b * g + a * b * c * gt) / 16)
+        )
     cols.append(t * (1 + t) / 2)
     grads.append((0 * r, 0 * r, (1 + 2 * t) / 2))
     for along_r, sign in ((True, -1), (False, 1), (True, 1), (False, -1)):  # base edges 0-1, 1-2, 2-3, 3-0
@@ -181,8 +190,9 @@ def _pyramid13(xi: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np
         grads.append((du, dv, dt) if along_r else (dv, du, dt))
     for ra, sa in corners:  # side edges 0-4, 1-4, 2-4, 3-4
         cols.append((1 + ra * r) * (1 + sa * s) * (1 - t * t) / 4)
-        grads.append((ra * (1 + sa * s) * (1 - t * t) / 4, (1 + ra * r) * sa * (1 - t * t) / 4,
-                      -(1 + ra * r) * (1 + sa * s) * 2 * t / 4))
+        grads.append(
+            (ra * (1 + sa * s) * (1 - t * t) / 4, (1 + ra * r) * sa * (1 - t * t) / 4, -(1 + ra * r) * (1 + sa * s) * 2 * t / 4)
+        )
     n = np.stack(cols, axis=1)
     dn = np.stack([np.stack([g[d] for g in grads], axis=1) for d in range(3)]) * 2  # d/dr = 2 d/dR
     return n, dn
@@ -253,10 +263,15 @@ def _points_for(degree: int) -> int:
 #   wedge                                                 (1, 1) -> (3, 4) -> 2 x 3 points
 #   wedge15, wedge18 (inside P2 x P2)                     (2, 2) -> (8, 9) -> 5 x 5 points
 _RULES = {
-    "hexahedron": ("cube", 4), "pyramid": ("cube", 4),
-    "hexahedron20": ("cube", 9), "hexahedron27": ("cube", 9), "pyramid13": ("cube", 9),
+    "hexahedron": ("cube", 4),
+    "pyramid": ("cube", 4),
+    "hexahedron20": ("cube", 9),
+    "hexahedron27": ("cube", 9),
+    "pyramid13": ("cube", 9),
     "tetra10": ("tet", 7),
-    "wedge": ("wedge", (3, 4)), "wedge15": ("wedge", (8, 9)), "wedge18": ("wedge", (8, 9)),
+    "wedge": ("wedge", (3, 4)),
+    "wedge15": ("wedge", (8, 9)),
+    "wedge18": ("wedge", (8, 9)),
 }
 
 
@@ -323,8 +338,9 @@ def shape_functions(name: str, xi: NDArray[np.float64]) -> tuple[NDArray[np.floa
 _BLOCK_POINTS = 1 << 16  # quadrature points per vectorised block: its ~40 (cells, q) temporaries take ~20 MB
 
 
-def _jacobians(xyz: list[NDArray[np.float64]], cells: NDArray[np.int64], rule: CellRule
-               ) -> tuple[list[NDArray[np.float64]], NDArray[np.float64], NDArray[np.float64], list[NDArray[np.float64]]]:
+def _jacobians(
+    xyz: list[NDArray[np.float64]], cells: NDArray[np.int64], rule: CellRule
+) -> tuple[list[NDArray[np.float64]], NDArray[np.float64], NDArray[np.float64], list[NDArray[np.float64]]]:
     """Positions (3 of (c, q)), det J (c, q), its rounding scale (c, q) and the positions' (3 of (c, q)).
 
     Formed from the edges D_a = X_a - X_0 of each cell (sum N_a = 1, sum dN_a = 0, so
@@ -340,12 +356,13 @@ def _jacobians(xyz: list[NDArray[np.float64]], cells: NDArray[np.int64], rule: C
     jac = [[e @ rule.grad_t[d, 1:] for e in edges] for d in range(3)]  # jac[d][k] = dx_k / dxi_d
     jac_abs = [[m @ rule.abs_grad_t[d, 1:] for m in magnitude] for d in range(3)]  # sum |dN_a| |D_a|
     a, b, c = jac
-    det = (a[0] * (b[1] * c[2] - b[2] * c[1]) + a[1] * (b[2] * c[0] - b[0] * c[2]) + a[2] * (b[0] * c[1] - b[1] * c[0]))
+    det = a[0] * (b[1] * c[2] - b[2] * c[1]) + a[1] * (b[2] * c[0] - b[0] * c[2]) + a[2] * (b[0] * c[1] - b[1] * c[0])
     aa, ba, ca = jac_abs
     # every product of the determinant, in bounds of its factors: det's rounding (each J entry a sum
     # of n - 1 products of rounded edges, then three products and five sums) is below (n + 6) u times this
-    cond = (aa[0] * (ba[1] * ca[2] + ba[2] * ca[1]) + aa[1] * (ba[2] * ca[0] + ba[0] * ca[2])
-            + aa[2] * (ba[0] * ca[1] + ba[1] * ca[0]))
+    cond = (
+        aa[0] * (ba[1] * ca[2] + ba[2] * ca[1]) + aa[1] * (ba[2] * ca[0] + ba[0] * ca[2]) + aa[2] * (ba[0] * ca[1] + ba[1] * ca[0])
+    )
     return pos, det, cond, pos_scale
 
 
@@ -383,15 +400,26 @@ def cell_sums(x: NDArray[np.float64], name: str, cells: NDArray[np.int64], weigh
     for row, (i, j) in enumerate(_IJ, start=4):
         m2[i, j] = m2[j, i] = total[row]
         a2[i, j] = a2[j, i] = total_abs[row]
-    return Sums(float(total[0]), total[1:4].copy(), m2, float(total_abs[0]), a2, float(total[10]),
-                total[11:14].copy(), float(total[14]), len(cells) * len(rule.weights), max(len(rows), 1))
+    return Sums(
+        float(total[0]),
+        total[1:4].copy(),
+        m2,
+        float(total_abs[0]),
+        a2,
+        float(total[10]),
+        total[11:14].copy(),
+        float(total[14]),
+        len(cells) * len(rule.weights),
+        max(len(rows), 1),
+    )
 
 
 _IJ = ((0, 0), (1, 1), (2, 2), (0, 1), (0, 2), (1, 2))
 
 
-def _block_rows(xyz: list[NDArray[np.float64]], cells: NDArray[np.int64], rule: CellRule,
-                weight: NDArray[np.float64] | None, n: int) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+def _block_rows(
+    xyz: list[NDArray[np.float64]], cells: NDArray[np.int64], rule: CellRule, weight: NDArray[np.float64] | None, n: int
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """The 15 rows of ``integrals`` (m0, m1, m2, noise, diagonal error scales, measure) of one block."""
     pos, det, cond, pos_scale = _jacobians(xyz, cells, rule)
     sign = np.sign(det @ rule.weights)  # a mirrored cell counts with |det J|
@@ -416,8 +444,18 @@ def _block_rows(xyz: list[NDArray[np.float64]], cells: NDArray[np.int64], rule: 
 
 def combined(a: Sums, b: Sums) -> Sums:
     """The sums of two disjoint sets of elements."""
-    return Sums(a.m0 + b.m0, a.m1 + b.m1, a.m2 + b.m2, a.abs_m0 + b.abs_m0, a.abs_m2 + b.abs_m2, a.noise + b.noise,
-                a.element_err + b.element_err, a.measure + b.measure, a.terms + b.terms, a.blocks + b.blocks)
+    return Sums(
+        a.m0 + b.m0,
+        a.m1 + b.m1,
+        a.m2 + b.m2,
+        a.abs_m0 + b.abs_m0,
+        a.abs_m2 + b.abs_m2,
+        a.noise + b.noise,
+        a.element_err + b.element_err,
+        a.measure + b.measure,
+        a.terms + b.terms,
+        a.blocks + b.blocks,
+    )
 
 
 def reference_volume(name: str) -> float:

@@ -104,8 +104,7 @@ def classify(frame: PrincipalFrame, tolerance: float | None = None) -> Classific
     i1, i2, i3 = (float(x) for x in frame.moments)
     if i3 == 0.0:  # all mass at one point: no axis is distinguished, every moment is zero
         return Classification(RotorClass.SPHERICAL, None, None, True, tol, Margins())
-    margins = Margins(gap12=(i2 - i1) / i3, gap23=(i3 - i2) / i3, smallest=i1 / i3,
-                      planarity=abs(i1 + i2 - i3) / i3)
+    margins = Margins(gap12=(i2 - i1) / i3, gap23=(i3 - i2) / i3, smallest=i1 / i3, planarity=abs(i1 + i2 - i3) / i3)
     pairs = equal_moment_pairs(frame.moments, tol)
     planar = margins.planarity <= tol
     axes = frame.axes

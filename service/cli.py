@@ -1,14 +1,17 @@
 """Command line: ``inertia analyze | batch | serve``, a thin front end over the pipeline.
 
 Errors are printed to stderr as a sentence (``error: ... (code)``), or in the API's
-envelope with ``--json``; the exit status comes from ``EXIT_CODES``:
+envelope with ``--json``; the exit status comes from ``EXIT_CODES``, chosen by the
+error's class (its nearest listed base class):
 
     0  success
     1  an unexpected internal error (a bug: please report it)
     2  a bad option or parameter
-    3  a file that cannot be read: unsupported format, unreadable, no geometry
-    4  a body that is not a solid: open mesh, zero volume
-    5  a time limit was reached
+    3  a file that cannot be read: unsupported format, unreadable, an external
+       reference that did not come with it, no geometry, past a size bound
+    4  a body that is not a solid: open mesh, zero volume, insufficient precision,
+       an inertia a simulator refuses
+    5  a time limit was reached (reserved: the command line sets none)
     6  the environment refused: a port in use, an output that cannot be written
   130  interrupted (Ctrl-C)
 """
@@ -18,27 +21,36 @@ from __future__ import annotations
 import argparse
 import gc
 import json
+import os
 import re
 import sys
 from collections.abc import Sequence
 from typing import Any
 
-from .errors import InvalidParameterError, ServiceError
+from .errors import (
+    DegenerateBodyError,
+    InputTooLargeError,
+    InvalidInertiaError,
+    InvalidMeshError,
+    InvalidParameterError,
+    LoadError,
+    ServiceError,
+)
+from .tolerances import DEFAULT_TOLERANCES
+from .vocabulary import METHODS, MODELS, Model, MotionMethod
 
-__all__ = ["main", "EXIT_CODES"]
+__all__ = ["main", "EXIT_CODES", "exit_code"]
 
-EXIT_CODES = {
-    "invalid_parameter": 2,
-    "unsupported_format": 3,
-    "unreadable_file": 3,
-    "empty_geometry": 3,
-    "not_watertight": 4,
-    "zero_volume": 4,
-    "insufficient_precision": 4,
-    "invalid_inertia": 4,
-    "timeout": 5,
-}
 EXIT_INTERNAL = 1
+EXIT_CODES: dict[type[ServiceError], int] = {
+    InvalidParameterError: 2,  # MotionError too
+    LoadError: 3,  # unsupported_format, unreadable_file, external_reference, empty_geometry
+    InputTooLargeError: 3,
+    InvalidMeshError: 4,  # not_watertight
+    DegenerateBodyError: 4,  # zero_volume, insufficient_precision
+    InvalidInertiaError: 4,
+    ServiceError: EXIT_INTERNAL,
+}
 EXIT_ENVIRONMENT = 6
 EXIT_INTERRUPTED = 130
 
@@ -78,27 +90,44 @@ def _quaternion(text: str) -> tuple[float, float, float, float]:
 def add_analysis_options(p: argparse.ArgumentParser) -> None:
     """Options shared by ``analyze`` and ``batch`` (the API's query parameters)."""
     p.add_argument("--format", help="file format; inferred from the name when absent")
-    p.add_argument("--units", help="length unit of the file: m, cm, mm, um, in, ft, angstrom "
-                   "(default: the file's; angstrom for .xyz; else m)")
+    p.add_argument(
+        "--units", help="length unit of the file: m, cm, mm, um, in, ft, angstrom (default: the file's; angstrom for .xyz; else m)"
+    )
     group = p.add_mutually_exclusive_group()
     group.add_argument("--density", type=float, help="density in kg/m^3 (default 1000)")
     group.add_argument("--mass", type=float, help="total mass in kg (density is derived)")
-    p.add_argument("--model", choices=("solid", "shell"), default="solid", help="closed solid or thin shell")
+    p.add_argument("--model", choices=MODELS, default=Model.SOLID.value, help="closed solid or thin shell")
     p.add_argument("--thickness", type=float, help="shell wall thickness, in the file's units")
-    p.add_argument("--tolerance", type=float, default=1e-6, help="relative tolerance for equal moments")
-    p.add_argument("--reference", type=_triple, metavar="X,Y,Z",
-                   help="point (file units): also report the tensor about it; negative values as written: -1,0,0")
+    p.add_argument("--tolerance", type=float, default=DEFAULT_TOLERANCES.moment_rel, help="relative tolerance for equal moments")
+    p.add_argument(
+        "--reference",
+        type=_triple,
+        metavar="X,Y,Z",
+        help="point (file units): also report the tensor about it; negative values as written: -1,0,0",
+    )
     p.add_argument("--densities", help="JSON file: part name -> density (kg/m^3) for files of several parts")
-    p.add_argument("--geometry", choices=("brep", "mesh"),
-                   help="CAD files: integrate the exact B-rep (default) or a tessellation of it")
-    p.add_argument("--deflection", type=float,
-                   help="CAD files: tessellate (implies --geometry mesh) with this chordal deflection relative to "
-                   "the bounding-box diagonal (default 1e-3)")
-    p.add_argument("--frame", type=_quaternion, metavar="W,X,Y,Z",
-                   help="unit quaternion carrying a named frame's axes into the file's: also report the centre of "
-                   "mass and tensors along that frame's axes")
-    p.add_argument("--isotopes", choices=("standard", "abundant"), default="standard",
-                   help="atoms named by element (.xyz): standard atomic weights or the most abundant isotope")
+    p.add_argument(
+        "--geometry", choices=("brep", "mesh"), help="CAD files: integrate the exact B-rep (default) or a tessellation of it"
+    )
+    p.add_argument(
+        "--deflection",
+        type=float,
+        help="CAD files: tessellate (implies --geometry mesh) with this chordal deflection relative to "
+        "the bounding-box diagonal (default 1e-3)",
+    )
+    p.add_argument(
+        "--frame",
+        type=_quaternion,
+        metavar="W,X,Y,Z",
+        help="unit quaternion carrying a named frame's axes into the file's: also report the centre of "
+        "mass and tensors along that frame's axes",
+    )
+    p.add_argument(
+        "--isotopes",
+        choices=("standard", "abundant"),
+        default="standard",
+        help="atoms named by element (.xyz): standard atomic weights or the most abundant isotope",
+    )
 
 
 def options_from_args(args: argparse.Namespace) -> Any:
@@ -125,7 +154,7 @@ def options_from_args(args: argparse.Namespace) -> Any:
         omega=getattr(args, "omega", None),
         duration=getattr(args, "duration", None),
         samples=getattr(args, "samples", None),
-        method=getattr(args, "method", "exact"),
+        method=getattr(args, "method", MotionMethod.EXACT.value),
         densities=densities,
         geometry=getattr(args, "geometry", None) or ("mesh" if getattr(args, "deflection", None) else "brep"),
         deflection=getattr(args, "deflection", None),
@@ -143,18 +172,30 @@ def _parser() -> argparse.ArgumentParser:
     a = sub.add_parser("analyze", help="analyse one mesh or points file (.json/.csv/.xyz)")
     a.add_argument("file", help="mesh, volume mesh or points file (.json/.csv/.xyz); the format from its name or --format")
     add_analysis_options(a)
-    a.add_argument("--omega", type=_triple, metavar="WX,WY,WZ",
-                   help="initial angular velocity, rad/s, input frame (adds the precession section)")
+    a.add_argument(
+        "--omega",
+        type=_triple,
+        metavar="WX,WY,WZ",
+        help="initial angular velocity, rad/s, input frame (adds the precession section)",
+    )
     a.add_argument("--duration", type=float, help="seconds of motion to predict (with --omega and --samples)")
     a.add_argument("--samples", type=int, help="number of time samples of the trajectory")
-    a.add_argument("--method", default="exact", choices=("exact", "dop853", "rk45", "splitting"),
-                   help="motion method: exact (closed form / elliptic), dop853, rk45 or splitting (default exact)")
+    a.add_argument(
+        "--method",
+        default=MotionMethod.EXACT.value,
+        choices=METHODS,
+        help="motion method: exact (closed form / elliptic), dop853, rk45 or splitting (default exact)",
+    )
     a.add_argument("--json", action="store_true", help="print the API's JSON instead of a table (errors as JSON too)")
-    a.add_argument("--output-units", choices=tuple(OUTPUT_UNITS), default="si",
-                   help="units of the table: si (kg, m, kg m^2; default), kg-mm (kg mm^2), g-mm (g mm^2) or g-cm "
-                        "(g cm^2); --json stays SI")
-    a.add_argument("--export", choices=("urdf", "sdf", "mjcf"),
-                   help="print only the inertial element of a robot description format (SI units)")
+    a.add_argument(
+        "--output-units",
+        choices=tuple(OUTPUT_UNITS),
+        default="si",
+        help="units of the table: si (kg, m, kg m^2; default), kg-mm (kg mm^2), g-mm (g mm^2) or g-cm (g cm^2); --json stays SI",
+    )
+    a.add_argument(
+        "--export", choices=("urdf", "sdf", "mjcf"), help="print only the inertial element of a robot description format (SI units)"
+    )
 
     b = sub.add_parser("batch", help="analyse many files, folders or .zip archives into JSONL/CSV/Parquet")
     b.add_argument("paths", nargs="+", help="files, folders (read recursively) or .zip archives")
@@ -169,8 +210,12 @@ def _parser() -> argparse.ArgumentParser:
     s.add_argument("--host", default="127.0.0.1", help="address to listen on (default 127.0.0.1; 0.0.0.0 for all)")
     s.add_argument("--port", type=int, default=8000, help="port to listen on (default 8000)")
     s.add_argument("--workers", type=int, default=1, help="uvicorn worker processes (default 1)")
-    s.add_argument("--log-level", default="info", choices=("critical", "error", "warning", "info", "debug", "trace"),
-                   help="uvicorn's log level (default info)")
+    s.add_argument(
+        "--log-level",
+        default="info",
+        choices=("critical", "error", "warning", "info", "debug", "trace"),
+        help="uvicorn's log level (default info)",
+    )
     return parser
 
 
@@ -216,13 +261,18 @@ def main(argv: Sequence[str] | None = None) -> int:
             print(json.dumps(exc.as_dict()), file=sys.stderr)
         else:
             print(f"error: {exc.message} ({exc.code})", file=sys.stderr)
-        return EXIT_CODES.get(exc.code, EXIT_INTERNAL)
+        return exit_code(exc)
     except BrokenPipeError:  # output piped into head & co.: not an error of ours
         sys.stderr.close()
         return 0
     except KeyboardInterrupt:
         print("interrupted", file=sys.stderr)
         return EXIT_INTERRUPTED
+
+
+def exit_code(exc: ServiceError) -> int:
+    """The exit status of an error: that of its nearest base class in ``EXIT_CODES``."""
+    return next(EXIT_CODES[cls] for cls in type(exc).__mro__ if cls in EXIT_CODES)
 
 
 def _analyze(args: argparse.Namespace) -> int:
@@ -239,8 +289,9 @@ def _analyze(args: argparse.Namespace) -> int:
         try:
             text = json.dumps(doc, indent=2, allow_nan=False)
         except ValueError as exc:  # a non-finite number is a bug: say so, never print Infinity or NaN
-            raise InvalidParameterError("the result holds a number that is not finite, which JSON cannot carry; "
-                                        "please report the input") from exc
+            raise InvalidParameterError(
+                "the result holds a number that is not finite, which JSON cannot carry; please report the input"
+            ) from exc
         print(text)
     else:
         print(render_table(doc, args.output_units))
@@ -251,25 +302,53 @@ def _batch(args: argparse.Namespace) -> int:
     """``inertia batch``: run, print a one-line summary to stderr, exit 0.
 
     Files that fail are rows of the output, not a failure of the run; a bad
-    option or a missing extra raises ``InvalidParameterError`` (exit 2).
+    option or a missing extra raises ``InvalidParameterError`` (exit 2).  The
+    output's folder is made when missing; on Ctrl-C the rows written so far
+    stay, and one line says how ``--resume`` continues.
     """
+    if not _output_folder_ready(args.out):
+        return EXIT_ENVIRONMENT
     if args.scheduler is None:  # a local cluster: its workers' imports start now, beside this process's
         from .batch.workers import start_forkserver
 
         start_forkserver()
     from .batch import run_batch
 
-    summary = run_batch(
-        args.paths,
-        args.out,
-        options_from_args(args),
-        resume=args.resume,
-        workers=args.workers,
-        scheduler=args.scheduler,
-        progress=not args.no_progress,
-    )
+    try:
+        summary = run_batch(
+            args.paths,
+            args.out,
+            options_from_args(args),
+            resume=args.resume,
+            workers=args.workers,
+            scheduler=args.scheduler,
+            progress=not args.no_progress,
+        )
+    except KeyboardInterrupt:
+        print(
+            f"\ninterrupted: the rows written so far are kept in {args.out}; run the same command with --resume "
+            "to analyse the rest",
+            file=sys.stderr,
+        )
+        return EXIT_INTERRUPTED
     print(summary.as_text(), file=sys.stderr)
     return 0
+
+
+def _output_folder_ready(out: str) -> bool:
+    """Make the output's folder if it is missing; say why in one sentence when it cannot be written."""
+    if "://" in out:  # a remote output: its filesystem says
+        return True
+    folder = os.path.dirname(os.path.abspath(out))
+    try:
+        os.makedirs(folder, exist_ok=True)
+    except OSError as exc:
+        print(f"error: cannot create the output folder {folder!r}: {exc.strerror}; choose another --out", file=sys.stderr)
+        return False
+    if not os.access(folder, os.W_OK):
+        print(f"error: the output folder {folder!r} is not writable; choose another --out", file=sys.stderr)
+        return False
+    return True
 
 
 def _port_free(host: str, port: int) -> bool:
@@ -293,12 +372,16 @@ def _serve(args: argparse.Namespace) -> int:
     import uvicorn
 
     if not _port_free(args.host, args.port):
-        print(f"error: port {args.port} on {args.host} is in use or not available; stop the other server "
-              f"or choose another port with --port", file=sys.stderr)
+        print(
+            f"error: port {args.port} on {args.host} is in use or not available; stop the other server "
+            f"or choose another port with --port",
+            file=sys.stderr,
+        )
         return EXIT_ENVIRONMENT
     # the service writes its own structured access line (inertia.api.access)
-    uvicorn.run(f"{__package__}.app:app", host=args.host, port=args.port, workers=args.workers,
-                log_level=args.log_level, access_log=False)
+    uvicorn.run(
+        f"{__package__}.app:app", host=args.host, port=args.port, workers=args.workers, log_level=args.log_level, access_log=False
+    )
     return 0
 
 
@@ -347,8 +430,7 @@ def render_table(doc: dict[str, Any], output_units: str = "si") -> str:
 
     def tensor_rows(label: str, tensor: Sequence[Sequence[float]]) -> list[tuple[str, str]]:
         scale = mu * lu * lu
-        return [(label if i == 0 else "", f"{_vec([x / scale for x in row])} {inertia_unit}")
-                for i, row in enumerate(tensor)]
+        return [(label if i == 0 else "", f"{_vec([x / scale for x in row])} {inertia_unit}") for i, row in enumerate(tensor)]
 
     src = doc["source"]
     lines = [f"{src.get('filename', 'points')}  ({src['format']}, {src['kind']}, units {src['units']})"]
@@ -382,13 +464,16 @@ def render_table(doc: dict[str, Any], output_units: str = "si") -> str:
     if "parts" in doc:
         for part in doc["parts"]:
             moments = [x / (mu * lu * lu) for x in part["principal"]["moments"]]
-            rows.append((f"part {part['name']}", f"mass {_fmt(part['mass'] / mu)} {mn}, "
-                         f"moments {_vec(moments)} {inertia_unit}"))
+            rows.append((f"part {part['name']}", f"mass {_fmt(part['mass'] / mu)} {mn}, moments {_vec(moments)} {inertia_unit}"))
     diag = doc["diagnostics"]
     rows.append(("relative error", f"{diag['relative_error_estimate']:.2g}"))
     if "tessellation_error" in diag:
-        rows.append(("tessellation error", f"{diag['tessellation_error']:.2g} vs the exact B-rep "
-                     f"(deflection {doc['source'].get('deflection')})"))
+        rows.append(
+            (
+                "tessellation error",
+                f"{diag['tessellation_error']:.2g} vs the exact B-rep (deflection {doc['source'].get('deflection')})",
+            )
+        )
     rows.append(("elapsed", f"{diag['elapsed_s'] * 1e3:.2f} ms"))
     width = max(len(k) for k, _ in rows)
     lines += [f"  {k:<{width}}  {v}" for k, v in rows]
@@ -398,9 +483,14 @@ def render_table(doc: dict[str, Any], output_units: str = "si") -> str:
 
 # Motion quantities of the table with their units; momentum and energy scale with the inertia unit.
 _MOTION_UNITS = {
-    "angular_momentum_magnitude": "momentum", "kinetic_energy": "energy",
-    "body_precession_rate": "rad/s", "space_precession_rate": "rad/s", "spin_rate": "rad/s",
-    "nutation_angle": "rad", "period": "s", "flip_interval": "s",
+    "angular_momentum_magnitude": "momentum",
+    "kinetic_energy": "energy",
+    "body_precession_rate": "rad/s",
+    "space_precession_rate": "rad/s",
+    "spin_rate": "rad/s",
+    "nutation_angle": "rad",
+    "period": "s",
+    "flip_interval": "s",
 }
 
 

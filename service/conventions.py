@@ -48,9 +48,7 @@ def length_scale(unit: str) -> float:
         return LENGTH_UNITS[unit]
     except KeyError:
         known = ", ".join(LENGTH_UNITS)
-        raise InvalidParameterError(
-            f"unknown length unit {unit!r}; use one of {known}", parameter="units"
-        ) from None
+        raise InvalidParameterError(f"unknown length unit {unit!r}; use one of {known}", parameter="units") from None
 
 
 def orient_axes(axes: NDArray[np.float64]) -> NDArray[np.float64]:

@@ -76,8 +76,7 @@ def atomic_mass(spec: str, isotopes: str = "standard") -> float:
     mass_number = int(number_text) if number_text else None
     if symbol in _HYDROGEN_ALIASES:
         if mass_number is not None:
-            raise InvalidParameterError(f"element {spec!r}: {symbol} already names an isotope of hydrogen",
-                                        parameter="element")
+            raise InvalidParameterError(f"element {spec!r}: {symbol} already names an isotope of hydrogen", parameter="element")
         mass_number, symbol = _HYDROGEN_ALIASES[symbol], "H"
     element = _element(symbol, spec)
     if mass_number is not None:

@@ -2,7 +2,9 @@
 
 Every failure the service can explain is a :class:`ServiceError`.  The HTTP
 layer (``service.api.errors``) maps classes to status codes and the CLI maps
-them to exit codes; nothing else needs to know about transports.
+them to exit codes; nothing else needs to know about transports.  Errors that
+only a transport raises (authentication, request size, the compute pool's time
+limit) live with it, in ``service.api.transport``.
 """
 
 from __future__ import annotations
@@ -23,9 +25,7 @@ __all__ = [
     "InsufficientPrecisionError",
     "InvalidParameterError",
     "MotionError",
-    "PayloadTooLargeError",
-    "ComputeTimeoutError",
-    "UnauthorizedError",
+    "InputTooLargeError",
     "InvalidInertiaError",
     "ServerBusyError",
 ]
@@ -110,16 +110,12 @@ class MotionError(InvalidParameterError):
     code = "invalid_parameter"
 
 
-class PayloadTooLargeError(ServiceError):
+class InputTooLargeError(ServiceError):
+    """The input passes a bound set on what is read: files in an archive, bytes it inflates to,
+    memory a reader may take.  (The HTTP layer's own size limit is its subclass
+    ``api.transport.PayloadTooLargeError``.)"""
+
     code = "payload_too_large"
-
-
-class ComputeTimeoutError(ServiceError):
-    code = "timeout"
-
-
-class UnauthorizedError(ServiceError):
-    code = "unauthorized"
 
 
 class InvalidInertiaError(ServiceError):

@@ -70,8 +70,7 @@ class Inertial:
     relative_error: float = 0.0
 
     def __post_init__(self) -> None:
-        freeze_fields(self, {"center_of_mass": (3,), "tensor": (3, 3), "moments": (3,), "axes": (3, 3),
-                             "quaternion": (4,)})
+        freeze_fields(self, {"center_of_mass": (3,), "tensor": (3, 3), "moments": (3,), "axes": (3, 3), "quaternion": (4,)})
 
 
 @dataclass(frozen=True, slots=True)
@@ -97,24 +96,35 @@ def _check(body: Inertial, fmt: str, name: str) -> None:
     who = f"{name}: " if name else ""
     i1, i3 = float(body.moments[0]), float(body.moments[2])
     if not (np.isfinite(body.mass) and body.mass > 0):
-        raise InvalidInertiaError(f"{who}the mass {body.mass!r} kg is not positive; simulators refuse such a body",
-                                  reason="mass", format=fmt)
+        raise InvalidInertiaError(
+            f"{who}the mass {body.mass!r} kg is not positive; simulators refuse such a body", reason="mass", format=fmt
+        )
     if body.linear or i3 <= 0:
         raise InvalidInertiaError(
             f"{who}the body is a linear rotator or a single point (smallest principal moment {i1:.3g} kg m^2 is zero); "
             "a simulator needs three positive moments: give the body some thickness",
-            reason="zero_moment", format=fmt, moments=body.moments.tolist())
+            reason="zero_moment",
+            format=fmt,
+            moments=body.moments.tolist(),
+        )
     # relative_error bounds each moment's error relative to itself: below 1, a positive moment is positive
     if not (i1 > 0 and body.relative_error < 1):
         raise InvalidInertiaError(
             f"{who}the smallest principal moment ({i1:.3g} kg m^2) is not positive within its error (largest {i3:.3g}); "
             "a simulator needs three positive moments: give the body some thickness",
-            reason="zero_moment", format=fmt, moments=body.moments.tolist())
+            reason="zero_moment",
+            format=fmt,
+            moments=body.moments.tolist(),
+        )
     if fmt in ("mjcf", "urdf") and (body.mass < MJ_MINVAL or i1 < MJ_MINVAL):
         raise InvalidInertiaError(
             f"{who}MuJoCo refuses a moving body whose mass or principal moment is below mjMINVAL = 1e-15 "
             f"(here mass {body.mass:.3g} kg, smallest moment {i1:.3g} kg m^2); scale the model up or use sdf",
-            reason="below_mjminval", format=fmt, mass=body.mass, moments=body.moments.tolist())
+            reason="below_mjminval",
+            format=fmt,
+            mass=body.mass,
+            moments=body.moments.tolist(),
+        )
 
 
 def _triangle(body: Inertial, margin: float, name: str) -> tuple[NDArray[np.float64], NDArray[np.float64], tuple[str, ...]]:
@@ -134,16 +144,20 @@ def _triangle(body: Inertial, margin: float, name: str) -> tuple[NDArray[np.floa
     if shortfall > max(body.relative_error, 0.0) + 2 * margin + 8 * EPS:
         raise InvalidInertiaError(
             f"{name + ': ' if name else ''}the principal moments {i1:.6g}, {i2:.6g}, {i3:.6g} kg m^2 break the triangle "
-            "inequality I1 + I2 >= I3, which simulators enforce", reason="triangle_inequality",
-            moments=moments.tolist())
+            "inequality I1 + I2 >= I3, which simulators enforce",
+            reason="triangle_inequality",
+            moments=moments.tolist(),
+        )
     moments[2] = target
     while moments[0] + moments[1] < moments[2]:  # the sum may round below the target
         moments[2] = np.nextafter(moments[2], 0.0)
     axis = body.axes[2]
     tensor = np.array(body.tensor) - (i3 - float(moments[2])) * np.outer(axis, axis)
     tensor = 0.5 * (tensor + tensor.T)
-    warning = (f"export: {name + ' ' if name else ''}planar body (I1 + I2 = I3): the largest principal moment "
-               f"was lowered by {shortfall:.2g} relative so that simulators' check I1 + I2 >= I3 holds after rounding")
+    warning = (
+        f"export: {name + ' ' if name else ''}planar body (I1 + I2 = I3): the largest principal moment "
+        f"was lowered by {shortfall:.2g} relative so that simulators' check I1 + I2 >= I3 holds after rounding"
+    )
     return moments, tensor, (warning,)
 
 
@@ -156,17 +170,28 @@ def inertial_snippet(fmt: str, body: Inertial, name: str = "") -> Snippet:
     moments, tensor, warnings = _triangle(body, 0.0 if fmt == "mjcf" else PLANAR_MARGIN, name)
     c = body.center_of_mass
     if fmt == "mjcf":
-        text = (f'<inertial pos="{_nums(c)}" quat="{_nums(body.quaternion)}" mass="{_num(body.mass)}" '
-                f'diaginertia="{_nums(moments)}"/>')
+        text = (
+            f'<inertial pos="{_nums(c)}" quat="{_nums(body.quaternion)}" mass="{_num(body.mass)}" diaginertia="{_nums(moments)}"/>'
+        )
         return Snippet(fmt, text, warnings)
-    t = {"ixx": tensor[0, 0], "ixy": tensor[0, 1], "ixz": tensor[0, 2],
-         "iyy": tensor[1, 1], "iyz": tensor[1, 2], "izz": tensor[2, 2]}
+    t = {
+        "ixx": tensor[0, 0],
+        "ixy": tensor[0, 1],
+        "ixz": tensor[0, 2],
+        "iyy": tensor[1, 1],
+        "iyz": tensor[1, 2],
+        "izz": tensor[2, 2],
+    }
     if fmt == "urdf":
         components = " ".join(f'{k}="{_num(v)}"' for k, v in t.items())
-        text = (f'<inertial>\n  <origin xyz="{_nums(c)}" rpy="0 0 0"/>\n  <mass value="{_num(body.mass)}"/>\n'
-                f'  <inertia {components}/>\n</inertial>')
+        text = (
+            f'<inertial>\n  <origin xyz="{_nums(c)}" rpy="0 0 0"/>\n  <mass value="{_num(body.mass)}"/>\n'
+            f"  <inertia {components}/>\n</inertial>"
+        )
         return Snippet(fmt, text, warnings)
     components = "".join(f"\n    <{k}>{_num(v)}</{k}>" for k, v in t.items())
-    text = (f"<inertial>\n  <pose>{_nums(c)} 0 0 0</pose>\n  <mass>{_num(body.mass)}</mass>\n"
-            f"  <inertia>{components}\n  </inertia>\n</inertial>")
+    text = (
+        f"<inertial>\n  <pose>{_nums(c)} 0 0 0</pose>\n  <mass>{_num(body.mass)}</mass>\n"
+        f"  <inertia>{components}\n  </inertia>\n</inertial>"
+    )
     return Snippet(fmt, text, warnings)

@@ -60,8 +60,8 @@ def frame_rotation(quaternion: Sequence[float]) -> tuple[NDArray[np.float64], ND
     norm = math.sqrt(math.fsum(float(v) * float(v) for v in q))
     if abs(norm - 1.0) > UNIT_QUATERNION_TOLERANCE:
         raise InvalidParameterError(
-            f"frame must be a unit quaternion w,x,y,z (its norm is {norm:.9g}); scalar first, e.g. 1,0,0,0",
-            parameter="frame")
+            f"frame must be a unit quaternion w,x,y,z (its norm is {norm:.9g}); scalar first, e.g. 1,0,0,0", parameter="frame"
+        )
     q = q / norm
     return q, matrix_from_quaternion(q)
 

@@ -25,7 +25,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ["Sums", "simplex_sums", "point_sums", "local_origin", "CHUNK"]
+__all__ = ["Sums", "simplex_sums", "point_sums", "local_origin", "CHUNK", "point_records", "gather_corners"]
 
 CHUNK = 1 << 15  # elements per vectorised block: its (n,) temporaries (256 KB each) stay in cache
 
@@ -69,9 +69,11 @@ def _cross(u: Vec, v: Vec) -> Vec:
 
 def _det_condition(a: Vec, u: Vec, v: Vec) -> NDArray[np.float64]:
     """sum over permutations of |a_i u_j v_k|: the rounding of a . (u x v) is a few eps times this."""
-    cond: NDArray[np.float64] = (np.abs(a[0]) * (np.abs(u[1] * v[2]) + np.abs(u[2] * v[1]))
-            + np.abs(a[1]) * (np.abs(u[2] * v[0]) + np.abs(u[0] * v[2]))
-            + np.abs(a[2]) * (np.abs(u[0] * v[1]) + np.abs(u[1] * v[0])))
+    cond: NDArray[np.float64] = (
+        np.abs(a[0]) * (np.abs(u[1] * v[2]) + np.abs(u[2] * v[1]))
+        + np.abs(a[1]) * (np.abs(u[2] * v[0]) + np.abs(u[0] * v[2]))
+        + np.abs(a[2]) * (np.abs(u[0] * v[1]) + np.abs(u[1] * v[0]))
+    )
     return cond
 
 
@@ -98,15 +100,32 @@ def _measure(corners: list[Vec], kind: str) -> tuple[NDArray[np.float64], NDArra
     return twice_area, twice_area
 
 
-def _block_sums(xyz: Vec, cells: NDArray[np.int64], kind: str,
-                weight: NDArray[np.float64] | None) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+def point_records(points: NDArray[np.float64]) -> NDArray[np.void]:
+    """The rows of an (n, 3) float64 array as n opaque 24-byte records, for ``gather_corners``."""
+    return np.ascontiguousarray(points, dtype=np.float64).view(np.dtype((np.void, 24))).reshape(-1)
+
+
+def gather_corners(records: NDArray[np.void], cells: NDArray[np.int64]) -> list[Vec]:
+    """corners[k][j]: coordinate j of corner k of each cell, each a contiguous (n,) row.
+
+    Each corner is gathered once as one 24-byte record (one random access per
+    corner instead of three), then the coordinates are split into rows.
+    """
+    block = records.take(cells).view(np.float64).reshape(len(cells), cells.shape[1], 3)
+    rows = block.transpose(1, 2, 0).copy()  # (corners, 3, n)
+    return [list(rows[k]) for k in range(cells.shape[1])]
+
+
+def _block_sums(
+    xyz: NDArray[np.void], cells: NDArray[np.int64], kind: str, weight: NDArray[np.float64] | None
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """Sums over one block of simplices of every row, and of their absolute values.
 
     Struct of arrays: each quantity is a contiguous (n,) row of one (10, n)
     array of terms, summed row by row (numpy's pairwise summation along each
     contiguous row, the same as summing each row alone) in one call.
     """
-    corners = [[x.take(cells[:, k]) for x in xyz] for k in range(cells.shape[1])]
+    corners = gather_corners(xyz, cells)
     raw, cond = _measure(corners, kind)
     f0, f1, f2 = _FACTORS[kind]
     dm = raw * f0
@@ -135,7 +154,7 @@ def _block_sums(xyz: Vec, cells: NDArray[np.int64], kind: str,
     total[:_NOISE] = terms.sum(axis=1)
     total_abs[:_NOISE] = np.abs(terms, out=terms).sum(axis=1)
     total[_NOISE] = total_abs[_NOISE] = noise.sum()
-    total[_ERR:_ERR + 3] = total_abs[_ERR:_ERR + 3] = errs.sum(axis=1)
+    total[_ERR : _ERR + 3] = total_abs[_ERR : _ERR + 3] = errs.sum(axis=1)
     total[_MEASURE] = total_abs[_MEASURE] = (raw * f0).sum()
     return total, total_abs
 
@@ -148,7 +167,7 @@ def simplex_sums(
 ) -> Sums:
     """Integrals of the simplices ``points[cells]``: "apex" (faces of a closed
     surface, each with the origin), "tet" (volume cells) or "tri" (area)."""
-    xyz = [np.ascontiguousarray(points[:, k]) for k in range(3)]
+    xyz = point_records(points)
     starts = range(0, len(cells), CHUNK)
     per_block = np.empty((2, ROWS, len(starts)))
     for b, start in enumerate(starts):
@@ -164,8 +183,18 @@ def _sums_from_rows(total: NDArray[np.float64], total_abs: NDArray[np.float64], 
     for row, (i, j) in enumerate(_IJ, start=4):
         m2[i, j] = m2[j, i] = total[row]
         a2[i, j] = a2[j, i] = total_abs[row]
-    return Sums(float(total[0]), total[1:4].copy(), m2, float(total_abs[0]), a2, float(total[_NOISE]),
-                total[_ERR:_ERR + 3].copy(), float(total[_MEASURE]), n, blocks)
+    return Sums(
+        float(total[0]),
+        total[1:4].copy(),
+        m2,
+        float(total_abs[0]),
+        a2,
+        float(total[_NOISE]),
+        total[_ERR : _ERR + 3].copy(),
+        float(total[_MEASURE]),
+        n,
+        blocks,
+    )
 
 
 def point_sums(masses: NDArray[np.float64], x: NDArray[np.float64]) -> Sums:

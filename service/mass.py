@@ -31,20 +31,15 @@ from .conventions import DEFAULT_DENSITY
 from .ddouble import rotated
 from .eigen import jacobi_eigh
 from .errors import InsufficientPrecisionError, InvalidParameterError, ZeroVolumeError
-from .integrals import Sums, local_origin, point_sums, simplex_sums
+from .integrals import Sums, local_origin, point_records, point_sums, simplex_sums
 from .solid import closed_surface
 from .tolerances import DEFAULT_TOLERANCES, EPS, Tolerances
+from .vocabulary import MODELS, Model
 
 __all__ = ["InertiaTensor", "MassProperties", "mass_properties", "assembly_properties", "Model", "parallel_axis"]
 
 MAX_PASSES = 4  # one coarse pass plus refinements; the frame settles in 2-3
 FRAME_SETTLED = 1e-7  # off-diagonal / sqrt(diag product) below this: the next pass moves moments < 1e-14
-
-
-class Model:
-    SOLID = "solid"
-    SHELL = "shell"
-    ALL = (SOLID, SHELL)
 
 
 @dataclass(frozen=True, slots=True)
@@ -125,9 +120,15 @@ def _inertia_from_covariance(cov: NDArray[np.float64]) -> NDArray[np.float64]:
 class _Geometry:
     """Points + cells of one body in a form the passes can re-integrate."""
 
-    def __init__(self, points: NDArray[np.float64], cells: NDArray[np.int64], kind: str,
-                 weight: NDArray[np.float64] | None, coordinate_eps: float = 2.0**-53,
-                 blocks: tuple[QuadBlock, ...] = ()) -> None:
+    def __init__(
+        self,
+        points: NDArray[np.float64],
+        cells: NDArray[np.int64],
+        kind: str,
+        weight: NDArray[np.float64] | None,
+        coordinate_eps: float = 2.0**-53,
+        blocks: tuple[QuadBlock, ...] = (),
+    ) -> None:
         self.points, self.cells, self.kind, self.weight = points, cells, kind, weight
         self.coordinate_eps = coordinate_eps  # unit roundoff of the stored coordinates (float32: 2**-24)
         self.blocks = blocks  # volume cells other than linear tetrahedra: (type, nodes, weight), by quadrature
@@ -157,8 +158,9 @@ class _Geometry:
 QuadBlock = tuple[str, NDArray[np.int64], NDArray[np.float64] | None]
 
 
-def _volume_sums(x: NDArray[np.float64], tets: NDArray[np.int64], weight: NDArray[np.float64] | None,
-                 blocks: tuple[QuadBlock, ...]) -> Sums:
+def _volume_sums(
+    x: NDArray[np.float64], tets: NDArray[np.int64], weight: NDArray[np.float64] | None, blocks: tuple[QuadBlock, ...]
+) -> Sums:
     """Linear tetrahedra in closed form plus every other cell by its exact quadrature (``cells``)."""
     from .cells import cell_sums, combined
 
@@ -224,8 +226,9 @@ def _refine(geometry: _Geometry, tolerances: Tolerances) -> _Refined:
     return _Refined(s, com, tensor, values, rotation.T.copy(), estimate, warnings)
 
 
-def _physical_moments(geometry: _Geometry, values: NDArray[np.float64],
-                      errors: NDArray[np.float64]) -> tuple[NDArray[np.float64], tuple[str, ...]]:
+def _physical_moments(
+    geometry: _Geometry, values: NDArray[np.float64], errors: NDArray[np.float64]
+) -> tuple[NDArray[np.float64], tuple[str, ...]]:
     """No zero or negative moment of a solid, and no negative moment at all, comes back.
 
     Points on one line have a smallest moment that is zero up to rounding: it is
@@ -243,9 +246,11 @@ def _physical_moments(geometry: _Geometry, values: NDArray[np.float64],
             return values, ()
         if bool(np.all(low)):  # a single point, or all the mass at one place: every moment is zero
             return np.zeros(3), () if not np.any(values) else (
-                "all principal moments are zero within rounding (the mass is at one point) and are reported as 0",)
+                "all principal moments are zero within rounding (the mass is at one point) and are reported as 0",
+            )
         return np.where(low, 0.0, values), (
-            "the smallest principal moment is zero within rounding (the points lie on a line) and is reported as 0",)
+            "the smallest principal moment is zero within rounding (the points lie on a line) and is reported as 0",
+        )
     order = np.sort(values)
     slack = float(errors.sum())
     if np.any(low) or order[0] + order[1] < order[2] - slack:
@@ -253,7 +258,8 @@ def _physical_moments(geometry: _Geometry, values: NDArray[np.float64],
             "the stored polyhedron integrates to principal moments no body has (zero, negative, or "
             f"I1 + I2 < I3: {', '.join(f'{x:.6g}' for x in order)} in the file's units): its faces cross "
             "or its shells are degenerate; repair the mesh or export it nearer the origin in float64",
-            moments=[float(x) for x in order])
+            moments=[float(x) for x in order],
+        )
     return values, ()
 
 
@@ -265,8 +271,9 @@ _RESOLUTION_WARN = 1e-3
 but it may differ that much from the part it was exported from."""
 
 
-def _check_resolution(geometry: _Geometry, s: Sums, com: NDArray[np.float64], rotation: NDArray[np.float64],
-                      values: NDArray[np.float64]) -> tuple[str, ...]:
+def _check_resolution(
+    geometry: _Geometry, s: Sums, com: NDArray[np.float64], rotation: NDArray[np.float64], values: NDArray[np.float64]
+) -> tuple[str, ...]:
     """Refuse a closed surface its stored coordinates cannot represent; warn when they barely do.
 
     Each stored coordinate x is the exporter's value to within delta = u |x|max
@@ -279,9 +286,10 @@ def _check_resolution(geometry: _Geometry, s: Sums, com: NDArray[np.float64], ro
     x = geometry.points
     delta = geometry.coordinate_eps * float(np.abs(x).max())
     y = x - com
+    records = point_records(y)  # one gather of 24 bytes per corner, not numpy's slower 2-D fancy indexing
     area = 0.0
     for start in range(0, len(geometry.cells), 1 << 16):
-        tri = y[geometry.cells[start : start + (1 << 16)]]
+        tri = records.take(geometry.cells[start : start + (1 << 16)]).view(np.float64).reshape(-1, 3, 3)
         area += 0.5 * float(np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]), axis=1).sum())
     weight = 1.0 if geometry.weight is None else float(np.max(geometry.weight))
     moved = math.sqrt(3.0) * delta * area  # volume the resolution can move
@@ -295,19 +303,29 @@ def _check_resolution(geometry: _Geometry, s: Sums, com: NDArray[np.float64], ro
     if not ratio >= _RESOLUTION_WARN:
         return ()
     float32 = geometry.coordinate_eps >= 2.0**-24
-    cause = (f"the file's float32 coordinates, {float(np.abs(x).max()):.3g} units from the origin, are resolved "
-             f"only to {delta:.3g} units" if float32 else
-             f"its coordinates are resolved only to {delta:.3g} units (degenerate shells, or a body thinner "
-             "than the rounding of its coordinates)")
+    cause = (
+        f"the file's float32 coordinates, {float(np.abs(x).max()):.3g} units from the origin, are resolved "
+        f"only to {delta:.3g} units"
+        if float32
+        else f"its coordinates are resolved only to {delta:.3g} units (degenerate shells, or a body thinner "
+        "than the rounding of its coordinates)"
+    )
     if ratio >= _RESOLUTION_REFUSE:
         raise InsufficientPrecisionError(
             f"the stored coordinates cannot represent this body: {cause}, which can change its volume or a "
             f"principal moment by {ratio:.3g} times its own value; "
-            + ("export it in float64 (e.g. OBJ, or ASCII STL with 9 digits) or nearer the origin"
-               if float32 else "repair the degenerate shells or export the part nearer the origin"),
-            resolution=delta, ratio=min(ratio, 1e300))
-    return (f"{cause}: the stored polyhedron is integrated exactly, but it may differ from the exported part by up "
-            f"to {ratio:.2g} of its volume or a principal moment; export in float64 or nearer the origin to avoid it",)
+            + (
+                "export it in float64 (e.g. OBJ, or ASCII STL with 9 digits) or nearer the origin"
+                if float32
+                else "repair the degenerate shells or export the part nearer the origin"
+            ),
+            resolution=delta,
+            ratio=min(ratio, 1e300),
+        )
+    return (
+        f"{cause}: the stored polyhedron is integrated exactly, but it may differ from the exported part by up "
+        f"to {ratio:.2g} of its volume or a principal moment; export in float64 or nearer the origin to avoid it",
+    )
 
 
 def _offdiagonal_ratio(t: NDArray[np.float64]) -> float:
@@ -373,8 +391,10 @@ def _tangled_warning(body: VolumeBody) -> tuple[str, ...]:
     count = sum(tangled_cells(body.points, b.type, b.nodes) for b in body.cells)
     if not count:
         return ()
-    return (f"{count} of {body.cell_count} cells fold over themselves (their Jacobian changes sign); "
-            "each was integrated with its signed Jacobian, so a folded region counts negatively: check the mesh",)
+    return (
+        f"{count} of {body.cell_count} cells fold over themselves (their Jacobian changes sign); "
+        "each was integrated with its signed Jacobian, so a folded region counts negatively: check the mesh",
+    )
 
 
 def mass_properties(
@@ -396,8 +416,14 @@ def mass_properties(
     _check_material(body, density, mass, model, thickness)
     geometry, warnings = _geometry(body, model, thickness, tolerances)
     refined = _refine(geometry, tolerances)
-    s, com, tensor, moments, axes, estimate = (refined.sums, refined.com, refined.tensor, refined.moments,
-                                               refined.axes, refined.estimate)
+    s, com, tensor, moments, axes, estimate = (
+        refined.sums,
+        refined.com,
+        refined.tensor,
+        refined.moments,
+        refined.axes,
+        refined.estimate,
+    )
     L = body.length_scale
     if isinstance(body, PointBody):
         measure_to_mass = 1.0 if mass is None else mass / s.m0
@@ -474,8 +500,9 @@ def assembly_properties(
     for body, density in parts:
         geometry, more = _geometry(body, model, thickness, tolerances)
         weights = _element_weights(geometry, density, model, thickness, L) * factor
-        geometry.blocks = tuple((name, nodes, _block_weights(w, len(nodes), density) * factor)
-                                for name, nodes, w in geometry.blocks)
+        geometry.blocks = tuple(
+            (name, nodes, _block_weights(w, len(nodes), density) * factor) for name, nodes, w in geometry.blocks
+        )
         geoms.append((geometry, weights))
         warnings.extend(more)
     kinds = {g.kind for g, _ in geoms}
@@ -492,8 +519,14 @@ def assembly_properties(
         tuple((name, nodes + off, w) for (g, _), off in zip(geoms, offsets) for name, nodes, w in g.blocks),
     )
     refined = _refine(whole, tolerances)
-    s, com, tensor, moments, axes, estimate = (refined.sums, refined.com, refined.tensor, refined.moments,
-                                               refined.axes, refined.estimate)
+    s, com, tensor, moments, axes, estimate = (
+        refined.sums,
+        refined.com,
+        refined.tensor,
+        refined.moments,
+        refined.axes,
+        refined.estimate,
+    )
     length_power = {"apex": 5, "tet": 5, "tri": 4, "points": 2}[kind]
     to_mass = L ** (length_power - 2)
     inertia_scale = L**length_power
@@ -509,8 +542,9 @@ def assembly_properties(
     )
 
 
-def _element_weights(geometry: _Geometry, density: float | None, model: str, thickness: float | None,
-                     L: float) -> NDArray[np.float64]:
+def _element_weights(
+    geometry: _Geometry, density: float | None, model: str, thickness: float | None, L: float
+) -> NDArray[np.float64]:
     """Mass per unit of each element's measure (file units): density, density x wall, or the masses."""
     n = len(geometry.points) if geometry.kind == "points" else len(geometry.cells)
     if geometry.weight is not None:  # cell densities or point masses
@@ -538,9 +572,8 @@ def _check_finite_results(mass: float, com: NDArray[np.float64], tensor: NDArray
         )
 
 
-
 def _check_material(body: Body, density: float | None, mass: float | None, model: str, thickness: float | None) -> None:
-    if model not in Model.ALL:
+    if model not in MODELS:
         raise InvalidParameterError(f"unknown model {model!r}; use 'solid' or 'shell'", parameter="model")
     if density is not None and mass is not None:
         raise InvalidParameterError("give either density or mass, not both", parameter="density")

@@ -12,12 +12,10 @@ from dataclasses import dataclass
 
 from .conventions import length_scale
 from .errors import InvalidParameterError
-from .mass import Model
 from .tolerances import DEFAULT_TOLERANCES
+from .vocabulary import METHODS, MODELS, Model, MotionMethod
 
 __all__ = ["AnalysisOptions", "METHODS"]
-
-METHODS = ("exact", "dop853", "rk45", "splitting")
 
 
 def _vector(name: str, value: Sequence[float] | None) -> tuple[float, float, float] | None:
@@ -58,7 +56,7 @@ class AnalysisOptions:
     omega: tuple[float, float, float] | None = None
     duration: float | None = None
     samples: int | None = None
-    method: str = "exact"
+    method: str = MotionMethod.EXACT.value
     densities: Mapping[str, float] | None = None
     geometry: str = "brep"
     deflection: float | None = None
@@ -74,7 +72,7 @@ class AnalysisOptions:
             _positive(name, getattr(self, name))
         if self.density is not None and self.mass is not None:
             raise InvalidParameterError("give either density or mass, not both", parameter="density")
-        if self.model not in Model.ALL:
+        if self.model not in MODELS:
             raise InvalidParameterError(f"model must be 'solid' or 'shell', got {self.model!r}", parameter="model")
         if not (isinstance(self.tolerance, (int, float)) and math.isfinite(self.tolerance) and 0 < self.tolerance < 1):
             raise InvalidParameterError("tolerance must be a number between 0 and 1 (relative)", parameter="tolerance")
@@ -101,14 +99,14 @@ def _check_v11(options: AnalysisOptions) -> None:
     from .frames import frame_rotation
 
     if options.export is not None and options.export not in EXPORT_FORMATS:
-        raise InvalidParameterError(f"export must be one of {', '.join(EXPORT_FORMATS)}, got {options.export!r}",
-                                    parameter="export")
+        raise InvalidParameterError(
+            f"export must be one of {', '.join(EXPORT_FORMATS)}, got {options.export!r}", parameter="export"
+        )
     if options.frame is not None:
         q, _ = frame_rotation(options.frame)
         object.__setattr__(options, "frame", tuple(float(v) for v in q))
     if options.isotopes not in ("standard", "abundant"):
-        raise InvalidParameterError(f"isotopes must be 'standard' or 'abundant', got {options.isotopes!r}",
-                                    parameter="isotopes")
+        raise InvalidParameterError(f"isotopes must be 'standard' or 'abundant', got {options.isotopes!r}", parameter="isotopes")
     if options.mass_unit not in ("kg", "u"):
         raise InvalidParameterError(f"mass_unit must be 'kg' or 'u', got {options.mass_unit!r}", parameter="mass_unit")
 
@@ -121,7 +119,8 @@ def _check_geometry(geometry: str, deflection: float | None) -> None:
         return
     _positive("deflection", deflection)
     if not deflection < 1:
-        raise InvalidParameterError("deflection is relative to the bounding-box diagonal: give a number below 1",
-                                    parameter="deflection")
+        raise InvalidParameterError(
+            "deflection is relative to the bounding-box diagonal: give a number below 1", parameter="deflection"
+        )
     if geometry != "mesh":
         raise InvalidParameterError("deflection applies to geometry=mesh", parameter="deflection")

@@ -35,8 +35,18 @@ if TYPE_CHECKING:
     from .export import Snippet
     from .motion import FreeMotion
 
-__all__ = ["AnalysisOptions", "AnalysisResult", "PartResult", "analyze", "analyze_points",
-           "analyze_loaded", "PrecessionResult", "precession", "METHODS"]
+__all__ = [
+    "AnalysisOptions",
+    "AnalysisResult",
+    "PartResult",
+    "analyze",
+    "analyze_points",
+    "analyze_loaded",
+    "PrecessionResult",
+    "precession",
+    "METHODS",
+]
+
 
 def analyze(
     source: bytes | str | os.PathLike[str] | Any,
@@ -53,8 +63,7 @@ def analyze(
     if isinstance(source, (bytearray, memoryview)):
         source = bytes(source)
     if isinstance(source, (bytes, str, os.PathLike)):
-        loaded = load_body(source, filename=filename, format=options.format, units=options.units,
-                           isotopes=options.isotopes)
+        loaded = load_body(source, filename=filename, format=options.format, units=options.units, isotopes=options.isotopes)
     else:
         loaded = _loaded_from_arrays(source, filename, options.units)
     return analyze_loaded(loaded, options, start)
@@ -71,7 +80,9 @@ def _loaded_from_arrays(source: Any, filename: str | None, units: str | None) ->
     else:
         raise InvalidParameterError(
             f"cannot analyse a {type(source).__name__}: give a file path, the file's bytes, a trimesh.Trimesh "
-            "or a (vertices, faces) pair of arrays", parameter="source")
+            "or a (vertices, faces) pair of arrays",
+            parameter="source",
+        )
     try:
         v = np.array(vertices, dtype=np.float64)
         f = np.array(faces)
@@ -158,19 +169,28 @@ def _tessellated_cad(loaded: Loaded, options: AnalysisOptions, start: float) -> 
     """geometry=mesh: the tessellation through the polyhedron pipeline, and its difference to the B-rep."""
     from .cad import DEFAULT_DEFLECTION, tessellated, tessellation_error
 
-    exact = analyze_loaded(loaded, replace(options, geometry="brep", deflection=None, reference=None, omega=None,
-                                           duration=None, samples=None))
+    exact = analyze_loaded(
+        loaded, replace(options, geometry="brep", deflection=None, reference=None, omega=None, duration=None, samples=None)
+    )
     deflection = options.deflection or DEFAULT_DEFLECTION
     result = analyze_loaded(tessellated(loaded, deflection), replace(options, geometry="brep", deflection=None), start)
     source = replace(result.source, geometry="mesh", deflection=deflection)
-    diagnostics = replace(result.diagnostics, elapsed_s=time.perf_counter() - start,
-                          tessellation_error=tessellation_error(exact.props, result.props))
+    diagnostics = replace(
+        result.diagnostics, elapsed_s=time.perf_counter() - start, tessellation_error=tessellation_error(exact.props, result.props)
+    )
     return replace(result, source=source, diagnostics=diagnostics)
 
 
-def _v11_sections(loaded: Loaded, props: MassProperties, frame: PrincipalFrame, cls: Classification,
-                  reference: InertiaTensor | None, parts: tuple[PartResult, ...] | None,
-                  options: AnalysisOptions, warnings: list[str]) -> dict[str, Any]:
+def _v11_sections(
+    loaded: Loaded,
+    props: MassProperties,
+    frame: PrincipalFrame,
+    cls: Classification,
+    reference: InertiaTensor | None,
+    parts: tuple[PartResult, ...] | None,
+    options: AnalysisOptions,
+    warnings: list[str],
+) -> dict[str, Any]:
     """surface_area, rotational_constants, frame and export (API.md 1.1), each only when it applies."""
     from .surface import part_surface_area
 
@@ -189,16 +209,21 @@ def _v11_sections(loaded: Loaded, props: MassProperties, frame: PrincipalFrame, 
         from .frames import named_frame
 
         out["named_frame"] = named_frame(
-            options.frame, props.center_of_mass, props.inertia.matrix,
-            None if reference is None else reference.point, None if reference is None else reference.matrix)
+            options.frame,
+            props.center_of_mass,
+            props.inertia.matrix,
+            None if reference is None else reference.point,
+            None if reference is None else reference.matrix,
+        )
     if options.export is not None:
         out["export"] = _export(options.export, props, frame, cls, "")
         warnings.extend(out["export"].warnings)
     if parts is not None:
         new_parts = []
         for part, area in zip(parts, areas):
-            snippet = None if options.export is None else _export(options.export, part.props, part.frame,
-                                                                  part.classification, part.name)
+            snippet = (
+                None if options.export is None else _export(options.export, part.props, part.frame, part.classification, part.name)
+            )
             if snippet is not None:
                 warnings.extend(snippet.warnings)
             new_parts.append(replace(part, surface_area=area, export=snippet))
@@ -210,9 +235,16 @@ def _export(fmt: str, props: MassProperties, frame: PrincipalFrame, cls: Classif
     from .classification import RotorClass
     from .export import Inertial, inertial_snippet
 
-    body = Inertial(props.mass, props.center_of_mass, props.inertia.matrix, frame.moments, frame.axes,
-                    frame.quaternion, linear=cls.rotor == RotorClass.LINEAR,
-                    relative_error=props.relative_error_estimate)
+    body = Inertial(
+        props.mass,
+        props.center_of_mass,
+        props.inertia.matrix,
+        frame.moments,
+        frame.axes,
+        frame.quaternion,
+        linear=cls.rotor == RotorClass.LINEAR,
+        relative_error=props.relative_error_estimate,
+    )
     return inertial_snippet(fmt, body, name)
 
 
@@ -225,8 +257,11 @@ def _check_part_names(loaded: Loaded, options: AnalysisOptions) -> None:
     if unknown:
         listed = ", ".join(repr(n) for n in names[:20]) + (" ..." if len(names) > 20 else "")
         raise InvalidParameterError(
-            f"densities names {', '.join(repr(n) for n in unknown)}, which is not a part of this file; "
-            f"its parts are: {listed}", parameter="densities", unknown=unknown, parts=names[:100])
+            f"densities names {', '.join(repr(n) for n in unknown)}, which is not a part of this file; its parts are: {listed}",
+            parameter="densities",
+            unknown=unknown,
+            parts=names[:100],
+        )
 
 
 def _extent(body: Any) -> NDArray[np.float64] | None:
@@ -250,9 +285,11 @@ def _unit_warning(loaded: Loaded) -> list[str]:
     diagonal = float(np.linalg.norm(np.max(sizes, axis=0)))
     if diagonal <= DEFAULT_TOLERANCES.metres_plausible:
         return []
-    return [f"the file declares no length unit and none was given, so it was read in metres: the part is "
-            f"{diagonal:.4g} m across; if it was drawn in millimetres, pass units=mm (CLI: --units mm), "
-            f"which divides the mass by 1e9"]
+    return [
+        f"the file declares no length unit and none was given, so it was read in metres: the part is "
+        f"{diagonal:.4g} m across; if it was drawn in millimetres, pass units=mm (CLI: --units mm), "
+        f"which divides the mass by 1e9"
+    ]
 
 
 def _shell_thickness_warning(loaded: Loaded, options: AnalysisOptions) -> list[str]:
@@ -271,10 +308,16 @@ def _shell_thickness_warning(loaded: Loaded, options: AnalysisOptions) -> list[s
             raise InvalidParameterError(
                 f"thickness {thickness:.4g} m is {ratio:.3g} times the part's size{where} ({size:.4g} m across): "
                 f"a thin shell needs a wall much thinner than the part; check thickness and units, or analyse "
-                f"it as a solid", parameter="thickness", thickness_m=thickness, size_m=size)
+                f"it as a solid",
+                parameter="thickness",
+                thickness_m=thickness,
+                size_m=size,
+            )
         if ratio >= DEFAULT_TOLERANCES.shell_thickness_warn:
-            out.append(f"thickness {thickness:.4g} m is {100 * ratio:.2g}% of the part's size{where}: the thin-shell "
-                       f"model (mass = area x thickness x density) is only approximate for so thick a wall")
+            out.append(
+                f"thickness {thickness:.4g} m is {100 * ratio:.2g}% of the part's size{where}: the thin-shell "
+                f"model (mass = area x thickness x density) is only approximate for so thick a wall"
+            )
     return out
 
 
@@ -294,8 +337,9 @@ def _part(name: str, body: Any, options: AnalysisOptions, single: bool) -> PartR
 
         props = brep_mass_properties(body, density=None if mass is not None else density, mass=mass, model=options.model)
     else:
-        props = mass_properties(body, density=None if mass is not None else density, mass=mass,
-                                model=options.model, thickness=options.thickness)
+        props = mass_properties(
+            body, density=None if mass is not None else density, mass=mass, model=options.model, thickness=options.thickness
+        )
     frame = principal_frame(props, options.tolerance)
     return PartResult(name, props, frame, classify(frame))
 
@@ -314,15 +358,13 @@ def _scaled(part: PartResult, factor: float) -> PartResult:
     return PartResult(part.name, props, frame, classify(frame))
 
 
-def _combined(loaded: Loaded, parts: Sequence[PartResult], options: AnalysisOptions,
-              factor: float) -> MassProperties:
+def _combined(loaded: Loaded, parts: Sequence[PartResult], options: AnalysisOptions, factor: float) -> MassProperties:
     """The whole assembly, integrated as one body with each part's material."""
     if loaded.kind == "cad" and isinstance(loaded.parts[0].body, BrepBody):
         from .cad import combined_properties
 
         return combined_properties([p.props for p in parts])
-    pairs = [(part.body, _part_density(part.name, options)) for part in loaded.parts
-             if not isinstance(part.body, BrepBody)]
+    pairs = [(part.body, _part_density(part.name, options)) for part in loaded.parts if not isinstance(part.body, BrepBody)]
     whole = assembly_properties(pairs, model=options.model, thickness=options.thickness, factor=factor)
     volumes = [p.props.volume for p in parts]
     densities = {p.props.density for p in parts}
@@ -339,7 +381,11 @@ def _motion(frame: PrincipalFrame, cls: Classification, options: AnalysisOptions
     from .motion import predict_motion
 
     return predict_motion(
-        frame, cls, np.asarray(options.omega, dtype=np.float64), duration=options.duration, samples=options.samples,
+        frame,
+        cls,
+        np.asarray(options.omega, dtype=np.float64),
+        duration=options.duration,
+        samples=options.samples,
         method=options.method,
     )
 
@@ -348,8 +394,7 @@ def _source(loaded: Loaded, parts: Sequence[PartResult]) -> Source:
     """The ``source`` section: what was read, and how many elements it had."""
     from .body import MeshBody, PointBody, VolumeBody
 
-    out: dict[str, Any] = {"format": loaded.format, "kind": loaded.kind,
-                           "units": loaded.units, "units_from": loaded.units_from}
+    out: dict[str, Any] = {"format": loaded.format, "kind": loaded.kind, "units": loaded.units, "units_from": loaded.units_from}
     if loaded.filename is not None:
         out = {"filename": loaded.filename, **out}
     bodies = [p.body for p in loaded.parts]
@@ -401,8 +446,13 @@ def precession(
 ) -> PrecessionResult:
     """Torque-free motion from a known inertia (tensor about the COM, or principal moments)."""
     start = time.perf_counter()
-    options = AnalysisOptions(tolerance=tolerance, omega=tuple(omega) if omega is not None else None,  # type: ignore[arg-type]
-                              duration=duration, samples=samples, method=method)
+    options = AnalysisOptions(
+        tolerance=tolerance,
+        omega=tuple(omega) if omega is not None else None,  # type: ignore[arg-type]
+        duration=duration,
+        samples=samples,
+        method=method,
+    )
     if options.omega is None:
         raise InvalidParameterError("omega is required", parameter="omega")
     if (inertia_tensor is None) == (principal_moments is None):
@@ -427,5 +477,4 @@ def precession(
     cls = classify(frame)
     motion = _motion(frame, cls, options)
     warnings = tuple(dict.fromkeys((*notes, *motion.warnings)))
-    return PrecessionResult(frame, cls, motion, Diagnostics(time.perf_counter() - start, max(estimate, 8 * EPS)),
-                            warnings)
+    return PrecessionResult(frame, cls, motion, Diagnostics(time.perf_counter() - start, max(estimate, 8 * EPS)), warnings)

@@ -21,8 +21,7 @@ from .tolerances import DEFAULT_TOLERANCES, EPS
 if TYPE_CHECKING:
     from .mass import MassProperties
 
-__all__ = ["PrincipalFrame", "principal_frame", "equal_moment_pairs", "TensorFrame", "tensor_frame",
-           "TENSOR_ERROR_FACTOR"]
+__all__ = ["PrincipalFrame", "principal_frame", "equal_moment_pairs", "TensorFrame", "tensor_frame", "TENSOR_ERROR_FACTOR"]
 
 TENSOR_ERROR_FACTOR = 17 * EPS
 """Absolute error of every eigenvalue of a given 3x3 tensor, times its Frobenius norm.
@@ -106,9 +105,7 @@ def _check_physical(moments: NDArray[np.float64], tolerance: float, rounding: fl
             f"the tensor has a negative principal moment ({moments[0]:.6g} kg m^2); it is not an inertia tensor"
         )
     if moments[0] + moments[1] < moments[2] * (1 - tolerance):
-        raise InvalidParameterError(
-            "principal moments break the triangle inequality I1 + I2 >= I3; no body has this tensor"
-        )
+        raise InvalidParameterError("principal moments break the triangle inequality I1 + I2 >= I3; no body has this tensor")
 
 
 @dataclass(frozen=True, slots=True)
@@ -145,8 +142,9 @@ def tensor_frame(tensor: NDArray[np.float64], tolerance: float = DEFAULT_TOLERAN
         raise InvalidParameterError("the inertia tensor must be a finite 3x3 matrix")
     scale = float(np.sqrt(np.sum((matrix / max(float(np.abs(matrix).max()), 1e-300)) ** 2))) * float(np.abs(matrix).max())
     if not np.isfinite(scale):
-        raise InvalidParameterError("the inertia tensor's entries are too large to compute with in float64; "
-                                    "express it in other units")
+        raise InvalidParameterError(
+            "the inertia tensor's entries are too large to compute with in float64; express it in other units"
+        )
     bound = TENSOR_ERROR_FACTOR * scale
     frame = PrincipalFrame.from_tensor(matrix, tolerance, rounding=bound)
     moments = frame.moments
@@ -158,8 +156,7 @@ def tensor_frame(tensor: NDArray[np.float64], tolerance: float = DEFAULT_TOLERAN
             f"(|I| <= {bound:.3g} kg m^2) and are reported as 0"
         )
         clamped = np.where(zero, 0.0, moments)
-        frame = PrincipalFrame(clamped, frame.axes, frame.quaternion,
-                               not equal_moment_pairs(clamped, tolerance), tolerance)
+        frame = PrincipalFrame(clamped, frame.axes, frame.quaternion, not equal_moment_pairs(clamped, tolerance), tolerance)
     errors = np.full(3, bound)
     live = ~zero
     relative = float(np.max(bound / frame.moments[live])) if np.any(live) else 1.0

@@ -30,12 +30,20 @@ if TYPE_CHECKING:
     from .rotational import RotationalConstants
 
 __all__ = [
-    "Source", "Diagnostics", "PartResult", "AnalysisResult", "PrecessionResult",
-    "analysis_dict", "precession_dict", "principal_dict", "classification_dict", "radii_of_gyration",
+    "Source",
+    "Diagnostics",
+    "PartResult",
+    "AnalysisResult",
+    "PrecessionResult",
+    "analysis_dict",
+    "precession_dict",
+    "principal_dict",
+    "classification_dict",
+    "radii_of_gyration",
 ]
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, kw_only=True)
 class Source:
     """The ``source`` section: what was read, how, and how many elements it had.
 
@@ -49,27 +57,51 @@ class Source:
     parts : the number of parts of a scene or assembly (absent for one body).
     """
 
+    filename: str | None = None
     format: str
     kind: str
     units: str
     units_from: str
-    filename: str | None = None
-    geometry: str | None = None
-    solids: int | None = None
-    deflection: float | None = None
     vertices: int | None = None
     triangles: int | None = None
     watertight: bool | None = None
     points: int | None = None
     tetrahedra: int | None = None
     cells: int | None = None
+    geometry: str | None = None
+    solids: int | None = None
+    deflection: float | None = None
     parts: int | None = None
 
     # the order of the keys in the JSON: the identity, then what the kind of input counts
-    _ORDER = ("filename", "format", "kind", "units", "units_from", "vertices", "triangles", "watertight",
-              "points", "tetrahedra", "cells", "parts")
-    _CAD_ORDER = ("filename", "format", "kind", "units", "units_from", "geometry", "solids", "watertight",
-                  "deflection", "vertices", "triangles", "parts")
+    _ORDER = (
+        "filename",
+        "format",
+        "kind",
+        "units",
+        "units_from",
+        "vertices",
+        "triangles",
+        "watertight",
+        "points",
+        "tetrahedra",
+        "cells",
+        "parts",
+    )
+    _CAD_ORDER = (
+        "filename",
+        "format",
+        "kind",
+        "units",
+        "units_from",
+        "geometry",
+        "solids",
+        "watertight",
+        "deflection",
+        "vertices",
+        "triangles",
+        "parts",
+    )
 
     def as_dict(self) -> dict[str, Any]:
         order = self._CAD_ORDER if self.kind == "cad" else self._ORDER
@@ -95,8 +127,7 @@ class Diagnostics:
     tessellation_error: float | None = None
 
     def as_dict(self) -> dict[str, Any]:
-        out: dict[str, Any] = {"elapsed_s": float(self.elapsed_s),
-                               "relative_error_estimate": float(self.relative_error_estimate)}
+        out: dict[str, Any] = {"elapsed_s": float(self.elapsed_s), "relative_error_estimate": float(self.relative_error_estimate)}
         if self.tessellation_error is not None:
             out["tessellation_error"] = float(self.tessellation_error)
         return out
@@ -248,8 +279,9 @@ def analysis_dict(result: AnalysisResult) -> dict[str, Any]:
     if result.parts is not None:
         out["parts"] = [_part_dict(part) for part in result.parts]
         if result.export is not None:
-            out["export"]["parts"] = [{"name": part.name, "text": part.export.text}
-                                      for part in result.parts if part.export is not None]
+            out["export"]["parts"] = [
+                {"name": part.name, "text": part.export.text} for part in result.parts if part.export is not None
+            ]
     out["warnings"] = list(result.warnings)
     out["diagnostics"] = result.diagnostics.as_dict()
     return out
@@ -263,8 +295,11 @@ def _v11_dict(result: AnalysisResult) -> dict[str, Any]:
         out["rotational_constants"] = {"MHz": list(rc.mhz), "cm-1": list(rc.wavenumber)}
     nf = result.named_frame
     if nf is not None:
-        out["frame"] = {"quaternion": _list(nf.quaternion), "center_of_mass": _list(nf.center_of_mass),
-                        "inertia_tensor": _list(nf.inertia_tensor)}
+        out["frame"] = {
+            "quaternion": _list(nf.quaternion),
+            "center_of_mass": _list(nf.center_of_mass),
+            "inertia_tensor": _list(nf.inertia_tensor),
+        }
         if nf.reference_inertia is not None:
             out["frame"]["reference_inertia"] = _list(nf.reference_inertia)
     if result.export is not None:

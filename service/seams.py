@@ -50,9 +50,11 @@ class SeamMerge:
     refused: int
 
     def warning(self) -> str:
-        text = (f"{self.merged} seam vertices merged onto a neighbour closer than {self.tolerance:.3g} "
-                f"(1e-12 of the part's size; largest gap {self.largest_gap:.3g} file units); "
-                "the results are exact for the merged surface")
+        text = (
+            f"{self.merged} seam vertices merged onto a neighbour closer than {self.tolerance:.3g} "
+            f"(1e-12 of the part's size; largest gap {self.largest_gap:.3g} file units); "
+            "the results are exact for the merged surface"
+        )
         if self.refused:
             text += f"; {self.refused} closer groups were left apart because merging them would collapse a triangle"
         return text
@@ -97,8 +99,7 @@ def close_pairs(points: NDArray[np.float64], tol: float) -> NDArray[np.int64]:
     return np.sort(pairs, axis=1)
 
 
-def merge_seams(vertices: NDArray[np.float64], faces: NDArray[np.int64],
-                tolerances: Tolerances = DEFAULT_TOLERANCES) -> SeamMerge:
+def merge_seams(vertices: NDArray[np.float64], faces: NDArray[np.int64], tolerances: Tolerances = DEFAULT_TOLERANCES) -> SeamMerge:
     """Merge the vertices of open edges that are closer than the seam tolerance.
 
     ``vertices`` must already be bit-exactly welded (distinct rows) and
@@ -150,8 +151,9 @@ def _welded_faces(vertices: NDArray[np.float64], faces: NDArray[np.int64]) -> tu
     return vertices, faces[good]
 
 
-def _closed_after_seams(vertices: NDArray[np.float64], faces: NDArray[np.int64],
-                        tolerances: Tolerances) -> tuple[bool, NDArray[np.int64]]:
+def _closed_after_seams(
+    vertices: NDArray[np.float64], faces: NDArray[np.int64], tolerances: Tolerances
+) -> tuple[bool, NDArray[np.int64]]:
     topo = surface_topology(faces, len(vertices))
     if topo.open_edges:
         faces = merge_seams(vertices, faces, tolerances).faces
@@ -218,15 +220,24 @@ def join_open_parts(parts: list[Part], tolerances: Tolerances = DEFAULT_TOLERANC
         names = [parts[open_ids[m]].name for m in members]
         name = "+".join(names) if len(names) <= 4 else f"{names[0]}+{len(names) - 1} more"
         listed = ", ".join(repr(n) for n in names[:8]) + (f" and {len(names) - 8} more" if len(names) > 8 else "")
-        note = (f"{len(names)} parts ({listed}) are open each but close together; "
-                f"analysed as one body {name!r} (an open part bounds no volume of its own)")
+        note = (
+            f"{len(names)} parts ({listed}) are open each but close together; "
+            f"analysed as one body {name!r} (an open part bounds no volume of its own)"
+        )
         member_bodies = [bodies[m] for m in members]
         body = MeshBody(
             np.concatenate([b.vertices for b in member_bodies if isinstance(b, MeshBody)]),
-            np.concatenate([b.faces + off for b, off in zip(
-                member_bodies, np.cumsum([0, *[len(b.vertices) for b in member_bodies if isinstance(b, MeshBody)][:-1]]))
-                if isinstance(b, MeshBody)]),
-            scales.copy().pop(), name,
+            np.concatenate(
+                [
+                    b.faces + off
+                    for b, off in zip(
+                        member_bodies, np.cumsum([0, *[len(b.vertices) for b in member_bodies if isinstance(b, MeshBody)][:-1]])
+                    )
+                    if isinstance(b, MeshBody)
+                ]
+            ),
+            scales.copy().pop(),
+            name,
             (*(w for b in member_bodies for w in b.warnings), note),
         )
         joined[open_ids[members[0]]] = Part(name, body)

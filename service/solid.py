@@ -24,7 +24,7 @@ from numpy.typing import NDArray
 
 from .body import MeshBody
 from .errors import NotWatertightError, ZeroVolumeError
-from .integrals import CHUNK, local_origin
+from .integrals import CHUNK, gather_corners, local_origin, point_records
 from .seams import merge_seams
 from .tolerances import EPS
 from .topology import SurfaceTopology, face_components, orient_consistently, surface_topology, weld
@@ -39,8 +39,11 @@ def closed_surface(body: MeshBody) -> tuple[NDArray[np.float64], NDArray[np.int6
     if np.any(degenerate):
         faces = faces[~degenerate]  # zero-area faces contribute nothing to any integral
     if len(faces) == 0:
-        cause = ("; its float32 coordinates are too coarse at that distance from the origin: export it in float64 "
-                 "or nearer the origin") if body.coordinate_eps >= 2.0**-24 else ""
+        cause = (
+            ("; its float32 coordinates are too coarse at that distance from the origin: export it in float64 or nearer the origin")
+            if body.coordinate_eps >= 2.0**-24
+            else ""
+        )
         raise ZeroVolumeError(f"every triangle of the mesh is degenerate; the file holds no solid{cause}")
     topo = surface_topology(faces, len(vertices))
     warnings: list[str] = []
@@ -55,7 +58,8 @@ def closed_surface(body: MeshBody) -> tuple[NDArray[np.float64], NDArray[np.int6
         raise NotWatertightError(
             f"{named}is not watertight ({topo.open_edges} open edges), so it does not bound a solid; "
             "repair it, or analyse it as a thin surface with model=shell and a thickness",
-            open_edges=topo.open_edges, **({"part": body.name} if body.name else {}),
+            open_edges=topo.open_edges,
+            **({"part": body.name} if body.name else {}),
         )
     if not topo.closed:
         faces, flipped = orient_consistently(faces, topo)
@@ -78,13 +82,13 @@ def _signed_volumes(x: NDArray[np.float64], faces: NDArray[np.int64]) -> NDArray
     Formed one coordinate column at a time (contiguous arrays), about three
     times faster than ``np.cross`` on rows for the meshes of a part library.
     """
-    xs = [np.ascontiguousarray(x[:, k]) for k in range(3)]
+    records = point_records(x)
     det = np.empty(len(faces))
     for start in range(0, len(faces), CHUNK):
-        block = faces[start : start + CHUNK]
-        a, b, c = ([xk.take(block[:, j]) for xk in xs] for j in range(3))
-        det[start : start + CHUNK] = (a[0] * (b[1] * c[2] - b[2] * c[1]) + a[1] * (b[2] * c[0] - b[0] * c[2])
-                                      + a[2] * (b[0] * c[1] - b[1] * c[0]))
+        a, b, c = gather_corners(records, faces[start : start + CHUNK])
+        det[start : start + CHUNK] = (
+            a[0] * (b[1] * c[2] - b[2] * c[1]) + a[1] * (b[2] * c[0] - b[0] * c[2]) + a[2] * (b[0] * c[1] - b[1] * c[0])
+        )
     return det
 
 
@@ -109,8 +113,10 @@ def _orient_outward(
     if isinstance(depth, str):  # nesting undecidable: keep the file's orientation
         if total < 0 and np.all(vol <= 0):
             return faces[:, [0, 2, 1]], ["inverted winding corrected (all faces pointed inward)"]
-        return faces, [f"the {count} shells are kept as the file winds them ({depth}, so nesting was not tested); "
-                       f"{int(np.count_nonzero(vol < 0))} of them enclose negative volume (cavities)"]
+        return faces, [
+            f"the {count} shells are kept as the file winds them ({depth}, so nesting was not tested); "
+            f"{int(np.count_nonzero(vol < 0))} of them enclose negative volume (cavities)"
+        ]
     want_positive = depth % 2 == 0
     flip_shell = ((vol > 0) != want_positive) & ~flat
     if not np.any(flip_shell):
@@ -120,8 +126,10 @@ def _orient_outward(
     out[sel] = out[sel][:, [0, 2, 1]]
     if np.all(flip_shell | flat):
         return out, ["inverted winding corrected (all faces pointed inward)"]
-    return out, [f"winding corrected on {int(flip_shell.sum())} of {count} shells by their nesting "
-                 "(a shell inside an odd number of others is a cavity)"]
+    return out, [
+        f"winding corrected on {int(flip_shell.sum())} of {count} shells by their nesting "
+        "(a shell inside an odd number of others is a cavity)"
+    ]
 
 
 def winding_numbers(x: NDArray[np.float64], faces: NDArray[np.int64], points: NDArray[np.float64]) -> NDArray[np.float64]:
@@ -142,8 +150,12 @@ def winding_numbers(x: NDArray[np.float64], faces: NDArray[np.int64], points: ND
         a, b, c = (t[None, start : start + step, :] - points[:, None, :] for t in tri)
         la, lb, lc = (np.sqrt(np.einsum("pfi,pfi->pf", v, v)) for v in (a, b, c))
         num = np.einsum("pfi,pfi->pf", a, np.cross(b, c))
-        den = (la * lb * lc + np.einsum("pfi,pfi->pf", a, b) * lc + np.einsum("pfi,pfi->pf", a, c) * lb
-               + np.einsum("pfi,pfi->pf", b, c) * la)
+        den = (
+            la * lb * lc
+            + np.einsum("pfi,pfi->pf", a, b) * lc
+            + np.einsum("pfi,pfi->pf", a, c) * lb
+            + np.einsum("pfi,pfi->pf", b, c) * la
+        )
         out += np.arctan2(num, den).sum(axis=1)
         scale = la * lb * lc
         on = (np.abs(num) <= 1e-12 * scale) & (den <= 1e-12 * scale)  # in a triangle's plane and inside it
@@ -157,8 +169,9 @@ NESTING_WORK_LIMIT = 400_000_000
 with a warning rather than the request stalling (a part with many thousands of cavities inside a fine outer skin)."""
 
 
-def _nesting_depth(x: NDArray[np.float64], faces: NDArray[np.int64], label: NDArray[np.int64],
-                   count: int) -> NDArray[np.int64] | str:
+def _nesting_depth(
+    x: NDArray[np.float64], faces: NDArray[np.int64], label: NDArray[np.int64], count: int
+) -> NDArray[np.int64] | str:
     """How many other shells contain each shell, or why that cannot be decided.
 
     A shell's test point is the centroid of its largest triangle; only shells

@@ -46,8 +46,9 @@ def weld(vertices: NDArray[np.float64], faces: NDArray[np.int64]) -> tuple[NDArr
     return vertices[heads], ids[faces]
 
 
-def row_ids(rows: NDArray[np.unsignedinteger] | Sequence[NDArray[np.unsignedinteger]]
-            ) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
+def row_ids(
+    rows: NDArray[np.unsignedinteger] | Sequence[NDArray[np.unsignedinteger]],
+) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
     """Group equal rows of integers exactly.
 
     ``rows`` is an (n, k) array (preferred: each row is gathered as one
@@ -95,8 +96,7 @@ def row_ids(rows: NDArray[np.unsignedinteger] | Sequence[NDArray[np.unsignedinte
     return ids, heads
 
 
-def _row_table(rows: NDArray[np.unsignedinteger] | Sequence[NDArray[np.unsignedinteger]]
-               ) -> NDArray[np.unsignedinteger]:
+def _row_table(rows: NDArray[np.unsignedinteger] | Sequence[NDArray[np.unsignedinteger]]) -> NDArray[np.unsignedinteger]:
     """The rows as one C-contiguous (n, k) array (columns are stacked)."""
     if isinstance(rows, np.ndarray) and rows.ndim == 2:
         return np.ascontiguousarray(rows)
@@ -164,8 +164,9 @@ def _equal_neighbours(table: NDArray[np.unsignedinteger], order: NDArray[np.int6
     return same
 
 
-def _resolve_collisions(table: NDArray[np.unsignedinteger], order: NDArray[np.int64],
-                        same_hash: NDArray[np.bool_]) -> NDArray[np.int64]:
+def _resolve_collisions(
+    table: NDArray[np.unsignedinteger], order: NDArray[np.int64], same_hash: NDArray[np.bool_]
+) -> NDArray[np.int64]:
     """Re-sort the hash runs that hold distinct rows by (run, columns, index)."""
     run = np.cumsum(np.r_[True, ~same_hash])
     same = _equal_neighbours(table, order)

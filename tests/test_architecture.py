@@ -21,10 +21,22 @@ SOURCE = ROOT / "service"
 # package, the first entry that is a prefix of the module's name decides (``motion`` covers
 # ``motion.elliptic``); the most specific prefix wins.
 LAYERS: list[tuple[str, list[str]]] = [
-    ("kernels", [
-        "errors", "tolerances", "conventions", "arrays", "integrals", "eigen", "ddouble", "cpus",
-        "cells", "elements",
-    ]),
+    (
+        "kernels",
+        [
+            "errors",
+            "tolerances",
+            "conventions",
+            "arrays",
+            "integrals",
+            "eigen",
+            "ddouble",
+            "cpus",
+            "cells",
+            "elements",
+            "vocabulary",
+        ],
+    ),
     ("body", ["body"]),
     ("geometry", ["topology", "seams", "solid", "surface"]),
     ("load", ["load", "cad.read", "cad.occ"]),
@@ -32,11 +44,12 @@ LAYERS: list[tuple[str, list[str]]] = [
     ("principal", ["principal"]),
     ("classification", ["classification"]),
     ("motion", ["motion"]),
-    ("derived", ["elements", "export", "frames", "rotational"]),
+    ("derived", ["export", "frames", "rotational"]),
     ("results", ["options", "results", "report"]),
     ("pipeline", ["pipeline"]),
     ("surfaces", ["api", "app", "batch", "cli", "web", "__main__", ""]),
 ]
+
 
 def module_name(path: Path) -> str:
     parts = list(path.relative_to(SOURCE).with_suffix("").parts)
@@ -147,9 +160,7 @@ def upward(graph: dict[str, set[str]]) -> list[str]:
     for source, targets in sorted(graph.items()):
         for target in sorted(targets):
             if layer_of(target) > layer_of(source):
-                bad.append(
-                    f"{source} ({LAYERS[layer_of(source)][0]}) imports {target} ({LAYERS[layer_of(target)][0]})"
-                )
+                bad.append(f"{source} ({LAYERS[layer_of(source)][0]}) imports {target} ({LAYERS[layer_of(target)][0]})")
     return bad
 
 
@@ -172,13 +183,16 @@ def _graph_of(tmp_path: Path, files: dict[str, str]) -> dict[str, set[str]]:
 
 
 def test_builder_sees_lazy_type_checking_and_submodule_edges(tmp_path: Path) -> None:
-    graph = _graph_of(tmp_path, {
-        "__init__.py": "",
-        "a.py": "def f():\n    from .b import g\n",
-        "b.py": "from typing import TYPE_CHECKING\nif TYPE_CHECKING:\n    from .pkg import sub, thing\n",
-        "pkg/__init__.py": "from . import sub\n",
-        "pkg/sub.py": "from .. import a\nimport inertia.pkg.sub\nimport inertia.b.nothing\nimport numpy\n",
-    })
+    graph = _graph_of(
+        tmp_path,
+        {
+            "__init__.py": "",
+            "a.py": "def f():\n    from .b import g\n",
+            "b.py": "from typing import TYPE_CHECKING\nif TYPE_CHECKING:\n    from .pkg import sub, thing\n",
+            "pkg/__init__.py": "from . import sub\n",
+            "pkg/sub.py": "from .. import a\nimport inertia.pkg.sub\nimport inertia.b.nothing\nimport numpy\n",
+        },
+    )
     assert graph["inertia.a"] == {"inertia.b"}
     assert graph["inertia.b"] == {"inertia.pkg.sub", "inertia.pkg"}
     assert graph["inertia.pkg"] == {"inertia.pkg.sub"}
@@ -202,14 +216,26 @@ def test_every_module_is_placed_in_a_layer() -> None:
 
 def test_no_import_cycle() -> None:
     found = cycles(edges())
-    assert found == [], "import cycles (lazy and TYPE_CHECKING imports count):\n" + "\n".join(
-        " <-> ".join(c) for c in found
-    )
+    assert found == [], "import cycles (lazy and TYPE_CHECKING imports count):\n" + "\n".join(" <-> ".join(c) for c in found)
 
 
 def test_no_module_imports_a_layer_above_its_own() -> None:
     bad = upward(edges())
     assert bad == [], "imports against the layer order:\n" + "\n".join(bad)
+
+
+def test_docs_describe_the_same_layers() -> None:
+    """docs/architecture.md has a row per layer, in this order, naming each module prefix of it."""
+    text = (ROOT / "docs" / "architecture.md").read_text(encoding="utf-8")
+    rows = [line for line in text.splitlines() if line.startswith("| ") and not line.startswith("| layer")]
+    rows = [r for r in rows if not set(r) <= set("|- ")]
+    assert [r.split("|")[1].strip() for r in rows] == [name for name, _ in LAYERS]
+    for row, (_, prefixes) in zip(rows, LAYERS):
+        cell = row.split("|")[2]
+        for prefix in prefixes:
+            if prefix:
+                shown = prefix.replace(".", "/")
+                assert f"`{prefix}" in cell or f"`{shown}" in cell, (prefix, row)
 
 
 if __name__ == "__main__":  # print the graph's problems without pytest

@@ -66,8 +66,9 @@ def test_mesh_analysis_imports_no_web_stack_or_ode_solver() -> None:
 
 
 def test_point_analysis_imports_no_mesh_library() -> None:
-    mods = imported_after("import inertia; inertia.analyze_points([{'mass': 1, 'position': [0, 0, 0]}, "
-                          "{'mass': 2, 'position': [1, 1, 0]}])")
+    mods = imported_after(
+        "import inertia; inertia.analyze_points([{'mass': 1, 'position': [0, 0, 0]}, {'mass': 2, 'position': [1, 1, 0]}])"
+    )
     assert not {"trimesh", "meshio", "fastapi", "scipy.integrate"} & mods
 
 

@@ -55,12 +55,15 @@ def test_errors_are_sentences_in_table_mode_and_envelopes_with_json(tmp_path: Pa
     assert json.loads(as_json.stderr)["error"]["code"] == "unreadable_file"
 
 
-@pytest.mark.parametrize(("units", "mass", "moment", "length"), [
-    ("si", "6000 kg", "2500", "m"),
-    ("kg-mm", "6000 kg", "2.5e+09", "mm"),      # 2500 kg m^2 = 2500e6 kg mm^2
-    ("g-mm", "6000000 g", "2.5e+12", "mm"),     # 2500e6 kg mm^2 = 2500e9 g mm^2
-    ("g-cm", "6000000 g", "2.5e+10", "cm"),     # 2500e4 kg cm^2 = 2500e7 g cm^2
-])
+@pytest.mark.parametrize(
+    ("units", "mass", "moment", "length"),
+    [
+        ("si", "6000 kg", "2500", "m"),
+        ("kg-mm", "6000 kg", "2.5e+09", "mm"),  # 2500 kg m^2 = 2500e6 kg mm^2
+        ("g-mm", "6000000 g", "2.5e+12", "mm"),  # 2500e6 kg mm^2 = 2500e9 g mm^2
+        ("g-cm", "6000000 g", "2.5e+10", "cm"),  # 2500e4 kg cm^2 = 2500e7 g cm^2
+    ],
+)
 def test_table_output_units(units: str, mass: str, moment: str, length: str, capsys: pytest.CaptureFixture[str]) -> None:
     assert main(["analyze", BOX, "--output-units", units]) == 0
     out = capsys.readouterr().out

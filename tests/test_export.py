@@ -86,9 +86,13 @@ def _mesh(client: Any, text: str, fmt: str, **params: Any) -> Any:
 
 def _quat_matrix(q: np.ndarray) -> np.ndarray:
     w, x, y, z = q / np.linalg.norm(q)
-    return np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
-                     [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
-                     [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)]])
+    return np.array(
+        [
+            [1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
+            [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
+            [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)],
+        ]
+    )
 
 
 def _compiled(model: Any, body: int) -> tuple[float, np.ndarray, np.ndarray]:
@@ -113,8 +117,9 @@ def _mjcf_model(snippets: list[str]) -> Any:
 
 def _urdf_model(snippets: list[str]) -> Any:
     links = "".join(f'<link name="p{i}">{s}</link>' for i, s in enumerate(snippets))
-    joints = "".join(f'<joint name="j{i}" type="floating"><parent link="base"/><child link="p{i}"/></joint>'
-                     for i in range(len(snippets)))
+    joints = "".join(
+        f'<joint name="j{i}" type="floating"><parent link="base"/><child link="p{i}"/></joint>' for i in range(len(snippets))
+    )
     return mujoco.MjModel.from_xml_string(f'<robot name="r"><link name="base"/>{links}{joints}</robot>')
 
 
@@ -168,8 +173,14 @@ def test_urdf_compiled_by_mujocos_urdf_compiler_equals_our_body(body_docs: dict[
     assert float(mass.get("value")) == doc["mass"]
     assert set(inertia.attrib) == URDF_INERTIA_ATTRIBUTES
     t = doc["inertia_tensor"]
-    assert [float(inertia.get(k)) for k in ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")] == \
-        [t[0][0], t[0][1], t[0][2], t[1][1], t[1][2], t[2][2]]
+    assert [float(inertia.get(k)) for k in ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")] == [
+        t[0][0],
+        t[0][1],
+        t[0][2],
+        t[1][1],
+        t[1][2],
+        t[2][2],
+    ]
 
 
 def test_sdf_uses_sdformat_names_and_our_numbers(body_docs: dict[str, dict[str, Any]]) -> None:
@@ -193,10 +204,13 @@ def test_numbers_have_17_significant_digits(body_docs: dict[str, dict[str, Any]]
     assert len(digits) <= 17 and float(mass) == body_docs["urdf"]["mass"]
 
 
-@pytest.mark.parametrize("points, reason", [
-    ([{"mass": 1.0, "position": [0, 0, 0]}, {"mass": 2.0, "position": [1, 1, 1]}], "zero_moment"),  # rotator
-    ([{"mass": 1.0, "position": [0.5, 0.2, 0.1]}], "zero_moment"),  # a single point
-])
+@pytest.mark.parametrize(
+    "points, reason",
+    [
+        ([{"mass": 1.0, "position": [0, 0, 0]}, {"mass": 2.0, "position": [1, 1, 1]}], "zero_moment"),  # rotator
+        ([{"mass": 1.0, "position": [0.5, 0.2, 0.1]}], "zero_moment"),  # a single point
+    ],
+)
 @pytest.mark.parametrize("fmt", ["urdf", "sdf", "mjcf"])
 def test_body_a_simulator_rejects_is_invalid_inertia(client: Any, points: list[Any], reason: str, fmt: str) -> None:
     r = client.post("/v1/analyze/points", json={"points": points, "export": fmt})
@@ -217,8 +231,11 @@ def test_mujoco_itself_rejects_what_we_refuse() -> None:
 
 @pytest.mark.parametrize("fmt", ["urdf", "mjcf"])
 def test_molecule_scale_body_is_refused_for_mujoco_formats(client: Any, fmt: str) -> None:
-    water = [{"element": "O", "position": [0, 0, 0.1173]}, {"element": "H", "position": [0, 0.7572, -0.4692]},
-             {"element": "H", "position": [0, -0.7572, -0.4692]}]
+    water = [
+        {"element": "O", "position": [0, 0, 0.1173]},
+        {"element": "H", "position": [0, 0.7572, -0.4692]},
+        {"element": "H", "position": [0, -0.7572, -0.4692]},
+    ]
     r = client.post("/v1/analyze/points", json={"points": water, "units": "angstrom", "export": fmt})
     assert r.status_code == 422 and r.json()["error"]["details"]["reason"] == "below_mjminval"
     sdf = client.post("/v1/analyze/points", json={"points": water, "units": "angstrom", "export": "sdf"})
@@ -248,8 +265,9 @@ def test_assembly_exports_each_part(client: Any) -> None:
     text = _box_obj("left") + _box_obj("right", BOX_OFFSET + np.array([1.0, 0.0, 0.0])).replace("\nf ", "\nf ")
     # the second object's face indices continue after the first object's 8 vertices
     first, second = text.split("o right\n")
-    second_lines = [(f"f {' '.join(str(int(i) + 8) for i in ln.split()[1:])}" if ln.startswith("f ") else ln)
-                    for ln in second.splitlines()]
+    second_lines = [
+        (f"f {' '.join(str(int(i) + 8) for i in ln.split()[1:])}" if ln.startswith("f ") else ln) for ln in second.splitlines()
+    ]
     text = first + "o right\n" + "\n".join(second_lines) + "\n"
     r = _mesh(client, text, "mjcf")
     assert r.status_code == 200, r.text
@@ -266,13 +284,23 @@ def test_assembly_exports_each_part(client: Any) -> None:
 def test_cli_export_prints_the_snippet_alone(tmp_path: Path) -> None:
     path = tmp_path / "part.obj"
     path.write_text(_box_obj())
-    run = subprocess.run([sys.executable, "-m", "inertia", "analyze", str(path), "--export", "mjcf"],
-                         capture_output=True, text=True, check=False, cwd=ROOT)
+    run = subprocess.run(
+        [sys.executable, "-m", "inertia", "analyze", str(path), "--export", "mjcf"],
+        capture_output=True,
+        text=True,
+        check=False,
+        cwd=ROOT,
+    )
     assert run.returncode == 0, run.stderr
     element = etree.fromstring(run.stdout.strip())
     assert element.tag == "inertial"
-    as_json = subprocess.run([sys.executable, "-m", "inertia", "analyze", str(path), "--export", "mjcf", "--json"],
-                             capture_output=True, text=True, check=True, cwd=ROOT)
+    as_json = subprocess.run(
+        [sys.executable, "-m", "inertia", "analyze", str(path), "--export", "mjcf", "--json"],
+        capture_output=True,
+        text=True,
+        check=True,
+        cwd=ROOT,
+    )
     assert json.loads(as_json.stdout)["export"]["text"] == run.stdout.strip()
 
 
@@ -290,8 +318,15 @@ def test_moments_rounded_just_past_the_triangle_inequality_still_load(fmt: str) 
     with pytest.raises(ValueError):
         _mjcf_model([f'<inertial pos="0 0 0" mass="1" diaginertia="1 2 {i3!r}"/>'])
     R = _rotation([0.3, 1.0, -0.4], 1.1)
-    body = Inertial(2.0, np.array([0.5, -0.25, 1.0]), R @ np.diag([1.0, 2.0, i3]) @ R.T, np.array([1.0, 2.0, i3]),
-                    R.T, _quaternion_of(R), relative_error=1e-15)
+    body = Inertial(
+        2.0,
+        np.array([0.5, -0.25, 1.0]),
+        R @ np.diag([1.0, 2.0, i3]) @ R.T,
+        np.array([1.0, 2.0, i3]),
+        R.T,
+        _quaternion_of(R),
+        relative_error=1e-15,
+    )
     snippet = inertial_snippet(fmt, body)
     assert any("planar" in w for w in snippet.warnings)
     model = (_mjcf_model if fmt == "mjcf" else _urdf_model)([snippet.text])

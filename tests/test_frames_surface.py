@@ -72,8 +72,7 @@ def test_rotated_body_seen_in_its_own_frame_is_the_unrotated_body(client: Any) -
     np.testing.assert_allclose(frame["center_of_mass"], OFFSET - R.T @ reference, rtol=0, atol=1e-12)
     d = OFFSET - R.T @ reference  # the reference seen from the centre of mass, named-frame axes
     about_reference = tensor + m * (np.dot(d, d) * np.eye(3) - np.outer(d, d))
-    np.testing.assert_allclose(frame["reference_inertia"], about_reference, rtol=0,
-                               atol=1e-12 * np.abs(about_reference).max())
+    np.testing.assert_allclose(frame["reference_inertia"], about_reference, rtol=0, atol=1e-12 * np.abs(about_reference).max())
     np.testing.assert_allclose(frame["quaternion"], [w, x, y, z], rtol=0, atol=1e-15)
 
 
@@ -87,8 +86,12 @@ def test_frame_without_reference_measures_from_the_input_origin(client: Any) -> 
 
 def test_points_frame_is_a_json_array(client: Any) -> None:
     q = [math.cos(0.25), 0.0, 0.0, math.sin(0.25)]  # 0.5 rad about z
-    points = [{"mass": 1.0, "position": [1.0, 0.0, 0.0]}, {"mass": 1.0, "position": [-1.0, 0.0, 0.0]},
-              {"mass": 2.0, "position": [0.0, 0.5, 0.0]}, {"mass": 2.0, "position": [0.0, -0.5, 0.0]}]
+    points = [
+        {"mass": 1.0, "position": [1.0, 0.0, 0.0]},
+        {"mass": 1.0, "position": [-1.0, 0.0, 0.0]},
+        {"mass": 2.0, "position": [0.0, 0.5, 0.0]},
+        {"mass": 2.0, "position": [0.0, -0.5, 0.0]},
+    ]
     doc = client.post("/v1/analyze/points", json={"points": points, "frame": q}).json()
     c, s = math.cos(0.5), math.sin(0.5)
     R = np.array([[c, -s, 0], [s, c, 0], [0, 0, 1]])
@@ -98,8 +101,9 @@ def test_points_frame_is_a_json_array(client: Any) -> None:
 
 @pytest.mark.parametrize("frame", ["1,0,0", "2,0,0,0", "1,nan,0,0", "w,x,y,z"])
 def test_a_frame_that_is_not_a_unit_quaternion_is_refused(client: Any, frame: str) -> None:
-    r = client.post("/v1/analyze/mesh", params={"frame": frame},
-                    files={"file": ("box.obj", _box_obj(np.eye(3), np.zeros(3)).encode())})
+    r = client.post(
+        "/v1/analyze/mesh", params={"frame": frame}, files={"file": ("box.obj", _box_obj(np.eye(3), np.zeros(3)).encode())}
+    )
     assert r.status_code == 422 and r.json()["error"]["code"] == "invalid_parameter"
     assert r.json()["error"]["details"].get("parameter") == "frame"
 
@@ -128,9 +132,16 @@ def test_surface_area_of_each_part_and_the_assembly(client: Any) -> None:
 
 
 def test_points_have_radii_of_gyration_but_no_surface_area(client: Any) -> None:
-    doc = client.post("/v1/analyze/points", json={"points": [{"mass": 2.0, "position": [0, 0, 0]},
-                                                              {"mass": 2.0, "position": [2, 0, 0]},
-                                                              {"mass": 1.0, "position": [1, 3, 0]}]}).json()
+    doc = client.post(
+        "/v1/analyze/points",
+        json={
+            "points": [
+                {"mass": 2.0, "position": [0, 0, 0]},
+                {"mass": 2.0, "position": [2, 0, 0]},
+                {"mass": 1.0, "position": [1, 3, 0]},
+            ]
+        },
+    ).json()
     assert "surface_area" not in doc
     k = [math.sqrt(max(i, 0) / doc["mass"]) for i in doc["principal"]["moments"]]
     np.testing.assert_allclose(doc["principal"]["radii_of_gyration"], k, rtol=1e-12)
@@ -152,8 +163,11 @@ def _unit_quaternions() -> Any:
     from hypothesis import strategies as st
 
     component = st.floats(-1.0, 1.0, allow_nan=False)
-    return st.tuples(component, component, component, component).filter(
-        lambda q: sum(v * v for v in q) > 1e-2).map(lambda q: tuple(v / math.sqrt(sum(u * u for u in q)) for v in q))
+    return (
+        st.tuples(component, component, component, component)
+        .filter(lambda q: sum(v * v for v in q) > 1e-2)
+        .map(lambda q: tuple(v / math.sqrt(sum(u * u for u in q)) for v in q))
+    )
 
 
 def test_any_rotation_of_points_seen_in_its_frame_is_invariant() -> None:
@@ -174,7 +188,8 @@ def test_any_rotation_of_points_seen_in_its_frame_is_invariant() -> None:
         plain = inertia.analyze_points([{"mass": m, "position": list(p)} for m, p in zip(masses, positions)])
         turned = inertia.analyze_points(
             [{"mass": m, "position": (R @ np.array(p)).tolist()} for m, p in zip(masses, positions)],
-            inertia.AnalysisOptions(frame=q))
+            inertia.AnalysisOptions(frame=q),
+        )
         frame = turned.as_dict()["frame"]
         base = plain.as_dict()
         scale = max(np.abs(base["inertia_tensor"]).max(), 1e-300)

@@ -29,8 +29,10 @@ def export(obj: trimesh.Trimesh | trimesh.Scene, fmt: str, **kw: object) -> byte
     return data.encode() if isinstance(data, str) else data
 
 
-@pytest.mark.parametrize("fmt,ext", [("stl", "stl"), ("stl_ascii", "stl"), ("obj", "obj"), ("ply", "ply"),
-                                     ("off", "off"), ("glb", "glb"), ("3mf", "3mf")])
+@pytest.mark.parametrize(
+    "fmt,ext",
+    [("stl", "stl"), ("stl_ascii", "stl"), ("obj", "obj"), ("ply", "ply"), ("off", "off"), ("glb", "glb"), ("3mf", "3mf")],
+)
 def test_every_surface_format_gives_the_box(fmt: str, ext: str) -> None:
     doc = analyze(export(box_mesh(), fmt), filename=f"part.{ext}").as_dict()
     scale = 1e-3 if ext == "3mf" else 1.0  # 3MF declares millimetres
@@ -63,8 +65,7 @@ def two_box_scene() -> trimesh.Scene:
     scene.add_geometry(trimesh.Trimesh(*box(1.0, 1.0, 1.0), process=False), node_name="left", geom_name="left")
     shift = np.eye(4)
     shift[:3, 3] = [3.0, 1.0, 0.0]
-    scene.add_geometry(trimesh.Trimesh(*box(1.0, 2.0, 1.0), process=False), node_name="right",
-                       geom_name="right", transform=shift)
+    scene.add_geometry(trimesh.Trimesh(*box(1.0, 2.0, 1.0), process=False), node_name="right", geom_name="right", transform=shift)
     return scene
 
 
@@ -80,8 +81,9 @@ def expected_two_boxes(rho_left: float, rho_right: float) -> tuple[float, np.nda
 
 @pytest.mark.parametrize("fmt", ["glb", "obj"])
 def test_assembly_is_the_parallel_axis_sum_of_its_parts(fmt: str) -> None:
-    doc = analyze(export(two_box_scene(), fmt), filename=f"asm.{fmt}",
-                  options=AnalysisOptions(densities={"right": 2000.0})).as_dict()
+    doc = analyze(
+        export(two_box_scene(), fmt), filename=f"asm.{fmt}", options=AnalysisOptions(densities={"right": 2000.0})
+    ).as_dict()
     m, com, tensor = expected_two_boxes(1000.0, 2000.0)
     assert doc["mass"] == pytest.approx(m, rel=1e-14)
     np.testing.assert_allclose(doc["center_of_mass"], com, rtol=1e-14)
@@ -107,8 +109,9 @@ def test_assembly_equals_its_parts_as_separate_files() -> None:
 
 
 def test_assembly_total_mass_scales_every_part() -> None:
-    doc = analyze(export(two_box_scene(), "glb"), filename="asm.glb",
-                  options=AnalysisOptions(mass=10.0, densities={"right": 2000.0})).as_dict()
+    doc = analyze(
+        export(two_box_scene(), "glb"), filename="asm.glb", options=AnalysisOptions(mass=10.0, densities={"right": 2000.0})
+    ).as_dict()
     assert doc["mass"] == pytest.approx(10.0, rel=1e-14)
     assert [p["mass"] for p in doc["parts"]] == pytest.approx([2.0, 8.0], rel=1e-14)
 
@@ -120,11 +123,27 @@ def test_single_body_scene_has_no_parts() -> None:
 
 def hex_wedge_pyramid_mesh() -> meshio.Mesh:
     """Unit cube as one hexahedron, a unit wedge beside it, a pyramid on top."""
-    pts = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0], [0, 0, 1], [1, 0, 1], [1, 1, 1], [0, 1, 1],
-                    [2, 0, 0], [2, 0, 1], [0.5, 0.5, 2.0]], dtype=float)
-    cells = [("hexahedron", np.array([[0, 1, 2, 3, 4, 5, 6, 7]])),
-             ("wedge", np.array([[1, 8, 2, 5, 9, 6]])),
-             ("pyramid", np.array([[4, 5, 6, 7, 10]]))]
+    pts = np.array(
+        [
+            [0, 0, 0],
+            [1, 0, 0],
+            [1, 1, 0],
+            [0, 1, 0],
+            [0, 0, 1],
+            [1, 0, 1],
+            [1, 1, 1],
+            [0, 1, 1],
+            [2, 0, 0],
+            [2, 0, 1],
+            [0.5, 0.5, 2.0],
+        ],
+        dtype=float,
+    )
+    cells = [
+        ("hexahedron", np.array([[0, 1, 2, 3, 4, 5, 6, 7]])),
+        ("wedge", np.array([[1, 8, 2, 5, 9, 6]])),
+        ("pyramid", np.array([[4, 5, 6, 7, 10]])),
+    ]
     return meshio.Mesh(pts, cells)
 
 

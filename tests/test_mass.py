@@ -112,8 +112,9 @@ def test_units_scale_results_to_si() -> None:
     in_mm = mass_properties(MeshBody(v, f, length_scale=1e-3), density=1000.0)
     m = 1000.0 * 0.01 * 0.02 * 0.03
     assert in_mm.mass == pytest.approx(m, rel=1e-14)
-    np.testing.assert_allclose(moments(in_mm), sorted([m * (4e-4 + 9e-4) / 12, m * (1e-4 + 9e-4) / 12,
-                                                        m * (1e-4 + 4e-4) / 12]), rtol=1e-13)
+    np.testing.assert_allclose(
+        moments(in_mm), sorted([m * (4e-4 + 9e-4) / 12, m * (1e-4 + 9e-4) / 12, m * (1e-4 + 4e-4) / 12]), rtol=1e-13
+    )
 
 
 def test_total_mass_sets_density() -> None:
@@ -187,7 +188,7 @@ def test_shell_box_matches_lamina_sum() -> None:
         p, q = sides[p_ax], sides[q_ax]
         m = rho * t * p * q
         diag = np.zeros(3)
-        diag[normal] = m * (p * p + q * q) / 12 
+        diag[normal] = m * (p * p + q * q) / 12
         diag[p_ax] = m * q * q / 12 + m * half**2
         diag[q_ax] = m * p * p / 12 + m * half**2
         total += 2 * diag
@@ -202,9 +203,13 @@ def test_reference_tensor_follows_parallel_axis_theorem() -> None:
     ref = props.about(np.zeros(3))
     m = 6.0
     # about the corner: I_xx = m (b² + c²)/3, I_xy = -m a b / 4 (box integrals)
-    expected = np.array([[m * (b * b + c * c) / 3, -m * a * b / 4, -m * a * c / 4],
-                         [-m * a * b / 4, m * (a * a + c * c) / 3, -m * b * c / 4],
-                         [-m * a * c / 4, -m * b * c / 4, m * (a * a + b * b) / 3]])
+    expected = np.array(
+        [
+            [m * (b * b + c * c) / 3, -m * a * b / 4, -m * a * c / 4],
+            [-m * a * b / 4, m * (a * a + c * c) / 3, -m * b * c / 4],
+            [-m * a * c / 4, -m * b * c / 4, m * (a * a + b * b) / 3],
+        ]
+    )
     np.testing.assert_allclose(ref.matrix, expected, rtol=1e-14)
     assert ref.about == "reference"
 
@@ -295,8 +300,9 @@ def test_results_are_bit_identical_across_processes(tmp_path: Path) -> None:
     )
     from tests.support.paths import ROOT
 
-    outs = {subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT, check=True).stdout
-            for _ in range(2)}
+    outs = {
+        subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT, check=True).stdout for _ in range(2)
+    }
     assert len(outs) == 1
 
 

@@ -74,8 +74,10 @@ def ammonia(r: float = 1.012, angle: float = 106.67) -> list[tuple[str, list[flo
     hh = 2 * r * math.sin(_deg(angle) / 2)
     rho = hh / math.sqrt(3)
     h = math.sqrt(r * r - rho * rho)
-    return [("N", [0, 0, 0])] + [("H", [rho * math.cos(k * 2 * math.pi / 3), rho * math.sin(k * 2 * math.pi / 3), -h])  # type: ignore[return-value]
-                                 for k in range(3)]
+    return [("N", [0, 0, 0])] + [
+        ("H", [rho * math.cos(k * 2 * math.pi / 3), rho * math.sin(k * 2 * math.pi / 3), -h])  # type: ignore[return-value]
+        for k in range(3)
+    ]
 
 
 def methane(r: float = 1.087) -> list[tuple[str, list[float]]]:
@@ -98,8 +100,7 @@ def carbon_dioxide(r: float = 1.162) -> list[tuple[str, list[float]]]:
 def benzene(rcc: float = 1.3914, rch: float = 1.0802) -> list[tuple[str, list[float]]]:
     """C6H6, D6h (re(CC) 1.3914, re(CH) 1.0802 A: Gauss & Stanton, J. Phys. Chem. A 104, 2865, 2000)."""
     ring = [(math.cos(k * math.pi / 3), math.sin(k * math.pi / 3)) for k in range(6)]
-    return ([("C", [rcc * x, rcc * y, 0.0]) for x, y in ring]
-            + [("H", [(rcc + rch) * x, (rcc + rch) * y, 0.0]) for x, y in ring])
+    return [("C", [rcc * x, rcc * y, 0.0]) for x, y in ring] + [("H", [(rcc + rch) * x, (rcc + rch) * y, 0.0]) for x, y in ring]
 
 
 def _points(atoms: list[tuple[str, list[float]]]) -> list[dict[str, Any]]:
@@ -175,23 +176,26 @@ def test_standard_weights_are_the_default_and_abundant_isotopes_on_request(clien
 
 @pytest.mark.parametrize("symbol, mass", [("D", DEUTERIUM), ("2H", DEUTERIUM), ("13C", CARBON13), ("12C", 12.0)])
 def test_mass_numbers_and_deuterium(client: Any, symbol: str, mass: float) -> None:
-    body = {"points": [{"element": symbol, "position": [0, 0, 0]}, {"mass": 1.0, "position": [1, 0, 0]}],
-            "mass_unit": "u"}
+    body = {"points": [{"element": symbol, "position": [0, 0, 0]}, {"mass": 1.0, "position": [1, 0, 0]}], "mass_unit": "u"}
     doc = client.post("/v1/analyze/points", json=body).json()
     assert doc["mass"] == pytest.approx((mass + 1.0) * DALTON, rel=1e-9)
 
 
 def test_mass_wins_over_element_and_mass_unit_u(client: Any) -> None:
-    body = {"points": [{"element": "O", "mass": 2.0, "position": [0, 0, 0]}, {"mass": 3.0, "position": [1, 0, 0]}],
-            "mass_unit": "u"}
+    body = {
+        "points": [{"element": "O", "mass": 2.0, "position": [0, 0, 0]}, {"mass": 3.0, "position": [1, 0, 0]}],
+        "mass_unit": "u",
+    }
     doc = client.post("/v1/analyze/points", json=body).json()
     assert doc["mass"] == pytest.approx(5.0 * DALTON, rel=1e-12)
     kg = client.post("/v1/analyze/points", json={**body, "mass_unit": "kg"}).json()
     assert kg["mass"] == 5.0
 
 
-@pytest.mark.parametrize("symbol, reason", [("Xx", "not an element"), ("99C", "mass numbers of C"),
-                                            ("Tc", "no standard atomic weight"), ("14D", "already names")])
+@pytest.mark.parametrize(
+    "symbol, reason",
+    [("Xx", "not an element"), ("99C", "mass numbers of C"), ("Tc", "no standard atomic weight"), ("14D", "already names")],
+)
 def test_unknown_elements_are_refused_with_advice(client: Any, symbol: str, reason: str) -> None:
     body = {"points": [{"element": symbol, "position": [0, 0, 0]}, {"element": "H", "position": [1, 0, 0]}]}
     r = client.post("/v1/analyze/points", json=body)
@@ -205,9 +209,12 @@ def test_a_point_needs_a_mass_or_an_element(client: Any) -> None:
 
 
 def test_points_with_masses_only_have_no_rotational_constants(client: Any) -> None:
-    doc = client.post("/v1/analyze/points", json={"points": [{"mass": 1, "position": [0, 0, 0]},
-                                                              {"mass": 1, "position": [1, 0, 0]},
-                                                              {"mass": 1, "position": [0, 1, 0]}]}).json()
+    doc = client.post(
+        "/v1/analyze/points",
+        json={
+            "points": [{"mass": 1, "position": [0, 0, 0]}, {"mass": 1, "position": [1, 0, 0]}, {"mass": 1, "position": [0, 1, 0]}]
+        },
+    ).json()
     assert "rotational_constants" not in doc
 
 
@@ -235,8 +242,10 @@ def test_xyz_atomic_numbers_and_trajectories(client: Any) -> None:
     assert any("first frame" in w for w in doc["warnings"])
 
 
-@pytest.mark.parametrize("text, message", [("x\n\nO 0 0 0\n", "number of atoms"), ("3\n\nO 0 0 0\n", "announces 3"),
-                                           ("1\n\nO 0 zero 0\n", "element x y z")])
+@pytest.mark.parametrize(
+    "text, message",
+    [("x\n\nO 0 0 0\n", "number of atoms"), ("3\n\nO 0 0 0\n", "announces 3"), ("1\n\nO 0 zero 0\n", "element x y z")],
+)
 def test_broken_xyz_is_unreadable_file(client: Any, text: str, message: str) -> None:
     r = client.post("/v1/analyze/mesh", files={"file": ("bad.xyz", text.encode())})
     assert r.status_code == 422
@@ -246,11 +255,18 @@ def test_broken_xyz_is_unreadable_file(client: Any, text: str, message: str) -> 
 def test_cli_analyze_water_xyz(tmp_path: Path) -> None:
     path = tmp_path / "water.xyz"
     path.write_text(_xyz(water()))
-    table = subprocess.run([sys.executable, "-m", "inertia", "analyze", str(path)], capture_output=True, text=True,
-                           check=True, cwd=ROOT).stdout
+    table = subprocess.run(
+        [sys.executable, "-m", "inertia", "analyze", str(path)], capture_output=True, text=True, check=True, cwd=ROOT
+    ).stdout
     assert "rotational A, B, C" in table and "cm^-1" in table and "asymmetric_top" in table
-    doc = json.loads(subprocess.run([sys.executable, "-m", "inertia", "analyze", str(path), "--json",
-                                     "--isotopes", "abundant"],
-                                    capture_output=True, text=True, check=True, cwd=ROOT).stdout)
+    doc = json.loads(
+        subprocess.run(
+            [sys.executable, "-m", "inertia", "analyze", str(path), "--json", "--isotopes", "abundant"],
+            capture_output=True,
+            text=True,
+            check=True,
+            cwd=ROOT,
+        ).stdout
+    )
     _, mhz = _constants(water(), ABUNDANT)
     np.testing.assert_allclose(doc["rotational_constants"]["MHz"], mhz, rtol=REL_MASS)

@@ -51,7 +51,7 @@ from __future__ import annotations
 
 import math
 import warnings
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
 import pytest
@@ -93,8 +93,7 @@ def carbon_dioxide(rco: float) -> Atoms:
 def benzene(rcc: float, rch: float) -> Atoms:
     """C6H6, D6h, in the xy plane: a regular hexagon of C, each H radially outside its C."""
     ring = [(math.cos(k * math.pi / 3), math.sin(k * math.pi / 3)) for k in range(6)]
-    return ([("C", [rcc * x, rcc * y, 0.0]) for x, y in ring]
-            + [("H", [(rcc + rch) * x, (rcc + rch) * y, 0.0]) for x, y in ring])
+    return [("C", [rcc * x, rcc * y, 0.0]) for x, y in ring] + [("H", [(rcc + rch) * x, (rcc + rch) * y, 0.0]) for x, y in ring]
 
 
 def methane(rch: float) -> Atoms:
@@ -111,11 +110,12 @@ def constants_cm(atoms: Atoms) -> np.ndarray:
     tensor = sum(mi * (np.dot(xi, xi) * np.eye(3) - np.outer(xi, xi)) for mi, xi in zip(m, x))
     moments = np.sort(np.linalg.eigvalsh(tensor))
     moments = moments[moments > 1e-12 * moments[-1]]  # a linear molecule has no A
-    return PLANCK / (8 * math.pi**2 * SPEED_OF_LIGHT * moments) / 100
+    return cast("np.ndarray", PLANCK / (8 * math.pi**2 * SPEED_OF_LIGHT * moments) / 100)
 
 
-def rounding_tolerance(build: Any, params: list[float], last_place: list[float], table: np.ndarray,
-                       table_place: float) -> np.ndarray:
+def rounding_tolerance(
+    build: Any, params: list[float], last_place: list[float], table: np.ndarray, table_place: float
+) -> np.ndarray:
     """Relative tolerance per constant from half a unit in each published last place."""
     base = constants_cm(build(*params))
     spread = np.zeros_like(base)
@@ -123,7 +123,7 @@ def rounding_tolerance(build: Any, params: list[float], last_place: list[float],
         shifted = list(params)
         shifted[i] += place / 2
         spread += np.abs(constants_cm(build(*shifted)) - base)
-    return spread / base + (table_place / 2) / table
+    return cast("np.ndarray", spread / base + (table_place / 2) / table)
 
 
 # CCCBDB expgeom2.asp?casno=50000 (geometry: Gurvich; constants: Herzberg 1966), cm^-1
@@ -134,8 +134,7 @@ H2CO_TABLE_PLACE = 0.00001
 
 
 def _analyze(client: Any, atoms: Atoms) -> dict[str, Any]:
-    body = {"points": [{"element": e, "position": p} for e, p in atoms], "units": "angstrom",
-            "isotopes": "abundant"}
+    body = {"points": [{"element": e, "position": p} for e, p in atoms], "units": "angstrom", "isotopes": "abundant"}
     r = client.post("/v1/analyze/points", json=body)
     assert r.status_code == 200, r.text
     doc: dict[str, Any] = r.json()
@@ -148,8 +147,7 @@ PAIRED = {
     # CCCBDB expgeom2x.asp?casno=124389: rCO 1.162 A and B 0.39021 cm^-1, both Herzberg 1966
     "carbon dioxide": (carbon_dioxide, [1.162], [0.001], [0.39021], 0.00001, "linear_rotator", None),
     # CCCBDB expgeom2x.asp?casno=71432: rCC 1.397, rCH 1.084 A; A B C 0.18960 0.18960 0.09480; Herzberg 1966
-    "benzene": (benzene, [1.397, 1.084], [0.001, 0.001], [0.18960, 0.18960, 0.09480], 0.00001,
-                "symmetric_top", "oblate"),
+    "benzene": (benzene, [1.397, 1.084], [0.001, 0.001], [0.18960, 0.18960, 0.09480], 0.00001, "symmetric_top", "oblate"),
 }
 
 

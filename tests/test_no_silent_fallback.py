@@ -27,8 +27,22 @@ SAMPLES = ROOT / "sample_meshes"
 def cube(side: float, offset: tuple[float, float, float] = (0.0, 0.0, 0.0)) -> tuple[np.ndarray, np.ndarray]:
     """An axis-aligned cube as (vertices, faces), outward winding."""
     v = np.array([[x, y, z] for x in (0, side) for y in (0, side) for z in (0, side)], dtype=float) + offset
-    f = np.array([[0, 1, 3], [0, 3, 2], [4, 6, 7], [4, 7, 5], [0, 4, 5], [0, 5, 1],
-                  [2, 3, 7], [2, 7, 6], [0, 2, 6], [0, 6, 4], [1, 5, 7], [1, 7, 3]])
+    f = np.array(
+        [
+            [0, 1, 3],
+            [0, 3, 2],
+            [4, 6, 7],
+            [4, 7, 5],
+            [0, 4, 5],
+            [0, 5, 1],
+            [2, 3, 7],
+            [2, 7, 6],
+            [0, 2, 6],
+            [0, 6, 4],
+            [1, 5, 7],
+            [1, 7, 3],
+        ]
+    )
     return v, f
 
 
@@ -109,19 +123,20 @@ def test_analyze_refuses_other_objects_with_a_sentence() -> None:
 
 
 def test_public_names_are_never_shadowed_by_submodules() -> None:
-    code = ("import inertia, types; inertia.analyze('sample_meshes/box.stl'); "
-            "import inertia.pipeline, inertia.motion, inertia.cli; "
-            "from inertia import classify; assert callable(classify) and not isinstance(classify, types.ModuleType); "
-            "bad = [n for n in inertia.__all__ if isinstance(getattr(inertia, n), types.ModuleType)]; "
-            "assert not bad, bad; print('ok')")
+    code = (
+        "import inertia, types; inertia.analyze('sample_meshes/box.stl'); "
+        "import inertia.pipeline, inertia.motion, inertia.cli; "
+        "from inertia import classify; assert callable(classify) and not isinstance(classify, types.ModuleType); "
+        "bad = [n for n in inertia.__all__ if isinstance(getattr(inertia, n), types.ModuleType)]; "
+        "assert not bad, bad; print('ok')"
+    )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT)
     assert out.returncode == 0 and out.stdout.strip() == "ok", out.stderr
 
 
 def test_import_inertia_needs_no_service_folder_on_the_path(tmp_path: Path) -> None:
     code = "import sys, inertia; r = inertia.analyze(sys.argv[1]); print(r.props.mass); print('service' in sys.modules)"
-    out = subprocess.run([sys.executable, "-c", code, str(SAMPLES / "box.stl")], capture_output=True, text=True,
-                         cwd=tmp_path)
+    out = subprocess.run([sys.executable, "-c", code, str(SAMPLES / "box.stl")], capture_output=True, text=True, cwd=tmp_path)
     assert out.returncode == 0, out.stderr
     mass, service_loaded = out.stdout.split()
     assert float(mass) == pytest.approx(6000.0, rel=1e-14) and service_loaded == "False"

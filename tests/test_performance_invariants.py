@@ -68,9 +68,16 @@ def test_stl_weld_keeps_points_one_ulp_apart_and_numbers_by_first_appearance() -
 def test_ascii_stl_comes_back_welded_like_binary() -> None:
     tri = TETRA[TETRA_FACES]
     tri[1, 0] = [-0.0, 0.0, -0.0]  # the origin again, with negative zeros
-    text = "solid t\n" + "".join(
-        " facet normal 0 0 0\n  outer loop\n" + "".join(f"   vertex {x!r} {y!r} {z!r}\n" for x, y, z in t.tolist())
-        + "  endloop\n endfacet\n" for t in tri) + "endsolid t\n"
+    text = (
+        "solid t\n"
+        + "".join(
+            " facet normal 0 0 0\n  outer loop\n"
+            + "".join(f"   vertex {x!r} {y!r} {z!r}\n" for x, y, z in t.tolist())
+            + "  endloop\n endfacet\n"
+            for t in tri
+        )
+        + "endsolid t\n"
+    )
     vertices, faces = read_stl(text.encode())
     binary_vertices, binary_faces = read_stl(_binary_stl(tri.astype(np.float32)))
     assert vertices.shape == (4, 3)
@@ -79,8 +86,9 @@ def test_ascii_stl_comes_back_welded_like_binary() -> None:
     assert not np.any(np.signbit(vertices))
 
 
-@pytest.mark.parametrize("degraded_hash", [lambda h: h & np.uint64(0), lambda h: h & np.uint64(3)],
-                         ids=["every-row-collides", "two-bit-hash"])
+@pytest.mark.parametrize(
+    "degraded_hash", [lambda h: h & np.uint64(0), lambda h: h & np.uint64(3)], ids=["every-row-collides", "two-bit-hash"]
+)
 def test_row_ids_exact_when_hashes_collide(monkeypatch: pytest.MonkeyPatch, degraded_hash: Any) -> None:
     rng = np.random.default_rng(7)
     rows = rng.integers(0, 5, size=(3000, 3)).astype(np.uint32)  # ~125 distinct rows, many repeats

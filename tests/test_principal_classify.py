@@ -108,8 +108,10 @@ def test_tolerance_decides_near_symmetric_box() -> None:
     assert classify(frame_of(moments, tol=1e-10)).rotor is RotorClass.ASYMMETRIC
 
 
-@pytest.mark.parametrize("tensor", [np.diag([1.0, 1.0, 3.0]), np.diag([-1.0, 2.0, 2.0]), np.zeros((3, 3)),
-                                    np.array([[1.0, 0.5, 0], [0, 1, 0], [0, 0, 1]])])
+@pytest.mark.parametrize(
+    "tensor",
+    [np.diag([1.0, 1.0, 3.0]), np.diag([-1.0, 2.0, 2.0]), np.zeros((3, 3)), np.array([[1.0, 0.5, 0], [0, 1, 0], [0, 0, 1]])],
+)
 def test_unphysical_tensors_are_rejected(tensor: np.ndarray) -> None:
     with pytest.raises(InvalidParameterError):
         PrincipalFrame.from_tensor(tensor)

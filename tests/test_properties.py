@@ -31,8 +31,7 @@ def test_rotating_the_body_rotates_the_tensor(mesh: Any, rotation: Any) -> None:
     turned = mass_properties(MeshBody(v @ rotation.T, f))
     expected = rotation @ base.inertia.matrix @ rotation.T
     np.testing.assert_allclose(turned.inertia.matrix, expected, atol=1e-12 * scale_of(base))
-    np.testing.assert_allclose(turned.center_of_mass, rotation @ base.center_of_mass,
-                               atol=1e-12 * np.abs(v).max())
+    np.testing.assert_allclose(turned.center_of_mass, rotation @ base.center_of_mass, atol=1e-12 * np.abs(v).max())
 
 
 @FAST
@@ -42,8 +41,9 @@ def test_translation_leaves_the_centre_of_mass_tensor_alone(mesh: Any, offset: A
     base = props_of(mesh)
     moved = mass_properties(MeshBody(v + offset, f))
     np.testing.assert_allclose(moved.inertia.matrix, base.inertia.matrix, atol=1e-12 * scale_of(base))
-    np.testing.assert_allclose(moved.center_of_mass, base.center_of_mass + offset,
-                               atol=1e-12 * (np.abs(offset).max() + np.abs(v).max()))
+    np.testing.assert_allclose(
+        moved.center_of_mass, base.center_of_mass + offset, atol=1e-12 * (np.abs(offset).max() + np.abs(v).max())
+    )
 
 
 @FAST
@@ -52,8 +52,7 @@ def test_scaling_by_s_scales_inertia_by_s_to_the_fifth(mesh: Any, s: Any) -> Non
     v, f = mesh
     base = props_of(mesh)
     scaled = mass_properties(MeshBody(v * s, f))
-    np.testing.assert_allclose(np.sort(scaled.principal_moments), np.sort(base.principal_moments) * s**5,
-                               rtol=1e-12)
+    np.testing.assert_allclose(np.sort(scaled.principal_moments), np.sort(base.principal_moments) * s**5, rtol=1e-12)
     np.testing.assert_allclose(scaled.mass, base.mass * s**3, rtol=1e-13)
 
 
@@ -66,8 +65,9 @@ def test_inertia_of_disjoint_parts_adds_up(first: Any, second: Any) -> None:
     both = mass_properties(MeshBody(np.vstack([v1, v2]), np.vstack([f1, f2 + len(v1)])))
     total = a.mass + b.mass
     com = (a.mass * a.center_of_mass + b.mass * b.center_of_mass) / total
-    expected = (parallel_axis(a.inertia.matrix, a.mass, a.center_of_mass - com)
-                + parallel_axis(b.inertia.matrix, b.mass, b.center_of_mass - com))
+    expected = parallel_axis(a.inertia.matrix, a.mass, a.center_of_mass - com) + parallel_axis(
+        b.inertia.matrix, b.mass, b.center_of_mass - com
+    )
     np.testing.assert_allclose(both.mass, total, rtol=1e-13)
     np.testing.assert_allclose(both.inertia.matrix, expected, atol=1e-12 * np.abs(expected).max())
 
@@ -104,7 +104,6 @@ def test_point_sets_rotate_covariantly(n: int, seed: int, rotation: Any) -> None
     base = mass_properties(PointBody(masses, x))
     turned = mass_properties(PointBody(masses, x @ rotation.T))
     scale = max(scale_of(base), 1e-300)
-    np.testing.assert_allclose(turned.inertia.matrix, rotation @ base.inertia.matrix @ rotation.T,
-                               atol=1e-12 * scale)
+    np.testing.assert_allclose(turned.inertia.matrix, rotation @ base.inertia.matrix @ rotation.T, atol=1e-12 * scale)
     i1, i2, i3 = np.sort(base.principal_moments)
     assert i1 + i2 >= i3 * (1 - 1e-13)

@@ -9,9 +9,23 @@ from importlib.metadata import version
 import inertia
 
 PUBLIC = {
-    "AnalysisOptions", "AnalysisResult", "Classification", "InertiaTensor", "Loaded", "MassProperties",
-    "PrincipalFrame", "RotorClass", "ServiceError", "Tolerances",
-    "analyze", "analyze_points", "classify", "load_body", "mass_properties", "precession", "principal_frame",
+    "AnalysisOptions",
+    "AnalysisResult",
+    "Classification",
+    "InertiaTensor",
+    "Loaded",
+    "MassProperties",
+    "PrincipalFrame",
+    "RotorClass",
+    "ServiceError",
+    "Tolerances",
+    "analyze",
+    "analyze_points",
+    "classify",
+    "load_body",
+    "mass_properties",
+    "precession",
+    "principal_frame",
 }
 
 

@@ -37,8 +37,22 @@ from tests.support.paths import ROOT
 # a 1 x 0.5 x 0.2 box, turned so that no coordinate lies on a float32 grid line
 ROT = Rotation.from_euler("zyx", [0.3, 0.5, -0.7]).as_matrix()
 CORNERS = np.array([[x, y, z] for x in (0, 1) for y in (0, 1) for z in (0, 1)], float) * [1.0, 0.5, 0.2]
-FACES = np.array([[0, 1, 3], [0, 3, 2], [4, 6, 7], [4, 7, 5], [0, 4, 5], [0, 5, 1],
-                  [2, 3, 7], [2, 7, 6], [0, 2, 6], [0, 6, 4], [1, 5, 7], [1, 7, 3]])
+FACES = np.array(
+    [
+        [0, 1, 3],
+        [0, 3, 2],
+        [4, 6, 7],
+        [4, 7, 5],
+        [0, 4, 5],
+        [0, 5, 1],
+        [2, 3, 7],
+        [2, 7, 6],
+        [0, 2, 6],
+        [0, 6, 4],
+        [1, 5, 7],
+        [1, 7, 3],
+    ]
+)
 
 
 def binary_stl(vertices: np.ndarray, faces: np.ndarray) -> bytes:
@@ -118,15 +132,17 @@ def test_zero_volume_float64_shells_are_refused_not_flipped_into_a_body() -> Non
         analyze(obj_text(vertices, faces), filename="shells.obj")
 
 
-COLLINEAR = [{"mass": 1.0, "position": [0.0, 0.0, 1e5]}, {"mass": 2.0, "position": [1.0, 1.0, 1e5 + 1.0]},
-             {"mass": 1.0, "position": [3.0, 3.0, 1e5 + 3.0]}]
+COLLINEAR = [
+    {"mass": 1.0, "position": [0.0, 0.0, 1e5]},
+    {"mass": 2.0, "position": [1.0, 1.0, 1e5 + 1.0]},
+    {"mass": 1.0, "position": [3.0, 3.0, 1e5 + 3.0]},
+]
 
 
 def _collinear(seed: int) -> list[dict[str, object]]:
     rng = np.random.default_rng(seed)
     d, p0 = rng.normal(size=3), rng.normal(size=3) * 10 ** rng.uniform(-3, 5)
-    return [{"mass": float(m), "position": (p0 + t * d).tolist()}
-            for m, t in zip(rng.uniform(0.1, 10, 4), rng.normal(size=4))]
+    return [{"mass": float(m), "position": (p0 + t * d).tolist()} for m, t in zip(rng.uniform(0.1, 10, 4), rng.normal(size=4))]
 
 
 @pytest.mark.parametrize("points", [COLLINEAR] + [_collinear(s) for s in range(20)])
@@ -177,14 +193,17 @@ def test_http_float32_collapse_is_a_422_naming_the_cause(client: TestClient) -> 
 def test_cli_json_never_prints_infinity(tmp_path: Path) -> None:
     path = tmp_path / "line.json"
     path.write_text(json.dumps({"points": COLLINEAR}))
-    out = subprocess.run([sys.executable, "-m", "inertia", "analyze", str(path), "--json", "--omega", "0.1,1,0.3"],
-                         capture_output=True, text=True, cwd=ROOT)
+    out = subprocess.run(
+        [sys.executable, "-m", "inertia", "analyze", str(path), "--json", "--omega", "0.1,1,0.3"],
+        capture_output=True,
+        text=True,
+        cwd=ROOT,
+    )
     assert out.returncode == 0, out.stderr
     assert "Infinity" not in out.stdout and "NaN" not in out.stdout
     assert json.loads(out.stdout)["precession"]["regime"] == "rotator"
     stl = tmp_path / "far.stl"
     stl.write_bytes(binary_stl(CORNERS @ ROT.T + 1e7 * np.array([1.0, 0.7, 0.4]), FACES))
-    out = subprocess.run([sys.executable, "-m", "inertia", "analyze", str(stl), "--json"],
-                         capture_output=True, text=True, cwd=ROOT)
+    out = subprocess.run([sys.executable, "-m", "inertia", "analyze", str(stl), "--json"], capture_output=True, text=True, cwd=ROOT)
     assert out.returncode == 4
     assert json.loads(out.stderr)["error"]["code"] == "insufficient_precision"

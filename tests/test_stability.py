@@ -83,8 +83,7 @@ def test_translated_box_error_does_not_grow_with_offset() -> None:
     for sizes in (1e3, 1e6, 1e8):
         v = placed(box(1, 2, 3)[0], offset=sizes * 3.0 * DIRECTION)
         props = mass_properties(MeshBody(v, BOX_FACES), density=1.0)
-        errors.append(max(check_moments(props.principal_moments, props.relative_error_estimate,
-                                        MeshCase("", v, BOX_FACES))))
+        errors.append(max(check_moments(props.principal_moments, props.relative_error_estimate, MeshCase("", v, BOX_FACES))))
     assert max(errors) <= 64 * EPS
 
 

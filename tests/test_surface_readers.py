@@ -33,18 +33,22 @@ def obj_text(v: np.ndarray, f: np.ndarray, extra: str = "") -> bytes:
 
 # --- OBJ -------------------------------------------------------------------------------------------
 
+
 def test_an_obj_vertex_with_two_coordinates_is_refused_with_its_line() -> None:
     with pytest.raises(UnreadableFileError) as err:
         analyze(b"v 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", filename="flat.obj")
     assert "line 1" in err.value.message and "2 numbers" in err.value.message
 
 
-@pytest.mark.parametrize("text, words", [
-    (b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n", "refers to vertex 9"),
-    (b"v 0 0 0 2\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", "weight"),
-    (b"v 0 0 x\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", "not a number"),
-    (b"v 0 0 0\nf 1 a 3\n", "not an integer"),
-])
+@pytest.mark.parametrize(
+    "text, words",
+    [
+        (b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n", "refers to vertex 9"),
+        (b"v 0 0 0 2\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", "weight"),
+        (b"v 0 0 x\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", "not a number"),
+        (b"v 0 0 0\nf 1 a 3\n", "not an integer"),
+    ],
+)
 def test_bad_obj_lines_are_named(text: bytes, words: str) -> None:
     with pytest.raises(UnreadableFileError) as err:
         analyze(text, filename="bad.obj")
@@ -67,6 +71,7 @@ def test_binary_bytes_named_obj_are_refused_in_words() -> None:
 
 
 # --- guarded reader calls ----------------------------------------------------------------------------
+
 
 def test_system_exit_from_a_reader_becomes_an_error_and_chatter_is_silenced(capsys: pytest.CaptureFixture[str]) -> None:
     def reader() -> None:
@@ -99,12 +104,16 @@ def test_a_key_error_inside_a_reader_is_a_sentence() -> None:
 
 # --- 3MF -----------------------------------------------------------------------------------------------
 
-CT = ('<?xml version="1.0" encoding="UTF-8"?><Types xmlns="http://schemas.openxmlformats.org/package/2006/'
-      'content-types"><Default Extension="model" ContentType="application/vnd.ms-package.3dmanufacturing-3dmodel+xml"/>'
-      '<Default Extension="rels" ContentType="application/vnd.openxmlformats-package.relationships+xml"/></Types>')
-RELS = ('<?xml version="1.0" encoding="UTF-8"?><Relationships xmlns="http://schemas.openxmlformats.org/package/2006/'
-        'relationships"><Relationship Target="/3D/3dmodel.model" Id="rel0" '
-        'Type="http://schemas.microsoft.com/3dmanufacturing/2013/01/3dmodel"/>{extra}</Relationships>')
+CT = (
+    '<?xml version="1.0" encoding="UTF-8"?><Types xmlns="http://schemas.openxmlformats.org/package/2006/'
+    'content-types"><Default Extension="model" ContentType="application/vnd.ms-package.3dmanufacturing-3dmodel+xml"/>'
+    '<Default Extension="rels" ContentType="application/vnd.openxmlformats-package.relationships+xml"/></Types>'
+)
+RELS = (
+    '<?xml version="1.0" encoding="UTF-8"?><Relationships xmlns="http://schemas.openxmlformats.org/package/2006/'
+    'relationships"><Relationship Target="/3D/3dmodel.model" Id="rel0" '
+    'Type="http://schemas.microsoft.com/3dmanufacturing/2013/01/3dmodel"/>{extra}</Relationships>'
+)
 CORE = "http://schemas.microsoft.com/3dmanufacturing/core/2015/02"
 PROD = "http://schemas.microsoft.com/3dmanufacturing/production/2015/06"
 
@@ -127,8 +136,10 @@ def package(model: str, extra_rels: str = "", parts: dict[str, str] | None = Non
 
 
 def model(resources: str, build: str, unit: str = "millimeter", ns: str = "") -> str:
-    return (f'<?xml version="1.0" encoding="UTF-8"?><model unit="{unit}" xmlns="{CORE}"{ns}>'
-            f"<resources>{resources}</resources><build>{build}</build></model>")
+    return (
+        f'<?xml version="1.0" encoding="UTF-8"?><model unit="{unit}" xmlns="{CORE}"{ns}>'
+        f"<resources>{resources}</resources><build>{build}</build></model>"
+    )
 
 
 def cube(a: float, origin: tuple[float, float, float] = (0.0, 0.0, 0.0)) -> tuple[np.ndarray, np.ndarray]:
@@ -137,48 +148,65 @@ def cube(a: float, origin: tuple[float, float, float] = (0.0, 0.0, 0.0)) -> tupl
 
 def test_3mf_support_objects_are_listed_not_weighed() -> None:
     part, support = mesh_xml(*cube(10.0)), mesh_xml(*cube(5.0, (20.0, 0.0, 0.0)))
-    data = package(model(f'<object id="1" type="model" name="part">{part}</object>'
-                         f'<object id="2" type="support" name="prop">{support}</object>',
-                         '<item objectid="1"/><item objectid="2"/>'))
+    data = package(
+        model(
+            f'<object id="1" type="model" name="part">{part}</object><object id="2" type="support" name="prop">{support}</object>',
+            '<item objectid="1"/><item objectid="2"/>',
+        )
+    )
     doc = analyze(data, filename="p.3mf", options=AnalysisOptions(density=1.0)).as_dict()
     assert doc["mass"] == pytest.approx(1000 * 1e-9, rel=1e-14)
     assert any("'prop'" in w and "not weighed" in w for w in doc["warnings"])
 
 
 def test_3mf_production_objects_in_another_model_part_are_read() -> None:
-    other = (f'<?xml version="1.0" encoding="UTF-8"?><model unit="millimeter" xmlns="{CORE}"><resources>'
-             f'<object id="7" type="model">{mesh_xml(*cube(2.0))}</object></resources><build/></model>')
-    root = model('<object id="1" type="model"><components><component objectid="7" p:path="/3D/Objects/cube.model" '
-                 'transform="1 0 0 0 1 0 0 0 1 5 0 0"/></components></object>', '<item objectid="1"/>',
-                 ns=f' xmlns:p="{PROD}" requiredextensions="p"')
-    doc = analyze(package(root, parts={"3D/Objects/cube.model": other}), filename="prod.3mf",
-                  options=AnalysisOptions(units="m", density=1.0)).as_dict()
+    other = (
+        f'<?xml version="1.0" encoding="UTF-8"?><model unit="millimeter" xmlns="{CORE}"><resources>'
+        f'<object id="7" type="model">{mesh_xml(*cube(2.0))}</object></resources><build/></model>'
+    )
+    root = model(
+        '<object id="1" type="model"><components><component objectid="7" p:path="/3D/Objects/cube.model" '
+        'transform="1 0 0 0 1 0 0 0 1 5 0 0"/></components></object>',
+        '<item objectid="1"/>',
+        ns=f' xmlns:p="{PROD}" requiredextensions="p"',
+    )
+    doc = analyze(
+        package(root, parts={"3D/Objects/cube.model": other}), filename="prod.3mf", options=AnalysisOptions(units="m", density=1.0)
+    ).as_dict()
     assert doc["mass"] == pytest.approx(8.0, rel=1e-15)
     np.testing.assert_allclose(doc["center_of_mass"], [6.0, 1.0, 1.0], rtol=1e-15)
 
 
 def test_3mf_mirroring_transform_keeps_the_part_outward() -> None:
-    data = package(model(f'<object id="1" type="model">{mesh_xml(*box(1.0, 2.0, 3.0))}</object>',
-                         '<item objectid="1" transform="-1 0 0 0 1 0 0 0 1 0 0 0"/>'))
+    data = package(
+        model(
+            f'<object id="1" type="model">{mesh_xml(*box(1.0, 2.0, 3.0))}</object>',
+            '<item objectid="1" transform="-1 0 0 0 1 0 0 0 1 0 0 0"/>',
+        )
+    )
     doc = analyze(data, filename="m.3mf", options=AnalysisOptions(units="m", density=1.0)).as_dict()
     assert doc["mass"] == pytest.approx(6.0, rel=1e-15)
     assert not any("winding" in w for w in doc["warnings"])
 
 
-@pytest.mark.parametrize("resources, build, words", [
-    ('<object id="1" type="other">{m}</object>', '<item objectid="1"/>', "type 'other'"),
-    ('<object id="1" type="model">{m}</object><object id="1" type="model">{m}</object>', '<item objectid="1"/>',
-     "used twice"),
-    ('<object id="1" type="model">{m}</object>', '<item objectid="2"/>', "does not define"),
-    ('<object id="1" type="model">{m}</object>', '<item objectid="1" transform="1 0 0 0 1 0 0 0 0 0 0 0"/>',
-     "singular"),
-    ('<object id="1" type="model">{m}</object>', '<item objectid="1" transform="1 0 0"/>', "12"),
-    ('<object id="1" type="shiny">{m}</object>', '<item objectid="1"/>', "type 'shiny'"),
-    ('<object id="1" type="model" pindex="0">{m}</object>', '<item objectid="1"/>', "pindex but no pid"),
-    ('<object id="1" type="model" pid="5" pindex="0">{m}</object>', '<item objectid="1"/>', "property group 5"),
-    ('<object id="1" type="model"><components><component objectid="2"/></components></object>{o2}',
-     '<item objectid="1"/>', "not defined before it"),
-])
+@pytest.mark.parametrize(
+    "resources, build, words",
+    [
+        ('<object id="1" type="other">{m}</object>', '<item objectid="1"/>', "type 'other'"),
+        ('<object id="1" type="model">{m}</object><object id="1" type="model">{m}</object>', '<item objectid="1"/>', "used twice"),
+        ('<object id="1" type="model">{m}</object>', '<item objectid="2"/>', "does not define"),
+        ('<object id="1" type="model">{m}</object>', '<item objectid="1" transform="1 0 0 0 1 0 0 0 0 0 0 0"/>', "singular"),
+        ('<object id="1" type="model">{m}</object>', '<item objectid="1" transform="1 0 0"/>', "12"),
+        ('<object id="1" type="shiny">{m}</object>', '<item objectid="1"/>', "type 'shiny'"),
+        ('<object id="1" type="model" pindex="0">{m}</object>', '<item objectid="1"/>', "pindex but no pid"),
+        ('<object id="1" type="model" pid="5" pindex="0">{m}</object>', '<item objectid="1"/>', "property group 5"),
+        (
+            '<object id="1" type="model"><components><component objectid="2"/></components></object>{o2}',
+            '<item objectid="1"/>',
+            "not defined before it",
+        ),
+    ],
+)
 def test_3mf_must_fail_rules(resources: str, build: str, words: str) -> None:
     m = mesh_xml(*cube(1.0))
     data = package(model(resources.format(m=m, o2=f'<object id="2" type="model">{m}</object>'), build))
@@ -189,8 +217,7 @@ def test_3mf_must_fail_rules(resources: str, build: str, words: str) -> None:
 
 def test_3mf_open_model_object_is_refused_by_the_specification() -> None:
     v, f = cube(1.0)
-    data = package(model(f'<object id="1" type="model" name="lid">{mesh_xml(v, f[:-1])}</object>',
-                         '<item objectid="1"/>'))
+    data = package(model(f'<object id="1" type="model" name="lid">{mesh_xml(v, f[:-1])}</object>', '<item objectid="1"/>'))
     with pytest.raises(NotWatertightError) as err:
         analyze(data, filename="open.3mf")
     assert "'lid'" in err.value.message and "chapter 4.1" in err.value.message
@@ -198,8 +225,10 @@ def test_3mf_open_model_object_is_refused_by_the_specification() -> None:
 
 def test_3mf_relationship_to_an_outside_file_is_refused() -> None:
     m = model(f'<object id="1" type="model">{mesh_xml(*cube(1.0))}</object>', '<item objectid="1"/>')
-    extra = ('<Relationship Target="C:/secret/thumb.png" Id="r9" '
-             'Type="http://schemas.openxmlformats.org/package/2006/relationships/metadata/thumbnail"/>')
+    extra = (
+        '<Relationship Target="C:/secret/thumb.png" Id="r9" '
+        'Type="http://schemas.openxmlformats.org/package/2006/relationships/metadata/thumbnail"/>'
+    )
     with pytest.raises(UnreadableFileError) as err:
         analyze(package(m, extra), filename="ext.3mf")
     assert "outside the package" in err.value.message
@@ -213,17 +242,22 @@ def test_3mf_with_only_supports_is_empty() -> None:
 
 def test_3mf_beam_lattice_required_is_unsupported() -> None:
     beam = "http://schemas.microsoft.com/3dmanufacturing/beamlattice/2017/02"
-    data = package(model(f'<object id="1" type="model">{mesh_xml(*cube(1.0))}</object>', '<item objectid="1"/>',
-                         ns=f' xmlns:b="{beam}" requiredextensions="b"'))
+    data = package(
+        model(
+            f'<object id="1" type="model">{mesh_xml(*cube(1.0))}</object>',
+            '<item objectid="1"/>',
+            ns=f' xmlns:b="{beam}" requiredextensions="b"',
+        )
+    )
     with pytest.raises(UnsupportedFormatError):
         analyze(data, filename="b.3mf")
 
 
 # --- glTF ----------------------------------------------------------------------------------------------
 
+
 def gltf_box_doc() -> dict[str, Any]:
-    data = trimesh.Scene(trimesh.Trimesh(*box(1.0, 2.0, 3.0), process=False)).export(file_type="gltf",
-                                                                                      embed_buffers=True)
+    data = trimesh.Scene(trimesh.Trimesh(*box(1.0, 2.0, 3.0), process=False)).export(file_type="gltf", embed_buffers=True)
     return cast("dict[str, Any]", json.loads(data["model.gltf"]))
 
 
@@ -238,14 +272,16 @@ def test_gltf_mirrored_node_is_read_outward() -> None:
     assert not any("winding" in w for w in res["warnings"])
 
 
-@pytest.mark.parametrize("change, words", [
-    (lambda d: d["accessors"][d["meshes"][0]["primitives"][0]["attributes"]["POSITION"]].update(
-        sparse={"count": 1}), "sparse"),
-    (lambda d: d["meshes"][0]["primitives"][0].update(mode=6), "triangle fan"),
-    (lambda d: d.update(extensionsRequired=["KHR_draco_mesh_compression"]), "KHR_draco_mesh_compression"),
-    (lambda d: d["meshes"][0].update(weights=[0.5]), "morph"),
-    (lambda d: [n.update(skin=0) for n in d["nodes"] if "mesh" in n], "skinned"),
-])
+@pytest.mark.parametrize(
+    "change, words",
+    [
+        (lambda d: d["accessors"][d["meshes"][0]["primitives"][0]["attributes"]["POSITION"]].update(sparse={"count": 1}), "sparse"),
+        (lambda d: d["meshes"][0]["primitives"][0].update(mode=6), "triangle fan"),
+        (lambda d: d.update(extensionsRequired=["KHR_draco_mesh_compression"]), "KHR_draco_mesh_compression"),
+        (lambda d: d["meshes"][0].update(weights=[0.5]), "morph"),
+        (lambda d: [n.update(skin=0) for n in d["nodes"] if "mesh" in n], "skinned"),
+    ],
+)
 def test_gltf_geometry_trimesh_would_misread_is_refused(change: str, words: str) -> None:
     doc = gltf_box_doc()
     change(doc)  # type: ignore[operator]
@@ -255,6 +291,7 @@ def test_gltf_geometry_trimesh_would_misread_is_refused(change: str, words: str)
 
 
 # --- several files in one upload -------------------------------------------------------------------------
+
 
 def test_an_upload_of_two_models_is_refused_with_advice() -> None:
     v, f = box(1.0, 1.0, 1.0)

@@ -32,7 +32,7 @@ def test_rotated_tensor_estimate_is_never_below_the_error(exponent: float) -> No
     worst = 0.0
     for _ in range(20):
         i3 = 10 ** rng.uniform(-6, 6)
-        i1 = i3 * 10 ** exponent
+        i1 = i3 * 10**exponent
         i2 = rng.uniform(max(i1, i3 - i1), i3)  # a body: I1 + I2 >= I3
         r = special_ortho_group.rvs(3, random_state=rng)
         tensor = r @ np.diag([i1, i2, i3]) @ r.T

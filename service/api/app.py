@@ -15,6 +15,7 @@ from .errors import install_error_handlers
 from .middleware import AccessLog, Guard, LastResort
 from .pages import install_pages
 from .routes import health, v1
+from .schemas import error_responses
 from .settings import Settings
 from .uploads import Workspace
 
@@ -57,10 +58,19 @@ def create_app(settings: Settings | None = None) -> FastAPI:
     app.state.pool = pool
     app.state.workspace = workspace
     install_error_handlers(app)
-    # the key is checked by Guard before the body is read; the dependency only documents it
-    security = [Depends(APIKeyHeader(name="X-API-Key", auto_error=False))] if settings.api_key else []
+    # the key is checked by Guard before the body is read; the dependency only documents it (the security
+    # scheme that lets /docs "Try it out" send the key) and the 401 every /v1 route may then answer
     app.include_router(health)
-    app.include_router(v1, dependencies=security)
+    if settings.api_key:
+        key = APIKeyHeader(
+            name="X-API-Key",
+            scheme_name="APIKey",
+            auto_error=False,
+            description="the server's INERTIA_API_KEY; /healthz needs none",
+        )
+        app.include_router(v1, dependencies=[Depends(key)], responses=error_responses(401))
+    else:
+        app.include_router(v1)
     install_pages(app)
     app.add_middleware(LastResort)
     app.add_middleware(Guard, settings=settings)

@@ -29,6 +29,7 @@ input that needs more fails with ``MemoryError`` (413) in that process only.
 from __future__ import annotations
 
 import asyncio
+import importlib
 import logging
 import math
 import multiprocessing
@@ -43,11 +44,11 @@ from contextlib import contextmanager
 from multiprocessing.connection import Connection
 from typing import Any
 
-from ..errors import ComputeTimeoutError, ServerBusyError, ServiceError, UnreadableFileError
+from ..errors import ServerBusyError, ServiceError, UnreadableFileError
 from .jobs import Job, MeshJob, run_job
+from .transport import ComputeTimeoutError
 
-__all__ = ["ComputePool", "WorkerCrashError", "memory_limit", "MEMORY_FLOOR_BYTES", "MEMORY_FACTOR",
-           "COMPRESSED_MEMORY_FACTOR"]
+__all__ = ["ComputePool", "WorkerCrashError", "memory_limit", "MEMORY_FLOOR_BYTES", "MEMORY_FACTOR", "COMPRESSED_MEMORY_FACTOR"]
 
 MIB = 1024 * 1024
 # A job may map this much more than its process did before it, plus a multiple of its upload's size.
@@ -65,11 +66,13 @@ def memory_limit(size: int, filename: str | None, cap: int) -> int:
     factor = COMPRESSED_MEMORY_FACTOR if (filename or "").lower().endswith(_COMPRESSED) else MEMORY_FACTOR
     return min(cap, MEMORY_FLOOR_BYTES + factor * size)
 
+
 _ROOT = __name__.split(".")[0]  # "inertia" when installed; the folder's name when run from a checkout
 log = logging.getLogger("inertia.api")
 
 PRELOAD = [f"{_ROOT}.api.jobs", f"{_ROOT}.report", f"{_ROOT}.load.stl", f"{_ROOT}.load.meshes", f"{_ROOT}.motion"]
 KILL_GRACE_S = 5.0  # how long to wait for a killed process to be reaped
+START_TIMEOUT_S = 60.0  # how long a new compute process may take to import what jobs need
 
 
 class WorkerCrashError(RuntimeError):
@@ -117,7 +120,13 @@ def _memory_bounded(limit: int | None) -> Iterator[None]:
 
 
 def _serve_jobs(conn: Connection) -> None:
-    """Main loop of a compute process: receive a job, send back its outcome."""
+    """Main loop of a compute process: say it is ready, then receive a job, send back its outcome."""
+    # What a job needs is imported before the process counts as started, so a job's deadline never pays for
+    # it: the forkserver is one per parent process and may have been started by someone else (the batch
+    # engine) without these modules preloaded, which made a replacement's first job seconds long.
+    for name in PRELOAD:
+        importlib.import_module(name)
+    conn.send(("ready", os.getpid()))
     while True:
         try:
             job = conn.recv()
@@ -168,6 +177,18 @@ class _Worker:
             self.process.start()
         child.close()
         self.conn = parent
+        # start() returns once the process exists; wait until it has imported what jobs need and said so,
+        # so that starting it (not counted against a job's deadline) really is over before a job is sent
+        try:
+            ready = parent.poll(START_TIMEOUT_S) and parent.recv()[0] == "ready"
+        except (EOFError, OSError):
+            ready = False
+        if not ready:
+            self.kill()
+            parent.close()
+            raise WorkerCrashError(
+                f"compute process did not start within {START_TIMEOUT_S:g} s (exit code {self.process.exitcode})"
+            )
 
     def call(self, job: Job) -> tuple[str, Any]:
         try:
@@ -191,7 +212,9 @@ def _died_on(job: MeshJob, worker: _Worker) -> UnreadableFileError:
     return UnreadableFileError(
         f"the reader stopped abnormally on this file (exit code {code}); the file may be corrupt or need more "
         f"than the {job.memory_limit_bytes or 0} bytes of memory allowed for it; check it or send a simpler one",
-        exit_code=code, limit_bytes=job.memory_limit_bytes)
+        exit_code=code,
+        limit_bytes=job.memory_limit_bytes,
+    )
 
 
 class ComputePool:
@@ -215,8 +238,7 @@ class ComputePool:
         # Made on first use, so a pool that was closed (end of a lifespan) can serve again.
         with self._lock:
             if self._executor is None:
-                self._executor = ThreadPoolExecutor(max_workers=2 * self.size + 2,
-                                                    thread_name_prefix="inertia-pipe")
+                self._executor = ThreadPoolExecutor(max_workers=2 * self.size + 2, thread_name_prefix="inertia-pipe")
             return self._executor
 
     async def warm_up(self) -> None:
@@ -234,8 +256,7 @@ class ComputePool:
         try:
             await asyncio.wait_for(slots.acquire(), self.timeout_s)
         except TimeoutError:
-            raise self._timeout("the server is busy; no compute process became free",
-                                retry_after_s=self._retry_after()) from None
+            raise self._timeout("the server is busy; no compute process became free", retry_after_s=self._retry_after()) from None
         finally:
             self._waiting -= 1
         start = time.monotonic()
@@ -249,9 +270,12 @@ class ComputePool:
         return max(1, math.ceil(self._job_s * (self._waiting + 1) / self.size))
 
     def _busy(self) -> ServerBusyError:
-        return ServerBusyError(f"the server is busy: {self.size} analyses are running and {self._waiting} are "
-                               "waiting; retry after the time in the Retry-After header",
-                               retry_after_s=self._retry_after(), waiting=self._waiting)
+        return ServerBusyError(
+            f"the server is busy: {self.size} analyses are running and {self._waiting} are "
+            "waiting; retry after the time in the Retry-After header",
+            retry_after_s=self._retry_after(),
+            waiting=self._waiting,
+        )
 
     def _slots_of(self, loop: asyncio.AbstractEventLoop) -> asyncio.Semaphore:
         # a semaphore belongs to one event loop; a server has one, test clients may make several
@@ -263,8 +287,7 @@ class ComputePool:
         loop = asyncio.get_running_loop()
         worker = await loop.run_in_executor(self._threads, self._acquire)
         try:
-            status, payload = await asyncio.wait_for(loop.run_in_executor(self._threads, worker.call, job),
-                                                     self.timeout_s)
+            status, payload = await asyncio.wait_for(loop.run_in_executor(self._threads, worker.call, job), self.timeout_s)
         except TimeoutError:
             await loop.run_in_executor(self._threads, worker.kill)
             raise self._timeout("the computation took too long and was stopped") from None
@@ -284,8 +307,11 @@ class ComputePool:
         raise WorkerCrashError(f"compute process failed:\n{payload}")
 
     def _timeout(self, what: str, **details: Any) -> ComputeTimeoutError:
-        return ComputeTimeoutError(f"{what} (limit {self.timeout_s:g} s); send a smaller input or "
-                                   "raise INERTIA_TIMEOUT_S", timeout_s=self.timeout_s, **details)
+        return ComputeTimeoutError(
+            f"{what} (limit {self.timeout_s:g} s); send a smaller input or raise INERTIA_TIMEOUT_S",
+            timeout_s=self.timeout_s,
+            **details,
+        )
 
     def _acquire(self) -> _Worker:
         with self._lock:

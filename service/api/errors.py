@@ -16,18 +16,17 @@ from starlette.exceptions import HTTPException
 from starlette.responses import JSONResponse
 
 from ..errors import (
-    ComputeTimeoutError,
     DegenerateBodyError,
+    InputTooLargeError,
     InvalidInertiaError,
     InvalidMeshError,
     InvalidParameterError,
     LoadError,
-    PayloadTooLargeError,
     ServerBusyError,
     ServiceError,
-    UnauthorizedError,
     UnsupportedFormatError,
 )
+from .transport import ComputeTimeoutError, PayloadTooLargeError, UnauthorizedError
 
 __all__ = ["STATUS", "error_response", "install_error_handlers", "status_of", "internal_error_response"]
 
@@ -41,6 +40,7 @@ STATUS: dict[type[ServiceError], int] = {
     DegenerateBodyError: 422,  # zero_volume, insufficient_precision
     InvalidParameterError: 422,
     InvalidInertiaError: 422,
+    InputTooLargeError: 413,
     PayloadTooLargeError: 413,
     UnauthorizedError: 401,
     ComputeTimeoutError: 503,
@@ -70,9 +70,17 @@ def error_response(exc: ServiceError) -> JSONResponse:
 def internal_error_response() -> JSONResponse:
     """The envelope of an unexpected failure; the connection is closed cleanly after it (``Connection: close``),
     so a keep-alive client's next request goes on a new connection instead of into a reset one."""
-    return JSONResponse({"error": {"code": "internal_error", "message": "the server failed unexpectedly; the error "
-                                   "was logged, please report it with the input that caused it", "details": {}}},
-                        status_code=500, headers={"Connection": "close"})
+    return JSONResponse(
+        {
+            "error": {
+                "code": "internal_error",
+                "message": "the server failed unexpectedly; the error was logged, please report it with the input that caused it",
+                "details": {},
+            }
+        },
+        status_code=500,
+        headers={"Connection": "close"},
+    )
 
 
 def _envelope(status: int, code: str, message: str, **details: Any) -> JSONResponse:
@@ -90,8 +98,14 @@ def _where(loc: tuple[Any, ...]) -> str:
 
 def invalid_request(exc: RequestValidationError) -> InvalidParameterError:
     """A schema failure as ``invalid_parameter``, naming the first bad field."""
-    errors = [{"loc": [str(p) if not isinstance(p, int) else p for p in e.get("loc", ())],
-               "msg": str(e.get("msg", "")), "type": str(e.get("type", ""))} for e in exc.errors()]
+    errors = [
+        {
+            "loc": [str(p) if not isinstance(p, int) else p for p in e.get("loc", ())],
+            "msg": str(e.get("msg", "")),
+            "type": str(e.get("type", "")),
+        }
+        for e in exc.errors()
+    ]
     first = errors[0] if errors else {"loc": [], "msg": "invalid request"}
     message = f"{_where(tuple(first['loc']))}: {first['msg']}; fix it and send the request again"
     parameter = str(first["loc"][-1]) if first["loc"] else None
@@ -117,8 +131,9 @@ async def _http_error(request: Request, exc: Exception) -> JSONResponse:
         return _envelope(422, "invalid_parameter", f"{detail}; send well-formed JSON or multipart data")
     code = _HTTP_CODES.get(exc.status_code, "http_error")
     message = f"{detail}: {request.method} {request.url.path}; see /docs for the endpoints"
-    return JSONResponse({"error": {"code": code, "message": message, "details": {}}},
-                        status_code=exc.status_code, headers=exc.headers)
+    return JSONResponse(
+        {"error": {"code": code, "message": message, "details": {}}}, status_code=exc.status_code, headers=exc.headers
+    )
 
 
 async def _unexpected_error(request: Request, exc: Exception) -> JSONResponse:

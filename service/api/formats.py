@@ -21,5 +21,4 @@ OPTIONAL_READERS: dict[str, tuple[str, str]] = {
 @cache
 def unavailable_formats() -> dict[str, str]:
     """Formats whose reader cannot be imported here, with what enables each."""
-    return {fmt: needs for fmt, (module, needs) in OPTIONAL_READERS.items()
-            if importlib.util.find_spec(module) is None}
+    return {fmt: needs for fmt, (module, needs) in OPTIONAL_READERS.items() if importlib.util.find_spec(module) is None}

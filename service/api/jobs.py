@@ -28,13 +28,16 @@ from contextlib import contextmanager
 from dataclasses import dataclass
 from typing import Any
 
-from ..errors import InvalidParameterError, PayloadTooLargeError, ServiceError, UnreadableFileError
+from ..errors import InvalidParameterError, ServiceError, UnreadableFileError
 from ..pipeline import AnalysisOptions, analyze_loaded, analyze_points, precession
+from .transport import PayloadTooLargeError
 
 log = logging.getLogger("inertia.api")
 
-_OUT_OF_RANGE = ("the input's numbers are too large or too small to compute with in float64 "
-                 "(the result would overflow or divide by zero); rescale the input, e.g. other units")
+_OUT_OF_RANGE = (
+    "the input's numbers are too large or too small to compute with in float64 "
+    "(the result would overflow or divide by zero); rescale the input, e.g. other units"
+)
 
 __all__ = ["MeshJob", "PointsJob", "PrecessionJob", "Job", "run_job", "is_small"]
 
@@ -67,8 +70,7 @@ class MeshJob:
 def _without_paths(exc: ServiceError, job: MeshJob) -> ServiceError:
     """The error with the server's own file and folder names replaced by the client's file name."""
     label = job.filename or "the upload"
-    files = job.source if isinstance(job.source, tuple) else ((label, job.source),) if isinstance(job.source, str) \
-        else ()
+    files = job.source if isinstance(job.source, tuple) else ((label, job.source),) if isinstance(job.source, str) else ()
     ours = [(path, name) for name, path in files] + [(p, "<temp>") for p in (job.workdir, tempfile.gettempdir()) if p]
 
     def scrub(value: Any) -> Any:
@@ -142,18 +144,20 @@ def _load(source: bytes | str | tuple[tuple[str, str], ...], filename: str | Non
     try:
         if isinstance(source, tuple):
             return load_body(_read_files(source), format=options.format, units=options.units, isotopes=options.isotopes)
-        return load_body(source, filename=filename, format=options.format, units=options.units,
-                         isotopes=options.isotopes)
+        return load_body(source, filename=filename, format=options.format, units=options.units, isotopes=options.isotopes)
     except (ServiceError, MemoryError):
         raise
     except RecursionError:
-        raise UnreadableFileError("the file nests its structure too deeply to read; no mesh file needs that",
-                                  reason="RecursionError") from None
+        raise UnreadableFileError(
+            "the file nests its structure too deeply to read; no mesh file needs that", reason="RecursionError"
+        ) from None
     except (Exception, SystemExit) as exc:  # a reader's own failure on this file, untranslated below load/
         log.warning("unclassified reader failure on %r, reported as unreadable_file", filename, exc_info=exc)
         raise UnreadableFileError(
             f"the file could not be read ({type(exc).__name__}: {_first_line(exc)}); check that it is a valid "
-            "file of its format, or export it again", reason=type(exc).__name__) from None
+            "file of its format, or export it again",
+            reason=type(exc).__name__,
+        ) from None
 
 
 def _first_line(exc: BaseException) -> str:
@@ -178,8 +182,10 @@ def run_job(job: Job) -> dict[str, Any]:
         limit = job.memory_limit_bytes
         raise PayloadTooLargeError(
             "the analysis needed more memory than this server allows for an input of this size"
-            + (f" ({limit} bytes)" if limit else "") + "; send a smaller or simpler file",
-            limit_bytes=limit) from None
+            + (f" ({limit} bytes)" if limit else "")
+            + "; send a smaller or simpler file",
+            limit_bytes=limit,
+        ) from None
     if not _finite(doc):
         log.warning("non-finite number in the result of %s, reported as invalid_parameter", type(job).__name__)
         raise InvalidParameterError(_OUT_OF_RANGE, reason="non-finite result")
@@ -187,7 +193,10 @@ def run_job(job: Job) -> dict[str, Any]:
     if isinstance(mass, float) and not mass >= sys.float_info.min:  # zero or subnormal: underflowed
         raise InvalidParameterError(
             f"the mass comes out as {mass!r}: the density or masses are too small to compute with in float64 "
-            "(the product underflowed); use larger units of mass or density", parameter="density", mass=mass)
+            "(the product underflowed); use larger units of mass or density",
+            parameter="density",
+            mass=mass,
+        )
     return doc
 
 

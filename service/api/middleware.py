@@ -10,9 +10,10 @@ from typing import Any
 
 from starlette.types import ASGIApp, Message, Receive, Scope, Send
 
-from ..errors import PayloadTooLargeError, ServiceError, UnauthorizedError
+from ..errors import ServiceError
 from .errors import error_response, internal_error_response
 from .settings import Settings
+from .transport import PayloadTooLargeError, UnauthorizedError
 
 __all__ = ["AccessLog", "Guard", "LastResort"]
 
@@ -45,11 +46,18 @@ class AccessLog:
             await self.app(scope, receive, send_logged)
         finally:
             client = scope.get("client")
-            access_log.info(json.dumps({
-                "event": "access", "method": scope["method"], "path": scope["path"], "status": status,
-                "elapsed_ms": round((time.perf_counter() - start) * 1e3, 3),
-                "client": client[0] if client else None,
-            }))
+            access_log.info(
+                json.dumps(
+                    {
+                        "event": "access",
+                        "method": scope["method"],
+                        "path": scope["path"],
+                        "status": status,
+                        "elapsed_ms": round((time.perf_counter() - start) * 1e3, 3),
+                        "client": client[0] if client else None,
+                    }
+                )
+            )
 
 
 class LastResort:
@@ -128,7 +136,9 @@ class Guard:
             details["content_length"] = size
         return PayloadTooLargeError(
             f"the request body is larger than the limit of {self.limit} bytes; send a smaller file "
-            "or raise INERTIA_MAX_UPLOAD_BYTES", **details)
+            "or raise INERTIA_MAX_UPLOAD_BYTES",
+            **details,
+        )
 
     async def _counted(self, scope: Scope, receive: Receive, send: Send) -> None:
         received = 0

@@ -49,9 +49,16 @@ async def _one(pool: ComputePool, item: Item, options: AnalysisOptions, folder: 
         return _error_line(item.filename, exc)
     except Exception as exc:
         log.error("unexpected error on batch file %r", item.filename, exc_info=exc)
-        return _line({"source": {"filename": item.filename}, "error": {
-            "code": "internal_error", "message": "the server failed on this file; the error was logged",
-            "details": {}}})
+        return _line(
+            {
+                "source": {"filename": item.filename},
+                "error": {
+                    "code": "internal_error",
+                    "message": "the server failed on this file; the error was logged",
+                    "details": {},
+                },
+            }
+        )
 
 
 def _next(items: Iterator[Item]) -> tuple[Item | None, bool]:
@@ -61,13 +68,18 @@ def _next(items: Iterator[Item]) -> tuple[Item | None, bool]:
         item = next(items, None)
     except Exception as exc:
         log.error("unpacking the batch failed", exc_info=exc)
-        return Item(None, error=UnreadableFileError(f"the upload could not be unpacked further ({type(exc).__name__});"
-                                                    " the files before this line were analysed")), True
+        return Item(
+            None,
+            error=UnreadableFileError(
+                f"the upload could not be unpacked further ({type(exc).__name__}); the files before this line were analysed"
+            ),
+        ), True
     return item, item is None
 
 
-async def batch_lines(items: Iterator[Item], options: AnalysisOptions, pool: ComputePool, window: int,
-                      folder: str, memory_cap: int) -> AsyncIterator[bytes]:
+async def batch_lines(
+    items: Iterator[Item], options: AnalysisOptions, pool: ComputePool, window: int, folder: str, memory_cap: int
+) -> AsyncIterator[bytes]:
     """NDJSON lines of ``items`` (a blocking iterator: read off the event loop); removes ``folder`` at the end."""
     pending: deque[asyncio.Task[bytes]] = deque()
     try:

@@ -1,34 +1,52 @@
-"""Every pydantic model of the HTTP API: requests (strict) and responses (documented).
+"""Every pydantic model of the HTTP API: requests and responses, both strict.
 
-Requests forbid unknown fields and non-finite numbers. Responses mirror the
-contract (API.md, "The analysis result"); they are built from the pipeline's
-``as_dict`` and keep only the sections present (absent, never null).
+Requests forbid unknown fields and non-finite numbers. Responses are the
+result model's one serialisation (``inertia.results``, ``as_dict``), each
+section a model that forbids keys it does not name, so a response the
+service sends is one the OpenAPI schema describes (a key added to the result
+model and not here fails every response that carries it, in the tests).
+The ``source`` and ``diagnostics`` models are generated from the result
+model's own dataclasses. Sections appear only when present (absent, never null).
+Every error status is documented with the envelope and an example.
 """
 
 from __future__ import annotations
 
 import json
 import math
-from typing import Annotated, Any, Literal
+from dataclasses import MISSING, fields
+from typing import Annotated, Any, Literal, get_type_hints
 
-from pydantic import BaseModel, ConfigDict, Field, model_validator
+from pydantic import BaseModel, ConfigDict, Field, create_model, model_validator
 
 from ..errors import InvalidParameterError
-from ..pipeline import METHODS, AnalysisOptions
+from ..options import METHODS, AnalysisOptions
+from ..results import Diagnostics, Source
+from .settings import MIN_SAMPLES, max_samples
 
 __all__ = [
-    "MeshQuery", "PointIn", "PointsRequest", "PrecessionRequest",
-    "AnalysisOut", "PrecessionOut", "PrecessionResponse", "ErrorOut", "HealthOut", "FormatsOut",
+    "MeshQuery",
+    "PointIn",
+    "PointsRequest",
+    "PrecessionRequest",
+    "AnalysisOut",
+    "PrecessionOut",
+    "PrecessionResponse",
+    "ErrorOut",
+    "HealthOut",
+    "FormatsOut",
     "UnavailableFormatOut",
-    "ERROR_RESPONSES",
+    "MAX_SAMPLES",
+    "error_responses",
 ]
 
 Method = Literal["exact", "dop853", "rk45", "splitting"]
 assert set(METHODS) == set(Method.__args__)  # type: ignore[attr-defined]
 
-# a trajectory of this many samples is ~2.3 MB of JSON and under a second of compute;
-# longer ones belong to the CLI or the library, not to one HTTP response
-MAX_SAMPLES = 10_000
+# the most trajectory samples one HTTP response carries (INERTIA_MAX_SAMPLES, default 10000: ~2.3 MB of
+# JSON and under a second of compute); longer ones belong to the CLI or the library
+MAX_SAMPLES = max_samples()
+_SAMPLES = f"number of time samples, {MIN_SAMPLES} to {MAX_SAMPLES} (the server's INERTIA_MAX_SAMPLES)"
 
 # request numbers beyond 1e100 in magnitude are refused: products of a few of them (m r^2,
 # I omega^2) would leave float64, and no body in SI units comes near
@@ -83,68 +101,89 @@ def _densities(text: str | None) -> dict[str, float] | None:
     try:
         value = json.loads(text, parse_constant=_reject_constant)
     except ValueError as exc:
-        raise InvalidParameterError(f"densities must be a JSON object of finite numbers: {exc}",
-                                    parameter="densities") from None
+        raise InvalidParameterError(f"densities must be a JSON object of finite numbers: {exc}", parameter="densities") from None
     except RecursionError:
-        raise InvalidParameterError('densities nests too deeply; send a flat JSON object {"part name": density}',
-                                    parameter="densities") from None
-    if not isinstance(value, dict) or not all(
-            isinstance(v, (int, float)) and not isinstance(v, bool) for v in value.values()):
-        raise InvalidParameterError('densities must be a JSON object {"part name": density in kg/m^3}',
-                                    parameter="densities")
+        raise InvalidParameterError(
+            'densities nests too deeply; send a flat JSON object {"part name": density}', parameter="densities"
+        ) from None
+    if not isinstance(value, dict) or not all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in value.values()):
+        raise InvalidParameterError('densities must be a JSON object {"part name": density in kg/m^3}', parameter="densities")
     return {str(k): float(v) for k, v in value.items()}
 
 
 class MeshQuery(_Request):
     """Query parameters of /v1/analyze/mesh and /v1/batch."""
 
-    format: str | None = Field(None, description="file format (stl, obj, ply, off, glb, gltf, 3mf, vtu, vtk, msh, "
-                               "...); inferred from the file name when absent", examples=["stl"])
-    units: str | None = Field(None, description="length unit of the file: m, cm, mm, um, in, ft, angstrom "
-                              "(default m; angstrom for xyz)",
-                              examples=["m"])
-    density: float | None = Field(None, gt=0, le=MAX_MAGNITUDE,
-                                  description="density [kg/m^3] (default 1000); exclusive with mass")
+    format: str | None = Field(
+        None,
+        description="file format (stl, obj, ply, off, glb, gltf, 3mf, vtu, vtk, msh, ...); inferred from the file name when absent",
+        examples=["stl"],
+    )
+    units: str | None = Field(
+        None, description="length unit of the file: m, cm, mm, um, in, ft, angstrom (default m; angstrom for xyz)", examples=["m"]
+    )
+    density: float | None = Field(None, gt=0, le=MAX_MAGNITUDE, description="density [kg/m^3] (default 1000); exclusive with mass")
     mass: float | None = Field(None, gt=0, le=MAX_MAGNITUDE, description="total mass [kg]; the density is then derived")
-    model: Literal["solid", "shell"] = Field("solid", description="solid (closed surface or volume mesh) or "
-                                             "shell (thin surface, needs thickness)")
+    model: Literal["solid", "shell"] = Field(
+        "solid", description="solid (closed surface or volume mesh) or shell (thin surface, needs thickness)"
+    )
     thickness: float | None = Field(None, gt=0, le=MAX_MAGNITUDE, description="shell wall thickness [file units]")
     tolerance: float = Field(1e-6, gt=0, lt=1, description="relative tolerance for equal principal moments")
-    reference: str | None = Field(None, description="'x,y,z' point [file units]: also report the tensor about it",
-                                  examples=["0,0,0"])
-    omega: str | None = Field(None, description="'wx,wy,wz' initial angular velocity [rad/s], input frame: "
-                              "adds precession", examples=["0,0.1,1"])
+    reference: str | None = Field(
+        None, description="'x,y,z' point [file units]: also report the tensor about it", examples=["0,0,0"]
+    )
+    omega: str | None = Field(
+        None, description="'wx,wy,wz' initial angular velocity [rad/s], input frame: adds precession", examples=["0,0.1,1"]
+    )
     duration: float | None = Field(None, gt=0, le=MAX_MAGNITUDE, description="with omega: seconds to predict [s]")
-    samples: int | None = Field(None, ge=1, le=MAX_SAMPLES,
-                                description="with omega: number of time samples (at most 10000)")
+    samples: int | None = Field(None, ge=MIN_SAMPLES, le=MAX_SAMPLES, description=f"with omega: {_SAMPLES}")
     method: Method = Field("exact", description="with omega: exact, dop853, rk45 or splitting")
-    densities: str | None = Field(None, description="JSON object: part name -> density [kg/m^3]",
-                                  examples=['{"bracket": 7850}'])
-    geometry: Literal["brep", "mesh"] = Field("brep", description="CAD files (STEP, IGES): integrate the exact "
-                                              "B-rep (brep) or its tessellation (mesh)")
-    deflection: float | None = Field(None, gt=0, lt=1, description="with geometry=mesh: chordal deflection "
-                                     "relative to the bounding-box diagonal [1] (default 1e-3)")
+    densities: str | None = Field(None, description="JSON object: part name -> density [kg/m^3]", examples=['{"bracket": 7850}'])
+    geometry: Literal["brep", "mesh"] = Field(
+        "brep", description="CAD files (STEP, IGES): integrate the exact B-rep (brep) or its tessellation (mesh)"
+    )
+    deflection: float | None = Field(
+        None,
+        gt=0,
+        lt=1,
+        description="with geometry=mesh: chordal deflection relative to the bounding-box diagonal [1] (default 1e-3)",
+    )
     export: ExportFormat | None = Field(None, description="urdf, sdf or mjcf: adds the format's inertial element")
-    frame: str | None = Field(None, description="'w,x,y,z' unit quaternion carrying a named frame's axes into the "
-                              "input frame: adds the frame section", examples=["1,0,0,0"])
-    isotopes: Isotopes = Field("standard", description="atoms of an XYZ file: standard atomic weights or the most "
-                               "abundant isotope")
+    frame: str | None = Field(
+        None,
+        description="'w,x,y,z' unit quaternion carrying a named frame's axes into the input frame: adds the frame section",
+        examples=["1,0,0,0"],
+    )
+    isotopes: Isotopes = Field("standard", description="atoms of an XYZ file: standard atomic weights or the most abundant isotope")
 
     def as_options(self) -> AnalysisOptions:
         return AnalysisOptions(
-            format=self.format, units=self.units, density=self.density, mass=self.mass, model=self.model,
-            thickness=self.thickness, tolerance=self.tolerance, reference=_triple("reference", self.reference),
-            omega=_triple("omega", self.omega), duration=self.duration, samples=self.samples,
-            method=self.method, densities=_densities(self.densities),
-            export=self.export, frame=_quaternion(self.frame), isotopes=self.isotopes,
-            geometry=self.geometry, deflection=self.deflection)
+            format=self.format,
+            units=self.units,
+            density=self.density,
+            mass=self.mass,
+            model=self.model,
+            thickness=self.thickness,
+            tolerance=self.tolerance,
+            reference=_triple("reference", self.reference),
+            omega=_triple("omega", self.omega),
+            duration=self.duration,
+            samples=self.samples,
+            method=self.method,
+            densities=_densities(self.densities),
+            export=self.export,
+            frame=_quaternion(self.frame),
+            isotopes=self.isotopes,
+            geometry=self.geometry,
+            deflection=self.deflection,
+        )
 
 
 class PointIn(_Request):
-    mass: float | None = Field(None, gt=0, le=MAX_MAGNITUDE, description="point mass [kg, or u with mass_unit=u]; "
-                               "wins over element")
-    element: str | None = Field(None, max_length=8, description="element symbol instead of a mass: 'O', '13C', 'D'",
-                                examples=["O"])
+    mass: float | None = Field(
+        None, gt=0, le=MAX_MAGNITUDE, description="point mass [kg, or u with mass_unit=u]; wins over element"
+    )
+    element: str | None = Field(None, max_length=8, description="element symbol instead of a mass: 'O', '13C', 'D'", examples=["O"])
     position: RealVector = Field(description="position [units of the request]")
 
     @model_validator(mode="after")
@@ -155,9 +194,10 @@ class PointIn(_Request):
 
 
 _POINTS_EXAMPLE: dict[str, Any] = {
-    "points": [{"mass": 1.0, "position": [0, 0, 0]}, {"mass": 2.0, "position": [1, 0, 0]},
-               {"mass": 1.0, "position": [0, 1, 0]}],
-    "units": "m", "tolerance": 1e-6, "reference": [0, 0, 0],
+    "points": [{"mass": 1.0, "position": [0, 0, 0]}, {"mass": 2.0, "position": [1, 0, 0]}, {"mass": 1.0, "position": [0, 1, 0]}],
+    "units": "m",
+    "tolerance": 1e-6,
+    "reference": [0, 0, 0],
 }
 
 
@@ -167,20 +207,20 @@ class PointsRequest(_Request):
     model_config = ConfigDict(json_schema_extra={"examples": [_POINTS_EXAMPLE]})
 
     points: list[PointIn] = Field(min_length=1, description="point masses")
-    units: str | None = Field(None, description="length unit of the positions: m, cm, mm, um, in, ft, angstrom "
-                              "(default m)")
+    units: str | None = Field(None, description="length unit of the positions: m, cm, mm, um, in, ft, angstrom (default m)")
     mass_unit: Literal["kg", "u"] = Field("kg", description="unit of given masses: kg, or u (dalton)")
-    isotopes: Isotopes = Field("standard", description="masses of points given by element: standard atomic weights "
-                               "or the most abundant isotope")
+    isotopes: Isotopes = Field(
+        "standard", description="masses of points given by element: standard atomic weights or the most abundant isotope"
+    )
     export: ExportFormat | None = Field(None, description="urdf, sdf or mjcf: adds the format's inertial element")
-    frame: Quaternion | None = Field(None, description="[w, x, y, z] unit quaternion carrying a named frame's axes "
-                                     "into the input frame: adds the frame section")
+    frame: Quaternion | None = Field(
+        None, description="[w, x, y, z] unit quaternion carrying a named frame's axes into the input frame: adds the frame section"
+    )
     tolerance: float = Field(1e-6, gt=0, lt=1, description="relative tolerance for equal principal moments")
     reference: RealVector | None = Field(None, description="also report the tensor about this point [units]")
     omega: RealVector | None = Field(None, description="initial angular velocity [rad/s]: adds precession")
     duration: float | None = Field(None, gt=0, le=MAX_MAGNITUDE, description="with omega: seconds to predict [s]")
-    samples: int | None = Field(None, ge=1, le=MAX_SAMPLES,
-                                description="with omega: number of time samples (at most 10000)")
+    samples: int | None = Field(None, ge=MIN_SAMPLES, le=MAX_SAMPLES, description=f"with omega: {_SAMPLES}")
     method: Method = Field("exact", description="with omega: exact, dop853, rk45 or splitting")
 
     def records(self) -> list[dict[str, Any]]:
@@ -188,29 +228,40 @@ class PointsRequest(_Request):
 
     def as_options(self) -> AnalysisOptions:
         return AnalysisOptions(
-            units=self.units, tolerance=self.tolerance, method=self.method, duration=self.duration,
-            samples=self.samples, mass_unit=self.mass_unit, isotopes=self.isotopes, export=self.export,
+            units=self.units,
+            tolerance=self.tolerance,
+            method=self.method,
+            duration=self.duration,
+            samples=self.samples,
+            mass_unit=self.mass_unit,
+            isotopes=self.isotopes,
+            export=self.export,
             frame=None if self.frame is None else tuple(self.frame),  # type: ignore[arg-type]
             reference=None if self.reference is None else tuple(self.reference),  # type: ignore[arg-type]
-            omega=None if self.omega is None else tuple(self.omega))  # type: ignore[arg-type]
+            omega=None if self.omega is None else tuple(self.omega),  # type: ignore[arg-type]
+        )
 
 
 class PrecessionRequest(_Request):
     """Body of /v1/precession: exactly one of inertia_tensor or principal_moments, and omega."""
 
-    model_config = ConfigDict(json_schema_extra={"examples": [
-        {"principal_moments": [1.0, 1.0, 2.0], "omega": [0.1, 0.0, 1.0], "duration": 10.0, "samples": 5},
-        {"inertia_tensor": [[2.0, 0, 0], [0, 3.0, 0], [0, 0, 4.0]], "omega": [1.0, 0.01, 0.0]},
-    ]})
+    model_config = ConfigDict(
+        json_schema_extra={
+            "examples": [
+                {"principal_moments": [1.0, 1.0, 2.0], "omega": [0.1, 0.0, 1.0], "duration": 10.0, "samples": 5},
+                {"inertia_tensor": [[2.0, 0, 0], [0, 3.0, 0], [0, 0, 4.0]], "omega": [1.0, 0.01, 0.0]},
+            ]
+        }
+    )
 
     inertia_tensor: RealTensor | None = Field(None, description="inertia about the centre of mass [kg m^2]")
-    principal_moments: RealVector | None = Field(None, description="principal moments [kg m^2]; the input frame "
-                                             "is then the principal frame")
+    principal_moments: RealVector | None = Field(
+        None, description="principal moments [kg m^2]; the input frame is then the principal frame"
+    )
     omega: RealVector = Field(description="initial angular velocity [rad/s], input frame")
     tolerance: float = Field(1e-6, gt=0, lt=1, description="relative tolerance for equal principal moments")
     duration: float | None = Field(None, gt=0, le=MAX_MAGNITUDE, description="seconds to predict [s]")
-    samples: int | None = Field(None, ge=1, le=MAX_SAMPLES,
-                                description="number of time samples (at most 10000)")
+    samples: int | None = Field(None, ge=MIN_SAMPLES, le=MAX_SAMPLES, description=_SAMPLES)
     method: Method = Field("exact", description="exact, dop853, rk45 or splitting")
 
     def arguments(self) -> dict[str, Any]:
@@ -221,22 +272,28 @@ class PrecessionRequest(_Request):
 
 
 class _Out(BaseModel):
-    # the pipeline may add fields (e.g. source.units_from, area); they pass through
-    model_config = ConfigDict(extra="allow")
-
-    @classmethod
-    def from_result(cls, doc: dict[str, Any]) -> Any:
-        return cls.model_validate(doc)
+    # a key the result model writes and this model does not name is an error, not a silent pass-through
+    model_config = ConfigDict(extra="forbid")
 
 
-class SourceOut(_Out):
-    filename: str | None = None
-    format: str
-    kind: str = Field(description="mesh, volume, points or cad")
-    units: str
-    vertices: int | None = None
-    triangles: int | None = None
-    watertight: bool | None = None
+def _from_dataclass(cls: type, name: str, doc: str) -> type[BaseModel]:
+    """A response model with exactly the fields of one of the result model's dataclasses (each optional
+    where the dataclass has a default: the serialiser leaves such a field out when it is None)."""
+    hints = get_type_hints(cls)
+    spec: dict[str, Any] = {}
+    for f in fields(cls):
+        required = f.default is MISSING and f.default_factory is MISSING
+        spec[f.name] = (hints[f.name], ... if required else None)
+    model: type[BaseModel] = create_model(name, __base__=_Out, __doc__=doc, **spec)
+    return model
+
+
+SourceOut = _from_dataclass(Source, "SourceOut", "What was read, how, and how many elements it had (inertia.results.Source).")
+DiagnosticsOut = _from_dataclass(
+    Diagnostics,
+    "DiagnosticsOut",
+    "Elapsed time [s] and the relative error estimate of the principal moments [1] (inertia.results.Diagnostics).",
+)
 
 
 class ReferenceInertiaOut(_Out):
@@ -268,12 +325,18 @@ class TrajectoryOut(_Out):
     quaternion: list[Quaternion] = Field(description="attitude relative to t = 0, [w, x, y, z]")
 
 
+class MotionDiagnosticsOut(_Out):
+    elapsed_s: float = Field(description="[s]")
+    energy_drift: float | None = Field(None, description="max |E(t) - E(0)| / E(0) over the trajectory [1]")
+    momentum_drift: float | None = Field(None, description="max |M(t) - M(0)| / |M(0)| over the trajectory [1]")
+
+
 class PrecessionOut(_Out):
-    regime: str = Field(description="rest, permanent_rotation, spherical, regular_precession, asymmetric, rotator")
-    angular_momentum: Vector | None = Field(None, description="[kg m^2/s], input frame")
-    angular_momentum_magnitude: float | None = None
-    kinetic_energy: float | None = Field(None, description="[J]")
-    omega_body: Vector | None = Field(None, description="initial angular velocity, principal frame [rad/s]")
+    regime: Literal["rest", "permanent_rotation", "spherical", "regular_precession", "asymmetric", "rotator"]
+    angular_momentum: Vector = Field(description="[kg m^2/s], input frame")
+    angular_momentum_magnitude: float = Field(description="[kg m^2/s]")
+    kinetic_energy: float = Field(description="[J]")
+    omega_body: Vector = Field(description="initial angular velocity, principal frame [rad/s]")
     body_precession_rate: float | None = Field(None, description="[rad/s]")
     space_precession_rate: float | None = Field(None, description="[rad/s]")
     spin_rate: float | None = Field(None, description="[rad/s]")
@@ -282,17 +345,21 @@ class PrecessionOut(_Out):
     stable: bool | None = None
     flip_interval: float | None = Field(None, description="[s]")
     trajectory: TrajectoryOut | None = None
-    diagnostics: dict[str, Any] | None = None
+    diagnostics: MotionDiagnosticsOut
 
 
 class PartOut(_Out):
     name: str
-    mass: float
-    center_of_mass: Vector
-    inertia_tensor: Tensor
+    mass: float = Field(description="[kg]")
+    volume: float | None = Field(None, description="[m^3], solids only")
+    density: float | None = Field(None, description="[kg/m^3], solids of one density")
+    area: float | None = Field(None, description="[m^2], thin shells: the area that carries the mass")
+    center_of_mass: Vector = Field(description="[m], scene frame")
+    inertia_tensor: Tensor = Field(description="about the part's own centre of mass [kg m^2]")
     surface_area: float | None = Field(None, description="[m^2]")
-    principal: PrincipalOut | None = None
-    classification: ClassificationOut | None = None
+    principal: PrincipalOut
+    classification: ClassificationOut
+    warnings: list[str] | None = None
 
 
 class RotationalConstantsOut(_Out):
@@ -318,20 +385,14 @@ class ExportOut(_Out):
     parts: list[ExportPartOut] | None = None
 
 
-class DiagnosticsOut(_Out):
-    elapsed_s: float
-    relative_error_estimate: float
-    tessellation_error: float | None = Field(None, description="geometry=mesh: largest relative difference of "
-                                             "mass and principal moments to the exact B-rep [1]")
-
-
 class AnalysisOut(_Out):
     """One analysis result (API.md); sections appear only when asked for."""
 
-    source: SourceOut
+    source: SourceOut  # type: ignore[valid-type]
     mass: float = Field(description="[kg]")
     volume: float | None = Field(None, description="[m^3], solids only")
     density: float | None = Field(None, description="[kg/m^3], solids only")
+    area: float | None = Field(None, description="[m^2], thin shells: the area that carries the mass")
     center_of_mass: Vector = Field(description="[m], input frame")
     inertia_tensor: Tensor = Field(description="about the centre of mass [kg m^2], input frame")
     reference_inertia: ReferenceInertiaOut | None = None
@@ -343,25 +404,27 @@ class AnalysisOut(_Out):
     export: ExportOut | None = None
     precession: PrecessionOut | None = None
     parts: list[PartOut] | None = None
-    warnings: list[str] = []
-    diagnostics: DiagnosticsOut
+    warnings: list[str]
+    diagnostics: DiagnosticsOut  # type: ignore[valid-type]
 
 
 class PrecessionResponse(_Out):
     principal: PrincipalOut
     classification: ClassificationOut
     precession: PrecessionOut
-    warnings: list[str] = []
-    diagnostics: DiagnosticsOut
+    warnings: list[str]
+    diagnostics: DiagnosticsOut  # type: ignore[valid-type]
 
 
-class ErrorBody(BaseModel):
-    code: str = Field(description="snake_case error code", examples=["not_watertight"])
-    message: str = Field(description="what went wrong and what to do")
-    details: dict[str, Any] = {}
+class ErrorBody(_Out):
+    code: str = Field(description="snake_case error code (API.md)", examples=["invalid_parameter"])
+    message: str = Field(description="what went wrong and what to do, one sentence")
+    details: dict[str, Any] = Field(description="machine-readable particulars (the parameter, the limit, ...)")
 
 
-class ErrorOut(BaseModel):
+class ErrorOut(_Out):
+    """The one error envelope of every status >= 400."""
+
     error: ErrorBody
 
 
@@ -388,19 +451,119 @@ class FormatsOut(BaseModel):
     points: list[str] = Field(description="formats of point-mass tables")
     cad: list[str] = Field(default_factory=list, description="CAD formats (B-rep solids; the 'cad' extra)")
     unavailable: list[UnavailableFormatOut] = Field(
-        default_factory=list, description="formats known to the service that this installation cannot read")
+        default_factory=list, description="formats known to the service that this installation cannot read"
+    )
 
 
-def _error(description: str) -> dict[str, Any]:
-    return {"model": ErrorOut, "description": description}
+# ---- error statuses: the envelope, with what each status means and a real example -----------------
 
 
-# the error statuses every /v1 endpoint may answer
-ERROR_RESPONSES: dict[int | str, dict[str, Any]] = {
-    401: _error("unauthorized: the API key is missing or wrong"),
-    413: _error("payload_too_large"),
-    422: _error("invalid_parameter, invalid_inertia (export of a body a simulator would refuse), "
-                "or a file that cannot be analysed"),
-    500: _error("internal_error"),
-    503: _error("timeout"),
+def _example(code: str, message: str, **details: Any) -> dict[str, Any]:
+    return {"error": {"code": code, "message": message, "details": details}}
+
+
+_ERRORS: dict[int, tuple[str, dict[str, dict[str, Any]]]] = {
+    401: (
+        "unauthorized: the server requires an API key (INERTIA_API_KEY) and the X-API-Key header is missing or wrong",
+        {
+            "unauthorized": _example("unauthorized", "missing or wrong API key; send it in the X-API-Key header"),
+        },
+    ),
+    413: (
+        "payload_too_large: the request body is larger than INERTIA_MAX_UPLOAD_BYTES, or a file would inflate "
+        "past what can be read",
+        {
+            "payload_too_large": _example(
+                "payload_too_large",
+                "the request body is larger than the limit of 536870912 bytes; send a "
+                "smaller file or raise INERTIA_MAX_UPLOAD_BYTES",
+                limit_bytes=536870912,
+                content_length=600000000,
+            ),
+        },
+    ),
+    415: (
+        "unsupported_format: the file's format is not one this service reads (GET /v1/formats), or its reader "
+        "needs an extra that is not installed",
+        {
+            "unsupported_format": _example(
+                "unsupported_format",
+                "cannot read files ending in .dwg; readable formats are stl, obj, ply, off, "
+                "glb, gltf, 3mf, ... (or pass format=... if the name is misleading)",
+                format="dwg",
+            ),
+        },
+    ),
+    422: (
+        "the request or its file cannot be analysed: invalid_parameter (also every schema validation failure), "
+        "unreadable_file, empty_geometry, not_watertight, zero_volume, invalid_inertia, ...",
+        {
+            "invalid_parameter": _example(
+                "invalid_parameter",
+                "query field 'density': Input should be greater than 0; fix it and send the request again",
+                parameter="density",
+                errors=[{"loc": ["query", "density"], "msg": "Input should be greater than 0", "type": "greater_than"}],
+            ),
+            "not_watertight": _example(
+                "not_watertight",
+                "part 'bracket' is not watertight (4 open edges), so it does not bound a "
+                "solid; repair it, or analyse it as a thin surface with model=shell and a thickness",
+                open_edges=4,
+                part="bracket",
+            ),
+            "invalid_inertia": _example(
+                "invalid_inertia",
+                "the body is a linear rotator or a single point (smallest principal moment "
+                "0 kg m^2 is zero); a simulator needs three positive moments: give the body some thickness",
+                reason="zero_moment",
+                format="urdf",
+                moments=[0.0, 0.0, 0.0],
+            ),
+        },
+    ),
+    500: (
+        "internal_error: a bug; the error was logged",
+        {
+            "internal_error": _example(
+                "internal_error",
+                "the server failed unexpectedly; the error was logged, please report it with the input that caused it",
+            ),
+        },
+    ),
+    503: (
+        "timeout (the compute limit INERTIA_TIMEOUT_S passed) or server_busy (every compute process is busy "
+        "and the queue is full; see Retry-After)",
+        {
+            "timeout": _example(
+                "timeout",
+                "the computation took too long and was stopped (limit 120 s); send a smaller input or raise INERTIA_TIMEOUT_S",
+                timeout_s=120.0,
+            ),
+            "server_busy": _example(
+                "server_busy",
+                "the server is busy: 4 analyses are running and 64 are waiting; retry after the time in the Retry-After header",
+                retry_after_s=5,
+                waiting=64,
+            ),
+        },
+    ),
 }
+
+
+def error_responses(*statuses: int) -> dict[int | str, dict[str, Any]]:
+    """The OpenAPI ``responses`` of these error statuses: the envelope, a description and real examples."""
+    out: dict[int | str, dict[str, Any]] = {}
+    for status in statuses:
+        description, examples = _ERRORS[status]
+        out[status] = {
+            "model": ErrorOut,
+            "description": description,
+            "content": {
+                "application/json": {"examples": {name: {"summary": name, "value": value} for name, value in examples.items()}}
+            },
+        }
+        if status == 503:
+            out[status]["headers"] = {
+                "Retry-After": {"description": "server_busy: seconds to wait before retrying", "schema": {"type": "integer"}}
+            }
+    return out

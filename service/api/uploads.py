@@ -23,7 +23,8 @@ from dataclasses import dataclass
 from pathlib import PurePosixPath, PureWindowsPath
 from typing import BinaryIO
 
-from ..errors import PayloadTooLargeError, ServiceError, UnreadableFileError
+from ..errors import ServiceError, UnreadableFileError
+from .transport import PayloadTooLargeError
 
 __all__ = ["Item", "Upload", "Workspace", "client_name", "expand", "save"]
 
@@ -94,8 +95,10 @@ def save(file: BinaryIO, folder: str, index: int, limit: int) -> tuple[str, int]
     file.seek(0)
     size = _copy(file.read, path, limit)
     if size is None:
-        raise PayloadTooLargeError(f"the file is larger than the limit of {limit} bytes; send a smaller file or "
-                                   "raise INERTIA_MAX_UPLOAD_BYTES", limit_bytes=limit)
+        raise PayloadTooLargeError(
+            f"the file is larger than the limit of {limit} bytes; send a smaller file or raise INERTIA_MAX_UPLOAD_BYTES",
+            limit_bytes=limit,
+        )
     return path, size
 
 
@@ -140,8 +143,12 @@ def _members(archive: str, file: BinaryIO, folder: str, counter: Iterator[int], 
     try:
         zf = zipfile.ZipFile(file)
     except (zipfile.BadZipFile, OSError, ValueError, EOFError) as exc:
-        yield Item(archive, error=UnreadableFileError(f"{archive} is not a readable zip archive ({exc}); "
-                                                      "send a valid .zip or the files themselves"))
+        yield Item(
+            archive,
+            error=UnreadableFileError(
+                f"{archive} is not a readable zip archive ({exc}); send a valid .zip or the files themselves"
+            ),
+        )
         return
     budget = [limit]  # what all members together may still inflate to
     with zf:
@@ -156,25 +163,32 @@ def _members(archive: str, file: BinaryIO, folder: str, counter: Iterator[int], 
 
 def _member(zf: zipfile.ZipFile, info: zipfile.ZipInfo, folder: str, index: int, budget: list[int]) -> Item:
     label = info.filename
-    too_large = PayloadTooLargeError(f"{label} inflates past the {budget[0]} bytes this archive may still inflate "
-                                     "to; send it separately or raise INERTIA_MAX_UPLOAD_BYTES",
-                                     limit_bytes=budget[0])
+    too_large = PayloadTooLargeError(
+        f"{label} inflates past the {budget[0]} bytes this archive may still inflate "
+        "to; send it separately or raise INERTIA_MAX_UPLOAD_BYTES",
+        limit_bytes=budget[0],
+    )
     if info.file_size > budget[0]:  # zipfile never inflates past the declared size: refuse before inflating
         return Item(label, error=too_large)
     path = os.path.join(folder, f"upload-{index}")
     try:
         with zf.open(info) as fh:
             size = _copy(fh.read, path, budget[0])
-    except (zipfile.BadZipFile, OSError, ValueError, NotImplementedError, RuntimeError, EOFError,
-            zlib.error) as exc:
+    except (zipfile.BadZipFile, OSError, ValueError, NotImplementedError, RuntimeError, EOFError, zlib.error) as exc:
         _unlink(path)
-        return Item(label, error=UnreadableFileError(f"cannot extract {label} from the archive ({exc}); "
-                                                     "the member is corrupt: send it again or on its own"))
+        return Item(
+            label,
+            error=UnreadableFileError(
+                f"cannot extract {label} from the archive ({exc}); the member is corrupt: send it again or on its own"
+            ),
+        )
     except Exception as exc:
         _unlink(path)
         log.warning("unclassified failure extracting %r", label, exc_info=exc)
-        return Item(label, error=UnreadableFileError(f"cannot extract {label} from the archive "
-                                                     f"({type(exc).__name__}); the member is corrupt"))
+        return Item(
+            label,
+            error=UnreadableFileError(f"cannot extract {label} from the archive ({type(exc).__name__}); the member is corrupt"),
+        )
     if size is None:
         _unlink(path)
         return Item(label, error=too_large)

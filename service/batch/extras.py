@@ -21,9 +21,7 @@ def require(module: str, *, purpose: str, extra: str, parameter: str) -> ModuleT
         importlib.import_module(top)  # the package first: a blocked or missing package fails here
         importlib.import_module(module)
     except ImportError as exc:
-        raise InvalidParameterError(
-            f"{purpose} needs {top}: pip install 'inertia-service[{extra}]'", parameter=parameter
-        ) from exc
+        raise InvalidParameterError(f"{purpose} needs {top}: pip install 'inertia-service[{extra}]'", parameter=parameter) from exc
     return sys.modules[top]
 
 
@@ -34,5 +32,4 @@ def ensure_installed(package: str, *, purpose: str, extra: str, parameter: str) 
     except (ImportError, ValueError):
         found = False
     if not found:
-        raise InvalidParameterError(f"{purpose} needs {package}: pip install 'inertia-service[{extra}]'",
-                                    parameter=parameter)
+        raise InvalidParameterError(f"{purpose} needs {package}: pip install 'inertia-service[{extra}]'", parameter=parameter)

@@ -44,8 +44,7 @@ def _ignore_interrupts() -> None:
 
 def _new_pool(workers: int) -> ProcessPoolExecutor:
     method = "forkserver" if start_forkserver() else "spawn"
-    return ProcessPoolExecutor(max_workers=workers, mp_context=multiprocessing.get_context(method),
-                               initializer=_ignore_interrupts)
+    return ProcessPoolExecutor(max_workers=workers, mp_context=multiprocessing.get_context(method), initializer=_ignore_interrupts)
 
 
 def _stop(pool: ProcessPoolExecutor) -> None:
@@ -60,8 +59,15 @@ def _stop(pool: ProcessPoolExecutor) -> None:
 Task = Callable[[list[Source], AnalysisOptions, str], Rendered]
 
 
-def run_pool(groups: Iterator[list[Source]], workers: int, window: int, options: AnalysisOptions, fmt: str,
-             write: Callable[[Rendered], None], task: Task = render_sources) -> None:
+def run_pool(
+    groups: Iterator[list[Source]],
+    workers: int,
+    window: int,
+    options: AnalysisOptions,
+    fmt: str,
+    write: Callable[[Rendered], None],
+    task: Task = render_sources,
+) -> None:
     """Analyse every group on ``workers`` local processes, ``window`` tasks in flight; ``write`` each task's rows.
 
     ``task`` (a module-level function the workers can import) is what runs on a group.
@@ -105,8 +111,15 @@ def run_pool(groups: Iterator[list[Source]], workers: int, window: int, options:
     pool.shutdown(wait=True)
 
 
-def _isolate(pool: ProcessPoolExecutor, suspects: list[Source], workers: int, options: AnalysisOptions, fmt: str,
-             write: Callable[[Rendered], None], task: Task) -> ProcessPoolExecutor:
+def _isolate(
+    pool: ProcessPoolExecutor,
+    suspects: list[Source],
+    workers: int,
+    options: AnalysisOptions,
+    fmt: str,
+    write: Callable[[Rendered], None],
+    task: Task,
+) -> ProcessPoolExecutor:
     """Analyse the files that were in flight when a worker died, one at a time; returns the (new) pool."""
     for src in suspects:
         try:
@@ -122,6 +135,7 @@ def _isolate(pool: ProcessPoolExecutor, suspects: list[Source], workers: int, op
 
 
 def _failed(src: Source, exc: BaseException, fmt: str) -> tuple[Any, bool]:
-    err = InternalError(f"the analysis of this file failed on the worker ({type(exc).__name__}: {exc}); "
-                        "it may need more memory than a worker has")
+    err = InternalError(
+        f"the analysis of this file failed on the worker ({type(exc).__name__}: {exc}); it may need more memory than a worker has"
+    )
     return render(error_row(src.name, err), fmt), True

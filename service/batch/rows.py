@@ -8,7 +8,10 @@ input's name, the key ``--resume`` uses.
 A flat row (CSV, Parquet) has the columns of :data:`COLUMNS`, all SI:
 ``mass`` kg, ``volume`` m^3 (empty for shells and points), ``com_*`` m, the six
 components of the inertia tensor about the centre of mass in the input frame
-and the principal moments ``I1 <= I2 <= I3`` in kg m^2.  ``Ixy`` is the (x, y)
+and the principal moments ``I1 <= I2 <= I3`` in kg m^2, the principal axes
+``axis{i}_{x,y,z}`` (unit vectors in the input frame, rows of
+``principal.axes``) and the quaternion ``q_w, q_x, q_y, q_z`` that rotates
+principal-frame vectors into the input frame.  ``Ixy`` is the (x, y)
 element of the tensor, i.e. the product of inertia with its minus sign,
 ``-integral(x y dm)``.  ``class`` is ``classification.kind``, ``kappa`` Ray's
 asymmetry (empty where the contract leaves it out), ``warnings`` joined by
@@ -24,11 +27,42 @@ from ..errors import ServiceError
 __all__ = ["COLUMNS", "FLOAT_COLUMNS", "error_row", "flat_row", "row_name"]
 
 COLUMNS = (
-    "name", "format", "mass", "volume", "com_x", "com_y", "com_z",
-    "Ixx", "Iyy", "Izz", "Ixy", "Ixz", "Iyz", "I1", "I2", "I3",
-    "class", "kappa", "warnings", "error",
+    "name",
+    "format",
+    "mass",
+    "volume",
+    "com_x",
+    "com_y",
+    "com_z",
+    "Ixx",
+    "Iyy",
+    "Izz",
+    "Ixy",
+    "Ixz",
+    "Iyz",
+    "I1",
+    "I2",
+    "I3",
+    "axis1_x",
+    "axis1_y",
+    "axis1_z",
+    "axis2_x",
+    "axis2_y",
+    "axis2_z",
+    "axis3_x",
+    "axis3_y",
+    "axis3_z",
+    "q_w",
+    "q_x",
+    "q_y",
+    "q_z",
+    "class",
+    "kappa",
+    "warnings",
+    "error",
 )
-FLOAT_COLUMNS = frozenset(COLUMNS[2:16]) | {"kappa"}
+FLOAT_COLUMNS = frozenset(COLUMNS[2 : COLUMNS.index("class")]) | {"kappa"}
+_AXES = tuple(f"axis{i}_{c}" for i in (1, 2, 3) for c in "xyz")
 
 # (column, row, col) of the tensor components, in COLUMNS order
 _TENSOR = (("Ixx", 0, 0), ("Iyy", 1, 1), ("Izz", 2, 2), ("Ixy", 0, 1), ("Ixz", 0, 2), ("Iyz", 1, 2))
@@ -59,7 +93,10 @@ def flat_row(row: dict[str, Any]) -> dict[str, Any]:
     tensor = row["inertia_tensor"]
     for column, i, j in _TENSOR:
         out[column] = tensor[i][j]
-    out["I1"], out["I2"], out["I3"] = row["principal"]["moments"]
+    principal = row["principal"]
+    out["I1"], out["I2"], out["I3"] = principal["moments"]
+    out.update(zip(_AXES, (x for axis in principal["axes"] for x in axis)))
+    out["q_w"], out["q_x"], out["q_y"], out["q_z"] = principal["quaternion"]
     cls = row["classification"]
     out["class"] = cls["kind"]
     out["kappa"] = cls.get("asymmetry")

@@ -103,8 +103,10 @@ class BatchSummary:
 
     def as_text(self) -> str:
         rate = self.analysed / self.elapsed_s if self.elapsed_s > 0 else 0.0
-        return (f"{self.analysed} files analysed ({self.errors} errors), {self.skipped} skipped as already in "
-                f"{self.out}; {self.elapsed_s:.1f} s, {rate:.1f} files/s")
+        return (
+            f"{self.analysed} files analysed ({self.errors} errors), {self.skipped} skipped as already in "
+            f"{self.out}; {self.elapsed_s:.1f} s, {rate:.1f} files/s"
+        )
 
 
 _DASK = {"purpose": "a batch run", "extra": "batch", "parameter": "workers"}
@@ -121,13 +123,19 @@ def local_cluster(workers: int | None = None) -> Any:
     import dask
 
     method = "forkserver" if start_forkserver(DASK_WORKER_PRELOAD) else "spawn"
-    environ = {k: v for k, v in dask.config.get("distributed.nanny.pre-spawn-environ", {}).items()
-               if k not in DROPPED_ENV}
-    settings = {"distributed.worker.multiprocessing-method": method, "distributed.nanny.pre-spawn-environ": environ,
-                "distributed.worker.profile.enabled": False}
+    environ = {k: v for k, v in dask.config.get("distributed.nanny.pre-spawn-environ", {}).items() if k not in DROPPED_ENV}
+    settings = {
+        "distributed.worker.multiprocessing-method": method,
+        "distributed.nanny.pre-spawn-environ": environ,
+        "distributed.worker.profile.enabled": False,
+    }
     with dask.config.set(settings):
         return distributed.LocalCluster(
-            n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None, silence_logs=logging.ERROR,
+            n_workers=n,
+            threads_per_worker=1,
+            processes=True,
+            dashboard_address=None,
+            silence_logs=logging.ERROR,
             preload=[f"{_ROOT}.batch.tasks"],  # a no-op after a forkserver; spawned workers import it at start-up
         )
 
@@ -146,9 +154,7 @@ def connect(scheduler: str | None, workers: int | None) -> tuple[Any, Any]:
         try:
             return distributed.Client(scheduler, timeout="30s"), None
         except OSError as exc:
-            raise InvalidParameterError(
-                f"cannot reach the Dask scheduler at {scheduler!r}: {exc}", parameter="scheduler"
-            ) from exc
+            raise InvalidParameterError(f"cannot reach the Dask scheduler at {scheduler!r}: {exc}", parameter="scheduler") from exc
     cluster = local_cluster(workers)
     return distributed.Client(cluster), cluster
 
@@ -174,11 +180,11 @@ def run_batch(
     """
     start = time.perf_counter()
     if scheduler is not None and workers is not None:
-        raise InvalidParameterError("give --workers (a local cluster) or --scheduler (an existing one), not both",
-                                    parameter="workers")
+        raise InvalidParameterError(
+            "give --workers (a local cluster) or --scheduler (an existing one), not both", parameter="workers"
+        )
     if engine not in ENGINES:
-        raise InvalidParameterError(f"unknown engine {engine!r}; use one of {', '.join(ENGINES)}",
-                                    parameter="engine")
+        raise InvalidParameterError(f"unknown engine {engine!r}; use one of {', '.join(ENGINES)}", parameter="engine")
     fmt = output_format(out)  # fail on a bad --out before any work
     local = client is None and scheduler is None
     if local:  # a bad --workers or a missing extra fails before any work too
@@ -205,8 +211,7 @@ def run_batch(
                 client.close()
         elif engine == "pool":
             n = min(_worker_count(workers), len(pending))
-            run_pool(_groups(pending, n, MIN_TASK_BYTES["pool"]), n, WINDOW_PER_THREAD * n, options, fmt,
-                     output.write)
+            run_pool(_groups(pending, n, MIN_TASK_BYTES["pool"]), n, WINDOW_PER_THREAD * n, options, fmt, output.write)
         else:
             _run_local(pending, workers, options, output)
     finally:
@@ -279,8 +284,7 @@ def _switch_interval(seconds: float) -> Iterator[None]:
         sys.setswitchinterval(previous)
 
 
-def _head_start(pending: list[Source], ready: Callable[[], bool], options: AnalysisOptions,
-                output: _Output) -> list[Source]:
+def _head_start(pending: list[Source], ready: Callable[[], bool], options: AnalysisOptions, output: _Output) -> list[Source]:
     """Analyse small files here, one at a time, until ``ready()``; returns the files left for the workers."""
     deferred: list[Source] = []
     for i, src in enumerate(pending):
@@ -324,8 +328,7 @@ def _distribute(client: Any, pending: list[Source], options: AnalysisOptions, ou
             submit(group, ac)
 
 
-def _rows(future: Any, group: list[Source], resubmit: Callable[[list[Source]], None],
-          fmt: str = "jsonl") -> list[tuple[Any, bool]]:
+def _rows(future: Any, group: list[Source], resubmit: Callable[[list[Source]], None], fmt: str = "jsonl") -> list[tuple[Any, bool]]:
     """The rendered rows of a finished task; a task that failed as a whole is split or reported."""
     try:
         rows: list[tuple[Any, bool]] = future.result()
@@ -335,8 +338,10 @@ def _rows(future: Any, group: list[Source], resubmit: Callable[[list[Source]], N
             for src in group:
                 resubmit([src])
             return []
-        err = InternalError(f"the analysis of this file failed on the worker ({type(exc).__name__}: {exc}); "
-                            "it may need more memory than a worker has")
+        err = InternalError(
+            f"the analysis of this file failed on the worker ({type(exc).__name__}: {exc}); "
+            "it may need more memory than a worker has"
+        )
         return [(render(error_row(group[0].name, err), fmt), True)]
 
 
@@ -386,8 +391,7 @@ def _progress_bar(total: int, enabled: bool) -> Any:
             ) from exc
         return _NoBar()
     # tqdm shows the count, the rate (files/s) and the ETA
-    return tqdm(total=total, unit="file", file=sys.stderr, disable=not enabled, dynamic_ncols=True,
-                smoothing=0.1)
+    return tqdm(total=total, unit="file", file=sys.stderr, disable=not enabled, dynamic_ncols=True, smoothing=0.1)
 
 
 class _NoBar:

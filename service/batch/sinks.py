@@ -118,8 +118,8 @@ def _jsonl_names(fh: IO[str]) -> Iterator[str]:
             yield row_name(json.loads(line))
         except (json.JSONDecodeError, KeyError, TypeError) as exc:
             raise InvalidParameterError(
-                f"line {lineno} of --out is not a batch result line ({exc}); "
-                "give a new --out or drop --resume", parameter="out",
+                f"line {lineno} of --out is not a batch result line ({exc}); give a new --out or drop --resume",
+                parameter="out",
             ) from exc
 
 
@@ -231,9 +231,11 @@ class ParquetSink:
     def _flush(self) -> None:
         if self._buffer:
             columns = list(zip(*self._buffer, strict=True))
-            self._writer.write_table(self._pa.Table.from_arrays(
-                [self._pa.array(col, type=f.type) for col, f in zip(columns, self._schema, strict=True)],
-                schema=self._schema))
+            self._writer.write_table(
+                self._pa.Table.from_arrays(
+                    [self._pa.array(col, type=f.type) for col, f in zip(columns, self._schema, strict=True)], schema=self._schema
+                )
+            )
             self._buffer = []
 
     def close(self) -> None:

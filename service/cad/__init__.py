@@ -26,26 +26,38 @@ from ..conventions import DEFAULT_DENSITY
 from ..errors import InvalidParameterError
 from ..surface import SURFACE_AREA_KEY
 from ..tolerances import EPS
+from ..vocabulary import Model
 from .read import CAD_FORMATS, DEFAULT_DEFLECTION, GEOMETRIES, read_cad_parts
 
 if TYPE_CHECKING:
     from ..load import Loaded
     from ..mass import MassProperties
 
-__all__ = ["CAD_FORMATS", "GEOMETRIES", "DEFAULT_DEFLECTION", "read_cad_parts", "brep_mass_properties",
-           "combined_properties", "tessellated", "tessellation_error", "source_counts"]
+__all__ = [
+    "CAD_FORMATS",
+    "GEOMETRIES",
+    "DEFAULT_DEFLECTION",
+    "read_cad_parts",
+    "brep_mass_properties",
+    "combined_properties",
+    "tessellated",
+    "tessellation_error",
+    "source_counts",
+]
 
 
-def brep_mass_properties(body: BrepBody, *, density: float | None = None, mass: float | None = None,
-                         model: str = "solid") -> MassProperties:
+def brep_mass_properties(
+    body: BrepBody, *, density: float | None = None, mass: float | None = None, model: str = Model.SOLID
+) -> MassProperties:
     """Mass properties of one B-rep solid, SI units; density kg/m^3 (default 1000) or a total ``mass`` kg."""
     from ..eigen import jacobi_eigh
     from ..mass import InertiaTensor, MassProperties
     from . import occ
 
-    if model != "solid":
-        raise InvalidParameterError("a CAD solid is integrated as a solid; model=shell applies to surface meshes",
-                                    parameter="model")
+    if model != Model.SOLID:
+        raise InvalidParameterError(
+            "a CAD solid is integrated as a solid; model=shell applies to surface meshes", parameter="model"
+        )
     integral = occ.integrate(body.solid)
     L = body.length_scale
     volume = integral.volume * L**3

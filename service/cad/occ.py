@@ -58,9 +58,24 @@ ROUNDING_FLOOR = 64 * 2.220446049250313e-16  # Gauss sums of a few hundred terms
 
 # OpenCASCADE's own names of length units, as STEPControl_Reader.FileUnits and the IGES global section spell them
 _UNIT_NAMES = {
-    "m": "m", "metre": "m", "meter": "m", "mm": "mm", "millimetre": "mm", "millimeter": "mm",
-    "cm": "cm", "centimetre": "cm", "centimeter": "cm", "um": "um", "micron": "um", "micrometre": "um",
-    "micrometer": "um", "in": "in", "inch": "in", "ft": "ft", "foot": "ft", "feet": "ft",
+    "m": "m",
+    "metre": "m",
+    "meter": "m",
+    "mm": "mm",
+    "millimetre": "mm",
+    "millimeter": "mm",
+    "cm": "cm",
+    "centimetre": "cm",
+    "centimeter": "cm",
+    "um": "um",
+    "micron": "um",
+    "micrometre": "um",
+    "micrometer": "um",
+    "in": "in",
+    "inch": "in",
+    "ft": "ft",
+    "foot": "ft",
+    "feet": "ft",
 }
 
 
@@ -135,9 +150,11 @@ def _refuse_external(data: bytes, fmt: str) -> None:
     match = _STEP_EXTERNAL.search(data) if fmt == "step" else None
     if match:
         raise ExternalReferenceError(
-            "the STEP file refers to other files for its parts (" + match.group(0).decode("ascii", "replace")[:80]
+            "the STEP file refers to other files for its parts ("
+            + match.group(0).decode("ascii", "replace")[:80]
             + "...); the server never opens files named by an upload: export the assembly as one self-contained STEP",
-            format=fmt)
+            format=fmt,
+        )
 
 
 def _read(data: bytes, fmt: str) -> tuple[list[Solid], str | None]:
@@ -159,11 +176,14 @@ def _read(data: bytes, fmt: str) -> tuple[list[Solid], str | None]:
         if status != IFSelect_RetDone:
             raise UnreadableFileError(
                 f"the file is not a readable {fmt.upper()} file (OpenCASCADE's reader status {int(status)}); "
-                "export it again from the CAD tool", library="OpenCASCADE")
+                "export it again from the CAD tool",
+                library="OpenCASCADE",
+            )
         unit = _declared_unit(reader, fmt)
         if not reader.Transfer(doc):
-            raise UnreadableFileError(f"OpenCASCADE read the {fmt.upper()} file but could not build its shapes",
-                                      library="OpenCASCADE")
+            raise UnreadableFileError(
+                f"OpenCASCADE read the {fmt.upper()} file but could not build its shapes", library="OpenCASCADE"
+            )
     return _solids(doc), unit
 
 
@@ -230,7 +250,9 @@ def _solids(doc: Any) -> list[Solid]:
     if loose:
         raise NotWatertightError(
             f"the CAD file holds {loose} shell(s) or face(s) that bound no solid, so it is not a closed body; "
-            "export closed solids (sew the surfaces into a solid in the CAD tool)", open_shapes=loose)
+            "export closed solids (sew the surfaces into a solid in the CAD tool)",
+            open_shapes=loose,
+        )
     if not solids:
         raise EmptyGeometryError("the CAD file holds no solid; export the part as a solid body")
     return _unique_names(solids)
@@ -391,7 +413,9 @@ def _check_closed(solid: Solid) -> None:
         if not BRep_Tool.IsClosed_s(TopoDS.Shell(explorer.Current())):
             raise NotWatertightError(
                 f"the solid {solid.name!r} has an open shell (a face is missing or not sewn), so it does not "
-                "bound a volume; repair it in the CAD tool", part=solid.name)
+                "bound a volume; repair it in the CAD tool",
+                part=solid.name,
+            )
         explorer.Next()
     if shells == 0:
         raise EmptyGeometryError(f"the solid {solid.name!r} has no faces", part=solid.name)
@@ -411,8 +435,7 @@ def bounding_box(shape: Any) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     box = Bnd_Box()
     BRepBndLib.AddOptimal_s(shape, box, False, False)
     lo, hi = box.CornerMin(), box.CornerMax()
-    return (np.array([lo.X(), lo.Y(), lo.Z()], dtype=np.float64),
-            np.array([hi.X(), hi.Y(), hi.Z()], dtype=np.float64))
+    return (np.array([lo.X(), lo.Y(), lo.Z()], dtype=np.float64), np.array([hi.X(), hi.Y(), hi.Z()], dtype=np.float64))
 
 
 ANGULAR_DEFLECTION = 0.5  # rad, OpenCASCADE's default; the linear deflection governs below ~1e-2 of the diagonal
@@ -451,15 +474,17 @@ def _tessellate(solid: Solid, deflection: float) -> tuple[NDArray[np.float64], N
             vertices, faces = _welded(*_triangles(shape, solid.name), MERGE_FRACTION * deflection * diagonal)
             if _closed(faces):
                 return vertices, faces
-    raise UnreadableFileError(f"OpenCASCADE could not tessellate the solid {solid.name!r} into a closed surface; "
-                              "use geometry=brep", part=solid.name)
+    raise UnreadableFileError(
+        f"OpenCASCADE could not tessellate the solid {solid.name!r} into a closed surface; use geometry=brep", part=solid.name
+    )
 
 
 MERGE_FRACTION = 1e-3  # nodes closer than this x the chordal deflection are one point (seams, poles)
 
 
-def _welded(vertices: NDArray[np.float64], faces: NDArray[np.int64],
-            radius: float) -> tuple[NDArray[np.float64], NDArray[np.int64]]:
+def _welded(
+    vertices: NDArray[np.float64], faces: NDArray[np.int64], radius: float
+) -> tuple[NDArray[np.float64], NDArray[np.int64]]:
     """Nodes within ``radius`` merged (a seam's two sides, a degenerate edge's nodes); collapsed triangles dropped."""
     from scipy.sparse import coo_matrix
     from scipy.sparse.csgraph import connected_components

@@ -23,8 +23,8 @@ def _binding() -> None:
 
     if not occ.available():
         raise UnsupportedFormatError(
-            f"reading STEP and IGES files needs the 'cad' extra (OpenCASCADE): {occ.CAD_EXTRA_HINT}",
-            extra="cad")
+            f"reading STEP and IGES files needs the 'cad' extra (OpenCASCADE): {occ.CAD_EXTRA_HINT}", extra="cad"
+        )
 
 
 def read_cad_parts(data: bytes, fmt: str, units: str | None) -> tuple[list[Part], str, str, tuple[str, ...]]:
@@ -41,15 +41,16 @@ def read_cad_parts(data: bytes, fmt: str, units: str | None) -> tuple[list[Part]
     if units is not None:
         if file_scale is None:
             raise InvalidParameterError(
-                f"the file's length unit ({declared or 'several units'}) cannot be overridden; omit units", parameter="units")
+                f"the file's length unit ({declared or 'several units'}) cannot be overridden; omit units", parameter="units"
+            )
         scale, unit, units_from = occ.MODEL_UNIT * LENGTH_UNITS[units] / file_scale, units, "request"
     elif file_scale is None:
         scale, unit, units_from = occ.MODEL_UNIT, "m", "file"
-        warnings.append(f"the file's length unit ({declared or 'several units'}) was converted to metres; "
-                        "reference points are read in metres")
+        warnings.append(
+            f"the file's length unit ({declared or 'several units'}) was converted to metres; reference points are read in metres"
+        )
     else:
         assert declared is not None
         scale, unit, units_from = occ.MODEL_UNIT, declared, "file"
-    parts = [Part(s.name, BrepBody(s, scale, s.name), {SURFACE_AREA_KEY: occ.surface_area(s) * scale**2})
-             for s in solids]
+    parts = [Part(s.name, BrepBody(s, scale, s.name), {SURFACE_AREA_KEY: occ.surface_area(s) * scale**2}) for s in solids]
     return parts, unit, units_from, tuple(warnings)

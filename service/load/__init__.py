@@ -89,8 +89,7 @@ def load_body(
     return _load_bytes(data, filename, format, units, isotopes)
 
 
-def _load_files(files: list[tuple[str, bytes]], format: str | None, units: str | None,
-                isotopes: str = "standard") -> Loaded:
+def _load_files(files: list[tuple[str, bytes]], format: str | None, units: str | None, isotopes: str = "standard") -> Loaded:
     """The model file of a multi-file upload, read with the others as its companions."""
     main, companions = pick_model_file(files, format)
     data = dict(files)[main]
@@ -119,8 +118,14 @@ def _load_path(path: str, filename: str, format: str | None, units: str | None, 
     return Loaded(parts, filename, "stl", "mesh", units or "m", "request" if units else "default")
 
 
-def _load_bytes(data: bytes, filename: str | None, format: str | None, units: str | None,
-                isotopes: str = "standard", companions: Mapping[str, bytes] | None = None) -> Loaded:
+def _load_bytes(
+    data: bytes,
+    filename: str | None,
+    format: str | None,
+    units: str | None,
+    isotopes: str = "standard",
+    companions: Mapping[str, bytes] | None = None,
+) -> Loaded:
     if not len(data):
         raise EmptyGeometryError("the file is empty; send a mesh with geometry", filename=filename)
     fmt = sniff_format(filename, format, bytes(data[:512]))
@@ -142,8 +147,9 @@ def _load_bytes(data: bytes, filename: str | None, format: str | None, units: st
         from .stl import read_stl
 
         vertices, faces = read_stl(data)
-        parts = [Part(_stem(filename), MeshBody(vertices, faces, scale, _stem(filename), welded=True,
-                                              coordinate_eps=stl_eps(vertices)))]
+        parts = [
+            Part(_stem(filename), MeshBody(vertices, faces, scale, _stem(filename), welded=True, coordinate_eps=stl_eps(vertices)))
+        ]
         kind = "mesh"
     elif fmt in POINT_FORMATS:
         from .points import read_points
@@ -178,8 +184,9 @@ def _load_bytes(data: bytes, filename: str | None, format: str | None, units: st
     return Loaded(tuple(parts), filename, fmt, kind, unit, units_from)
 
 
-def load_points(records: list[dict[str, object]], units: str | None = None, *,
-                isotopes: str = "standard", mass_unit: str = "kg") -> Loaded:
+def load_points(
+    records: list[dict[str, object]], units: str | None = None, *, isotopes: str = "standard", mass_unit: str = "kg"
+) -> Loaded:
     """Point masses given as records ``{"mass": m, "position": [x, y, z]}`` (or ``"element"``)."""
     from .points import names_elements, points_from_records
 
@@ -192,8 +199,7 @@ def load_points(records: list[dict[str, object]], units: str | None = None, *,
 def _rescaled(part: Part, scale: float) -> Part:
     body = part.body
     if isinstance(body, MeshBody):
-        new: Body = MeshBody(body.vertices, body.faces, scale, body.name, body.warnings, body.welded,
-                             body.coordinate_eps)
+        new: Body = MeshBody(body.vertices, body.faces, scale, body.name, body.warnings, body.welded, body.coordinate_eps)
     elif isinstance(body, VolumeBody):
         new = VolumeBody(body.points, body.tets, body.cell_density, scale, body.name, body.warnings, body.cells)
     else:

@@ -20,7 +20,7 @@ protected alike:
   every block is inflated with a bound of its declared size, discarding the
   output, so a block that inflates past what its header says is caught
   without holding it. The total may not exceed :func:`inflate_budget` of
-  the upload's size (:class:`PayloadTooLargeError`). GLB chunk lengths, and
+  the upload's size (:class:`InputTooLargeError`). GLB chunk lengths, and
   the element counts in PLY and OFF headers, must fit in the file.
 
 What each reader does with each kind of reference is tabled in
@@ -43,10 +43,9 @@ from dataclasses import dataclass
 from pathlib import PurePosixPath, PureWindowsPath
 from typing import Any
 
-from ..errors import ExternalReferenceError, PayloadTooLargeError, UnreadableFileError
+from ..errors import ExternalReferenceError, InputTooLargeError, UnreadableFileError
 
-__all__ = ["check_upload", "inflate_budget", "INFLATE_RATIO", "INFLATE_FLOOR_BYTES", "MAX_INFLATED_BYTES",
-           "MAX_JSON_DEPTH"]
+__all__ = ["check_upload", "inflate_budget", "INFLATE_RATIO", "INFLATE_FLOOR_BYTES", "MAX_INFLATED_BYTES", "MAX_JSON_DEPTH"]
 
 MIB = 1024 * 1024
 # deflate cannot exceed ~1032:1; real mesh files (3MF XML, VTU float blocks) compress 3-20:1,
@@ -74,10 +73,12 @@ class _Context:
         """Count ``nbytes`` more of inflated content; refuse past the budget."""
         self.inflated += nbytes
         if self.inflated > self.budget:
-            raise PayloadTooLargeError(
+            raise InputTooLargeError(
                 f"the {self.fmt.upper()} file would inflate to more than {self.budget} bytes ({what}); "
                 f"at most {INFLATE_RATIO} times the upload's size (or {INFLATE_FLOOR_BYTES} bytes) is accepted",
-                limit_bytes=self.budget, format=self.fmt)
+                limit_bytes=self.budget,
+                format=self.fmt,
+            )
 
     def reference(self, target: str, what: str) -> None:
         """Accept a referenced file only if it is a plain name that came in the same upload."""
@@ -87,7 +88,9 @@ class _Context:
         raise ExternalReferenceError(
             f"the {self.fmt.upper()} file refers to another file ({what} {name[:120]!r}); the server never "
             "opens files named by an upload: send the referenced file in the same upload, or a self-contained file",
-            format=self.fmt, reference=name[:200])
+            format=self.fmt,
+            reference=name[:200],
+        )
 
 
 def _plain_name(name: str) -> bool:
@@ -100,7 +103,7 @@ def check_upload(data: bytes, fmt: str, companions: Collection[str] = ()) -> Non
     """Refuse ``data`` (format ``fmt``) if it names a file outside ``companions`` or inflates past its budget.
 
     companions : the plain file names of the other files that came in the same upload.
-    Raises ``ExternalReferenceError`` (422), ``PayloadTooLargeError`` (413) or
+    Raises ``ExternalReferenceError`` (422), ``InputTooLargeError`` (413) or
     ``UnreadableFileError`` (422, a header that contradicts the file).
     """
     check = _CHECKS.get(fmt)
@@ -133,15 +136,21 @@ _ATTR = re.compile(rb"([\w:]+)\s*=\s*(?:\"([^\"]*)\"|'([^']*)')")
 
 
 def _attrs(text: bytes) -> dict[str, str]:
-    return {m.group(1).decode("ascii", "replace"): (m.group(2) if m.group(2) is not None else m.group(3) or b"")
-            .decode("utf-8", "replace") for m in _ATTR.finditer(text)}
+    return {
+        m.group(1).decode("ascii", "replace"): (m.group(2) if m.group(2) is not None else m.group(3) or b"").decode(
+            "utf-8", "replace"
+        )
+        for m in _ATTR.finditer(text)
+    }
 
 
 def _refuse_doctype(xml: bytes, ctx: _Context) -> None:
     if _DOCTYPE.search(xml):
         raise ExternalReferenceError(
             f"the {ctx.fmt.upper()} file declares a document type or entities (<!DOCTYPE>/<!ENTITY>), which can "
-            "name files on the server or expand without bound; remove the declaration", format=ctx.fmt)
+            "name files on the server or expand without bound; remove the declaration",
+            format=ctx.fmt,
+        )
 
 
 _XDMF_ITEM = re.compile(rb"<DataItem\b([^>]*)>([^<]*)", re.IGNORECASE)
@@ -190,7 +199,7 @@ def _check_vtk_xml(data: bytes, ctx: _Context) -> None:
         fmt = arr.get("format", "ascii")
         if fmt == "binary" and not match.group(2):
             end = xml.find(b"</DataArray>", match.end())
-            blocks.check_base64(xml[match.end(): end if end >= 0 else len(xml)])
+            blocks.check_base64(xml[match.end() : end if end >= 0 else len(xml)])
         elif fmt == "appended":
             offsets.append(_int(arr.get("offset", "0"), ctx))
     if offsets and appended:
@@ -202,7 +211,7 @@ def _check_appended(data: bytes, tag: re.Match[bytes], offsets: list[int], block
     stop = data.rfind(b"</AppendedData>")
     if start < 0:
         raise UnreadableFileError("the VTK file's appended data does not start with '_'", format=blocks.ctx.fmt)
-    blob = data[start + 1: stop if stop > start else len(data)]
+    blob = data[start + 1 : stop if stop > start else len(data)]
     base64_encoded = _attrs(tag.group(1)).get("encoding", "raw") == "base64"
     for offset in offsets:
         if base64_encoded:
@@ -215,8 +224,7 @@ def _int(text: str, ctx: _Context) -> int:
     try:
         value = int(text)
     except ValueError:
-        raise UnreadableFileError(f"the {ctx.fmt.upper()} file has a non-integer size or offset {text!r}",
-                                  format=ctx.fmt) from None
+        raise UnreadableFileError(f"the {ctx.fmt.upper()} file has a non-integer size or offset {text!r}", format=ctx.fmt) from None
     if value < 0:
         raise UnreadableFileError(f"the {ctx.fmt.upper()} file has a negative size or offset {value}", format=ctx.fmt)
     return value
@@ -232,8 +240,10 @@ class _Blocks:
         self.compressor = compressor
 
     def _lie(self, what: str) -> UnreadableFileError:
-        return UnreadableFileError(f"the VTK file's compressed data header does not match its content ({what}); "
-                                   "the file is corrupt or truncated", format=self.ctx.fmt)
+        return UnreadableFileError(
+            f"the VTK file's compressed data header does not match its content ({what}); the file is corrupt or truncated",
+            format=self.ctx.fmt,
+        )
 
     def check_base64(self, text: bytes, appended: bool = False) -> None:
         """An array in base64: the header and the blocks are encoded separately (as VTK writes them)."""
@@ -271,22 +281,23 @@ class _Blocks:
             raise self._lie("the blocks run past the end of the data")
         for k, size in enumerate(sizes):
             expected = last if (k == count - 1 and last) else block
-            self._inflate_one(buf[position: position + size], expected)
+            self._inflate_one(buf[position : position + size], expected)
             position += size
 
     def _inflate_one(self, chunk: bytes, expected: int) -> None:
         if self.compressor == "vtkLZ4DataCompressor":
             return  # no lz4 reader here: no reader inflates it either, the declared sizes were counted
-        decompressor: Any = (zlib.decompressobj() if self.compressor == "vtkZLibDataCompressor"
-                             else lzma.LZMADecompressor())
+        decompressor: Any = zlib.decompressobj() if self.compressor == "vtkZLibDataCompressor" else lzma.LZMADecompressor()
         try:
             out = decompressor.decompress(chunk, expected + 1)
         except (zlib.error, lzma.LZMAError) as exc:
             raise self._lie(f"a block does not inflate: {exc}") from None
         if len(out) > expected:
-            raise PayloadTooLargeError(
+            raise InputTooLargeError(
                 f"a compressed block of the {self.ctx.fmt.upper()} file inflates past the {expected} bytes "
-                "its header declares; refused before inflating it", format=self.ctx.fmt)
+                "its header declares; refused before inflating it",
+                format=self.ctx.fmt,
+            )
 
 
 def _b64_chars(nbytes: int) -> int:
@@ -302,12 +313,12 @@ def _b64(text: bytes) -> bytes | None:
 
 # --- zip packages (3MF) ------------------------------------------------------------------------------
 
+
 def _check_zip(data: bytes, ctx: _Context) -> None:
     try:
         archive = zipfile.ZipFile(io.BytesIO(data))
     except (zipfile.BadZipFile, OSError, ValueError, EOFError, NotImplementedError) as exc:
-        raise UnreadableFileError(f"the {ctx.fmt.upper()} file is not a readable zip package ({exc})",
-                                  format=ctx.fmt) from None
+        raise UnreadableFileError(f"the {ctx.fmt.upper()} file is not a readable zip package ({exc})", format=ctx.fmt) from None
     with archive:
         infos = archive.infolist()
         for info in infos:  # declared sizes first: a bomb is refused before anything is inflated
@@ -325,13 +336,23 @@ def _scan_member(archive: zipfile.ZipFile, info: zipfile.ZipInfo, ctx: _Context)
             for chunk in iter(lambda: fh.read(_CHUNK), b""):
                 _refuse_doctype(tail + chunk, ctx)
                 tail = chunk[-16:]
-    except (zipfile.BadZipFile, OSError, ValueError, EOFError, NotImplementedError, RuntimeError,
-            zlib.error, lzma.LZMAError) as exc:
-        raise UnreadableFileError(f"cannot inflate {info.filename} from the {ctx.fmt.upper()} package ({exc})",
-                                  format=ctx.fmt) from None
+    except (
+        zipfile.BadZipFile,
+        OSError,
+        ValueError,
+        EOFError,
+        NotImplementedError,
+        RuntimeError,
+        zlib.error,
+        lzma.LZMAError,
+    ) as exc:
+        raise UnreadableFileError(
+            f"cannot inflate {info.filename} from the {ctx.fmt.upper()} package ({exc})", format=ctx.fmt
+        ) from None
 
 
 # --- glTF ---------------------------------------------------------------------------------------------
+
 
 def _json_document(text: bytes, ctx: _Context) -> Any:
     try:
@@ -341,8 +362,9 @@ def _json_document(text: bytes, ctx: _Context) -> Any:
     except RecursionError:
         doc = None
     if doc is None or _depth_exceeds(doc, MAX_JSON_DEPTH):
-        raise UnreadableFileError(f"the {ctx.fmt.upper()} file's JSON nests deeper than {MAX_JSON_DEPTH} levels; "
-                                  "no model needs that", format=ctx.fmt)
+        raise UnreadableFileError(
+            f"the {ctx.fmt.upper()} file's JSON nests deeper than {MAX_JSON_DEPTH} levels; no model needs that", format=ctx.fmt
+        )
     return doc
 
 
@@ -352,8 +374,9 @@ def _depth_exceeds(doc: Any, limit: int) -> bool:
         node, depth = stack.pop()
         if depth > limit:
             return True
-        children: Iterator[Any] = iter(node.values()) if isinstance(node, dict) else \
-            iter(node) if isinstance(node, list) else iter(())
+        children: Iterator[Any] = (
+            iter(node.values()) if isinstance(node, dict) else iter(node) if isinstance(node, list) else iter(())
+        )
         stack.extend((child, depth + 1) for child in children if isinstance(child, (dict, list)))
     return False
 
@@ -381,22 +404,39 @@ def _check_glb(data: bytes, ctx: _Context) -> None:
         raise UnreadableFileError("the GLB file does not start with a glTF header", format=ctx.fmt)
     _, length = struct.unpack_from("<II", data, 4)
     if length != len(data):
-        raise UnreadableFileError(f"the GLB header declares {length} bytes but the file has {len(data)}; "
-                                  "it is truncated or corrupt", format=ctx.fmt)
+        raise UnreadableFileError(
+            f"the GLB header declares {length} bytes but the file has {len(data)}; it is truncated or corrupt", format=ctx.fmt
+        )
     position = 12
     while position + 8 <= len(data):
         size, kind = struct.unpack_from("<II", data, position)
         if position + 8 + size > len(data):
             raise UnreadableFileError(f"a GLB chunk declares {size} bytes, past the end of the file", format=ctx.fmt)
         if kind == _GLB_JSON:
-            _check_gltf_uris(_json_document(data[position + 8: position + 8 + size], ctx), ctx)
+            _check_gltf_uris(_json_document(data[position + 8 : position + 8 + size], ctx), ctx)
         position += 8 + size
 
 
 # --- headers with element counts -----------------------------------------------------------------------
 
-_PLY_SCALARS = {"char": 1, "uchar": 1, "int8": 1, "uint8": 1, "short": 2, "ushort": 2, "int16": 2, "uint16": 2,
-                "int": 4, "uint": 4, "int32": 4, "uint32": 4, "float": 4, "float32": 4, "double": 8, "float64": 8}
+_PLY_SCALARS = {
+    "char": 1,
+    "uchar": 1,
+    "int8": 1,
+    "uint8": 1,
+    "short": 2,
+    "ushort": 2,
+    "int16": 2,
+    "uint16": 2,
+    "int": 4,
+    "uint": 4,
+    "int32": 4,
+    "uint32": 4,
+    "float": 4,
+    "float32": 4,
+    "double": 8,
+    "float64": 8,
+}
 
 
 def _check_ply(data: bytes, ctx: _Context) -> None:
@@ -417,8 +457,11 @@ def _check_ply(data: bytes, ctx: _Context) -> None:
     body = len(data) - end - len(b"end_header")
     need = sum(count * max(least, 1) for count, least in elements)
     if need > body:
-        raise UnreadableFileError(f"the PLY header declares elements needing at least {need} bytes, but only {body} "
-                                  "follow it; the header is wrong or the file truncated", format=ctx.fmt)
+        raise UnreadableFileError(
+            f"the PLY header declares elements needing at least {need} bytes, but only {body} "
+            "follow it; the header is wrong or the file truncated",
+            format=ctx.fmt,
+        )
 
 
 def _check_off(data: bytes, ctx: _Context) -> None:
@@ -431,12 +474,16 @@ def _check_off(data: bytes, ctx: _Context) -> None:
     vertices, faces = int(counts[0]), int(counts[1])
     need = 6 * vertices + 8 * faces  # "0 0 0\n" and "3 0 1 2\n" are the shortest lines
     if need > len(data):
-        raise UnreadableFileError(f"the OFF header declares {vertices} vertices and {faces} faces, needing at least "
-                                  f"{need} bytes, but the file has {len(data)}; the header is wrong or the file "
-                                  "truncated", format=ctx.fmt)
+        raise UnreadableFileError(
+            f"the OFF header declares {vertices} vertices and {faces} faces, needing at least "
+            f"{need} bytes, but the file has {len(data)}; the header is wrong or the file "
+            "truncated",
+            format=ctx.fmt,
+        )
 
 
 # --- HDF5 (MED) ---------------------------------------------------------------------------------------
+
 
 def _check_hdf5(data: bytes, ctx: _Context) -> None:
     try:
@@ -466,9 +513,15 @@ def _hdf5_links(group: Any, ctx: _Context, h5py: Any) -> None:
 
 _CHECKS: dict[str, Callable[[bytes, _Context], None]] = {
     "inp": _check_abaqus,
-    "bdf": _check_nastran, "nas": _check_nastran, "fem": _check_nastran,
-    "xdmf": _check_xdmf, "xmf": _check_xdmf,
-    "vtu": _check_vtk_xml, "vtp": _check_vtk_xml, "vts": _check_vtk_xml, "vtr": _check_vtk_xml,
+    "bdf": _check_nastran,
+    "nas": _check_nastran,
+    "fem": _check_nastran,
+    "xdmf": _check_xdmf,
+    "xmf": _check_xdmf,
+    "vtu": _check_vtk_xml,
+    "vtp": _check_vtk_xml,
+    "vts": _check_vtk_xml,
+    "vtr": _check_vtk_xml,
     "pvtu": _check_vtk_xml,
     "3mf": _check_zip,
     "gltf": _check_gltf,

@@ -27,12 +27,12 @@ from .safe import guarded_read
 __all__ = ["read_trimesh_parts", "read_surface_parts", "mesh_part"]
 
 # glTF extensions that change nothing in the geometry we read (materials, textures, lights, metadata)
-_HARMLESS_GLTF_EXTENSIONS = ("KHR_materials_", "KHR_texture_", "KHR_lights_", "KHR_xmp", "KHR_animation_pointer",
-                             "EXT_texture_")
+_HARMLESS_GLTF_EXTENSIONS = ("KHR_materials_", "KHR_texture_", "KHR_lights_", "KHR_xmp", "KHR_animation_pointer", "EXT_texture_")
 
 
-def read_surface_parts(data: bytes, fmt: str, length_scale: float,
-                       companions: Mapping[str, bytes] | None = None) -> tuple[list[Part], str | None, list[str]]:
+def read_surface_parts(
+    data: bytes, fmt: str, length_scale: float, companions: Mapping[str, bytes] | None = None
+) -> tuple[list[Part], str | None, list[str]]:
     """Parts of a surface file, the unit it declares, and notes on what was left out (not weighed)."""
     if fmt == "obj":
         from .obj import read_obj
@@ -57,23 +57,33 @@ def mesh_part(name: str, vertices: NDArray[Any], faces: NDArray[Any], length_sca
     v = np.asarray(vertices, dtype=np.float64)
     f = np.asarray(faces)
     if v.ndim != 2 or v.shape[1] != 3:
-        raise UnreadableFileError(f"the {fmt.upper()} file's vertices of {name!r} do not have three coordinates "
-                                  "each; check the file or re-export it", format=fmt, part=name)
+        raise UnreadableFileError(
+            f"the {fmt.upper()} file's vertices of {name!r} do not have three coordinates each; check the file or re-export it",
+            format=fmt,
+            part=name,
+        )
     if f.ndim != 2 or f.shape[1] != 3 or not np.issubdtype(f.dtype, np.integer):
-        raise UnreadableFileError(f"the {fmt.upper()} file's faces of {name!r} are not triangles of vertex "
-                                  "numbers; check the file or re-export it", format=fmt, part=name)
+        raise UnreadableFileError(
+            f"the {fmt.upper()} file's faces of {name!r} are not triangles of vertex numbers; check the file or re-export it",
+            format=fmt,
+            part=name,
+        )
     if len(f) == 0:
         raise EmptyGeometryError(f"part {name!r} of the {fmt.upper()} file has no triangles", format=fmt, part=name)
     if f.min() < 0 or f.max() >= len(v):
-        raise UnreadableFileError(f"a triangle of {name!r} in the {fmt.upper()} file refers to a vertex that does "
-                                  f"not exist (number {int(f.max())} of {len(v)}); the file is corrupt or truncated",
-                                  format=fmt, part=name)
+        raise UnreadableFileError(
+            f"a triangle of {name!r} in the {fmt.upper()} file refers to a vertex that does "
+            f"not exist (number {int(f.max())} of {len(v)}); the file is corrupt or truncated",
+            format=fmt,
+            part=name,
+        )
     # non-finite coordinates: MeshBody refuses them as invalid_parameter (API.md)
     return Part(name, MeshBody(v, f.astype(np.int64), length_scale, name))
 
 
-def read_trimesh_parts(data: bytes, fmt: str, length_scale: float,
-                       companions: Mapping[str, bytes] | None = None) -> tuple[list[Part], str | None]:
+def read_trimesh_parts(
+    data: bytes, fmt: str, length_scale: float, companions: Mapping[str, bytes] | None = None
+) -> tuple[list[Part], str | None]:
     """Parts of a PLY/OFF/GLB/glTF file (one per scene node) and the unit it declares."""
     import trimesh
 
@@ -81,8 +91,12 @@ def read_trimesh_parts(data: bytes, fmt: str, length_scale: float,
     kwargs: dict[str, Any] = {}
     if companions:
         kwargs["resolver"] = trimesh.resolvers.ZipResolver(dict(companions))
-    scene = guarded_read(lambda: trimesh.load_scene(io.BytesIO(data), file_type=fmt, process=False,
-                                                    skip_materials=True, merge_primitives=False, **kwargs), fmt)
+    scene = guarded_read(
+        lambda: trimesh.load_scene(
+            io.BytesIO(data), file_type=fmt, process=False, skip_materials=True, merge_primitives=False, **kwargs
+        ),
+        fmt,
+    )
     parts: list[Part] = []
     skipped = 0
     nodes = guarded_read(lambda: sorted(scene.graph.nodes_geometry, key=str), fmt)  # node order is not stable
@@ -104,8 +118,7 @@ def read_trimesh_parts(data: bytes, fmt: str, length_scale: float,
         parts.append(mesh_part(name, vertices, faces, length_scale, fmt))
     if not parts:
         what = " (only points or lines)" if skipped else ""
-        raise EmptyGeometryError(f"the {fmt.upper()} file holds no triangles{what}; a solid needs a triangle mesh",
-                                 format=fmt)
+        raise EmptyGeometryError(f"the {fmt.upper()} file holds no triangles{what}; a solid needs a triangle mesh", format=fmt)
     if notes:
         first = parts[0]
         assert isinstance(first.body, MeshBody)
@@ -117,7 +130,7 @@ def _gltf_document(data: bytes, fmt: str) -> Any:
     try:
         if fmt == "glb":
             size = int.from_bytes(data[12:16], "little")
-            return json.loads(data[20:20 + size])
+            return json.loads(data[20 : 20 + size])
         return json.loads(data)
     except (ValueError, UnicodeDecodeError):
         return None  # the reader reports a malformed document in its own words
@@ -142,11 +155,17 @@ def _check_gltf_document(data: bytes, fmt: str) -> list[str]:
         return UnsupportedFormatError(f"the {fmt.upper()} file {what}", format=fmt, **details)
 
     required = doc.get("extensionsRequired", [])
-    unknown = [str(e) for e in required if isinstance(e, str) and not e.startswith(_HARMLESS_GLTF_EXTENSIONS)] \
-        if isinstance(required, list) else []
+    unknown = (
+        [str(e) for e in required if isinstance(e, str) and not e.startswith(_HARMLESS_GLTF_EXTENSIONS)]
+        if isinstance(required, list)
+        else []
+    )
     if unknown:
-        raise refuse(f"requires the extension(s) {', '.join(unknown)}, which this service does not decode "
-                     "(compressed or quantized geometry); export it without mesh compression", extensions=unknown)
+        raise refuse(
+            f"requires the extension(s) {', '.join(unknown)}, which this service does not decode "
+            "(compressed or quantized geometry); export it without mesh compression",
+            extensions=unknown,
+        )
     accessors: list[Any] = doc["accessors"] if isinstance(doc.get("accessors"), list) else []
     meshes: list[Any] = doc["meshes"] if isinstance(doc.get("meshes"), list) else []
     nodes: list[Any] = doc["nodes"] if isinstance(doc.get("nodes"), list) else []
@@ -158,8 +177,10 @@ def _check_gltf_document(data: bytes, fmt: str) -> list[str]:
         label = mesh.get("name") or f"mesh {mi}"
         weights = mesh.get("weights")
         if isinstance(weights, list) and any(isinstance(w, (int, float)) and w != 0 for w in weights):
-            raise refuse(f"gives mesh {label!r} morph-target weights, so its shape is not the stored positions; "
-                         "export it with the morph applied")
+            raise refuse(
+                f"gives mesh {label!r} morph-target weights, so its shape is not the stored positions; "
+                "export it with the morph applied"
+            )
         for prim in mesh.get("primitives", []) if isinstance(mesh.get("primitives"), list) else []:
             if not isinstance(prim, dict):
                 continue
@@ -168,17 +189,26 @@ def _check_gltf_document(data: bytes, fmt: str) -> list[str]:
                 lines += 1
                 continue
             if mode == 6:
-                raise refuse(f"stores mesh {label!r} as a triangle fan (mode 6), which this service does not "
-                             "read; export it as triangles")
+                raise refuse(
+                    f"stores mesh {label!r} as a triangle fan (mode 6), which this service does not read; export it as triangles"
+                )
             attrs: dict[str, Any] = prim["attributes"] if isinstance(prim.get("attributes"), dict) else {}
             for key in (attrs.get("POSITION"), prim.get("indices")):
-                if isinstance(key, int) and 0 <= key < len(accessors) and isinstance(accessors[key], dict) \
-                        and "sparse" in accessors[key]:
-                    raise refuse(f"stores mesh {label!r} with a sparse accessor, which this service does not "
-                                 "apply; export it without sparse storage")
+                if (
+                    isinstance(key, int)
+                    and 0 <= key < len(accessors)
+                    and isinstance(accessors[key], dict)
+                    and "sparse" in accessors[key]
+                ):
+                    raise refuse(
+                        f"stores mesh {label!r} with a sparse accessor, which this service does not "
+                        "apply; export it without sparse storage"
+                    )
     if any(isinstance(n, dict) and "skin" in n and "mesh" in n for n in nodes):
-        raise refuse("holds a skinned mesh, whose shape is set by its joints (the node's own transform is "
-                     "ignored, glTF 2.0 section 3.7.3); export the mesh with the skin applied")
+        raise refuse(
+            "holds a skinned mesh, whose shape is set by its joints (the node's own transform is "
+            "ignored, glTF 2.0 section 3.7.3); export the mesh with the skin applied"
+        )
     if lines:
         notes.append(f"{lines} point or line primitive(s) of the glTF file hold no volume and were left out")
     return notes
@@ -197,10 +227,26 @@ def _declared_unit(scene: Any, fmt: str) -> str | None:
 
 
 _UNIT_NAMES = {
-    "micron": "um", "micrometer": "um", "micrometre": "um", "um": "um",
-    "millimeter": "mm", "millimetre": "mm", "millimeters": "mm", "mm": "mm",
-    "centimeter": "cm", "centimetre": "cm", "centimeters": "cm", "cm": "cm",
-    "meter": "m", "metre": "m", "meters": "m", "m": "m",
-    "inch": "in", "inches": "in", "in": "in",
-    "foot": "ft", "feet": "ft", "ft": "ft",
+    "micron": "um",
+    "micrometer": "um",
+    "micrometre": "um",
+    "um": "um",
+    "millimeter": "mm",
+    "millimetre": "mm",
+    "millimeters": "mm",
+    "mm": "mm",
+    "centimeter": "cm",
+    "centimetre": "cm",
+    "centimeters": "cm",
+    "cm": "cm",
+    "meter": "m",
+    "metre": "m",
+    "meters": "m",
+    "m": "m",
+    "inch": "in",
+    "inches": "in",
+    "in": "in",
+    "foot": "ft",
+    "feet": "ft",
+    "ft": "ft",
 }

@@ -32,8 +32,9 @@ __all__ = ["read_obj"]
 
 def _fail(line_no: int, text: str, why: str) -> UnreadableFileError:
     shown = text if len(text) <= 60 else text[:57] + "..."
-    return UnreadableFileError(f"the OBJ file's line {line_no} ({shown!r}) {why}; fix that line or re-export the file",
-                               format="obj", line=line_no)
+    return UnreadableFileError(
+        f"the OBJ file's line {line_no} ({shown!r}) {why}; fix that line or re-export the file", format="obj", line=line_no
+    )
 
 
 def _lines(data: bytes) -> list[str]:
@@ -42,8 +43,9 @@ def _lines(data: bytes) -> list[str]:
     except UnicodeDecodeError:
         text = data.decode("latin-1")  # names only; numbers are ASCII in every encoding OBJ files use
     if "\x00" in text:
-        raise UnreadableFileError("the OBJ file holds binary data (NUL bytes), not OBJ text; check the file and "
-                                  "its extension", format="obj")
+        raise UnreadableFileError(
+            "the OBJ file holds binary data (NUL bytes), not OBJ text; check the file and its extension", format="obj"
+        )
     return text.replace("\\\r\n", " ").replace("\\\n", " ").splitlines()
 
 
@@ -91,8 +93,9 @@ def read_obj(data: bytes) -> list[tuple[str, NDArray[np.float64], NDArray[np.int
         raise EmptyGeometryError("the OBJ file has no vertices (v lines); send a mesh with geometry", format="obj")
     vertices = _vertices(v_rows, v_line, lines)
     if not f_rows:
-        raise EmptyGeometryError("the OBJ file has vertices but no faces (f lines); a solid needs triangles or "
-                                 "polygons", format="obj")
+        raise EmptyGeometryError(
+            "the OBJ file has vertices but no faces (f lines); a solid needs triangles or polygons", format="obj"
+        )
     triangles, owner = _faces(f_rows, f_line, f_part, f_seen, lines)
     order = sorted(names, key=names.__getitem__)
     parts = []
@@ -108,8 +111,11 @@ def _vertices(rows: list[list[str]], line_nos: list[int], lines: list[str]) -> N
     bad = np.flatnonzero(~np.isin(counts, (3, 4, 6, 7)))
     if len(bad):
         i = int(bad[0])
-        raise _fail(line_nos[i], lines[line_nos[i] - 1].strip(), f"gives {counts[i]} numbers; a vertex needs x y z "
-                    "(and optionally w, or r g b)")
+        raise _fail(
+            line_nos[i],
+            lines[line_nos[i] - 1].strip(),
+            f"gives {counts[i]} numbers; a vertex needs x y z (and optionally w, or r g b)",
+        )
     try:
         xyz = np.array([r[1:4] for r in rows], dtype=np.float64)
         weighted = np.flatnonzero(np.isin(counts, (4, 7)))
@@ -125,8 +131,9 @@ def _vertices(rows: list[list[str]], line_nos: list[int], lines: list[str]) -> N
     return xyz
 
 
-def _faces(rows: list[list[str]], line_nos: list[int], part: list[int], seen: list[int],
-           lines: list[str]) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
+def _faces(
+    rows: list[list[str]], line_nos: list[int], part: list[int], seen: list[int], lines: list[str]
+) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
     """Triangles (0-based, polygons split into fans from their first corner) and the part of each."""
     corners = np.fromiter((len(r) - 1 for r in rows), dtype=np.int64, count=len(rows))
     short = np.flatnonzero(corners < 3)
@@ -147,8 +154,11 @@ def _faces(rows: list[list[str]], line_nos: list[int], part: list[int], seen: li
     bad = np.flatnonzero((refs == 0) | (idx < 0) | (idx >= before))
     if len(bad):
         i = int(face_of[bad[0]])
-        raise _fail(line_nos[i], lines[line_nos[i] - 1].strip(),
-                    f"refers to vertex {int(refs[bad[0]])}, but only {seen[i]} vertices come before it")
+        raise _fail(
+            line_nos[i],
+            lines[line_nos[i] - 1].strip(),
+            f"refers to vertex {int(refs[bad[0]])}, but only {seen[i]} vertices come before it",
+        )
     starts = np.concatenate([[0], np.cumsum(corners)[:-1]])
     fans = corners - 2  # triangles per face
     tri_face = np.repeat(np.arange(len(rows)), fans)

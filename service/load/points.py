@@ -45,8 +45,9 @@ def _mass(rec: Mapping[str, Any], k: int, isotopes: str, dalton: float | None) -
         raise InvalidParameterError(f"point {k}: {exc.message}", index=k, **exc.details) from None
 
 
-def points_from_records(records: Iterable[Mapping[str, Any]], length_scale: float = 1.0, *,
-                        isotopes: str = "standard", mass_unit: str = "kg") -> PointBody:
+def points_from_records(
+    records: Iterable[Mapping[str, Any]], length_scale: float = 1.0, *, isotopes: str = "standard", mass_unit: str = "kg"
+) -> PointBody:
     """``[{"mass": m, "position": [x, y, z]}, ...]`` (or ``"element"`` for ``mass``) as a ``PointBody``.
 
     mass_unit : "kg" or "u" for given masses; element masses are always right.
@@ -75,15 +76,13 @@ def points_from_records(records: Iterable[Mapping[str, Any]], length_scale: floa
     return PointBody(np.array(masses), np.array(positions).reshape(-1, 3), length_scale)
 
 
-def read_points_file(data: bytes, fmt: str, length_scale: float = 1.0, *,
-                     isotopes: str = "standard") -> PointBody:
+def read_points_file(data: bytes, fmt: str, length_scale: float = 1.0, *, isotopes: str = "standard") -> PointBody:
     """A JSON list of records (or ``{"points": [...]}``), a CSV with columns mass,x,y,z
     (or element,x,y,z), or an XYZ file."""
     return read_points(data, fmt, length_scale, isotopes=isotopes)[0]
 
 
-def read_points(data: bytes, fmt: str, length_scale: float = 1.0, *,
-                isotopes: str = "standard") -> tuple[PointBody, bool]:
+def read_points(data: bytes, fmt: str, length_scale: float = 1.0, *, isotopes: str = "standard") -> tuple[PointBody, bool]:
     """The points of a file, and whether it names elements (a molecule: XYZ always does)."""
     records, warnings = _file_records(data.decode("utf-8-sig", errors="replace"), fmt)
     body = points_from_records(records, length_scale, isotopes=isotopes)
@@ -107,8 +106,9 @@ def _file_records(text: str, fmt: str) -> tuple[list[Any], list[str]]:
     rows = list(csv.DictReader(io.StringIO(text)))
     if not rows or not {"x", "y", "z"} <= set(rows[0]) or not {"mass", "element"} & set(rows[0]):
         raise UnreadableFileError("the CSV needs a header with columns mass,x,y,z (or element,x,y,z) and one row per point")
-    return [{"mass": r.get("mass") or None, "element": r.get("element") or None,
-             "position": [r["x"], r["y"], r["z"]]} for r in rows], []
+    return [
+        {"mass": r.get("mass") or None, "element": r.get("element") or None, "position": [r["x"], r["y"], r["z"]]} for r in rows
+    ], []
 
 
 def _xyz_records(text: str) -> tuple[list[Any], list[str]]:
@@ -122,7 +122,7 @@ def _xyz_records(text: str) -> tuple[list[Any], list[str]]:
         raise UnreadableFileError("an XYZ file starts with the number of atoms on its first line") from None
     if count < 1:
         raise EmptyGeometryError("the XYZ file holds no atoms; send at least one")
-    atoms = lines[2:2 + count]
+    atoms = lines[2 : 2 + count]
     if len(atoms) < count:
         raise UnreadableFileError(f"the XYZ file announces {count} atoms but holds {len(atoms)} atom lines")
     records = []
@@ -133,11 +133,11 @@ def _xyz_records(text: str) -> tuple[list[Any], list[str]]:
                 raise ValueError
             position = [float(x) for x in fields[1:4]]
         except ValueError:
-            raise UnreadableFileError(f"XYZ line {k + 3} must read 'element x y z', got {line.strip()!r}",
-                                      line=k + 3) from None
+            raise UnreadableFileError(f"XYZ line {k + 3} must read 'element x y z', got {line.strip()!r}", line=k + 3) from None
         records.append({"element": element_symbol(fields[0]), "position": position})
     warnings = []
-    if any(line.strip() for line in lines[2 + count:]):
-        warnings.append(f"the XYZ file goes on after its first frame of {count} atoms (a trajectory?); "
-                        "only the first frame was analysed")
+    if any(line.strip() for line in lines[2 + count :]):
+        warnings.append(
+            f"the XYZ file goes on after its first frame of {count} atoms (a trajectory?); only the first frame was analysed"
+        )
     return records, warnings

@@ -22,7 +22,7 @@ import zlib
 from collections.abc import Callable
 from typing import TypeVar
 
-from ..errors import PayloadTooLargeError, ServiceError, UnreadableFileError
+from ..errors import InputTooLargeError, ServiceError, UnreadableFileError
 
 __all__ = ["guarded_read", "explain"]
 
@@ -40,8 +40,11 @@ def explain(exc: BaseException) -> str:
     if isinstance(exc, (zipfile.BadZipFile, zlib.error)):
         return "its zip package or compressed data is corrupt"
     if isinstance(exc, KeyError):
-        return f"an entry the format requires is missing ({exc.args[0]!r:.60})" if exc.args else \
-            "an entry the format requires is missing"
+        return (
+            f"an entry the format requires is missing ({exc.args[0]!r:.60})"
+            if exc.args
+            else "an entry the format requires is missing"
+        )
     if isinstance(exc, IndexError):
         return "an element refers to another one that does not exist (an index past the end)"
     if isinstance(exc, RecursionError):
@@ -67,13 +70,15 @@ def guarded_read(fn: Callable[[], T], fmt: str) -> T:
     except ServiceError:
         raise
     except MemoryError as exc:
-        raise PayloadTooLargeError(f"the {fmt.upper()} file is too large to read in the memory available; "
-                                   "send a smaller or decimated mesh", format=fmt) from exc
+        raise InputTooLargeError(
+            f"the {fmt.upper()} file is too large to read in the memory available; send a smaller or decimated mesh", format=fmt
+        ) from exc
     except BaseException as exc:
         raise UnreadableFileError(
             f"the {fmt.upper()} file could not be read: {explain(exc)}; check that it is a complete {fmt.upper()} "
             "file, or re-export it from the program that made it",
-            format=fmt, reader_error=f"{type(exc).__name__}: {_short(exc)}",
+            format=fmt,
+            reader_error=f"{type(exc).__name__}: {_short(exc)}",
         ) from None
     finally:
         logging.disable(previous)

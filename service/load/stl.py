@@ -39,8 +39,7 @@ def read_stl(data: bytes | memoryview) -> tuple[NDArray[np.float64], NDArray[np.
     if head.startswith(b"solid"):
         return _ascii(bytes(buf))
     raise UnreadableFileError(
-        "the STL file is neither ASCII (starting with 'solid') nor binary of consistent length; "
-        "it may be truncated"
+        "the STL file is neither ASCII (starting with 'solid') nor binary of consistent length; it may be truncated"
     )
 
 

@@ -71,9 +71,13 @@ XML_NS = "http://www.w3.org/XML/1998/namespace"
 _SUPPORTED = {CORE, PROD, MAT, SLICE}
 _UNITS = {"micron": "um", "millimeter": "mm", "centimeter": "cm", "inch": "in", "foot": "ft", "meter": "m"}
 _TYPES = ("model", "support", "solidsupport", "surface", "other")
-_PROPERTY_TAGS = {f"{{{CORE}}}basematerials": "base", f"{{{MAT}}}colorgroup": "color",
-                  f"{{{MAT}}}texture2dgroup": "tex2coord", f"{{{MAT}}}compositematerials": "composite",
-                  f"{{{MAT}}}multiproperties": "multi"}
+_PROPERTY_TAGS = {
+    f"{{{CORE}}}basematerials": "base",
+    f"{{{MAT}}}colorgroup": "color",
+    f"{{{MAT}}}texture2dgroup": "tex2coord",
+    f"{{{MAT}}}compositematerials": "composite",
+    f"{{{MAT}}}multiproperties": "multi",
+}
 _MAX_DEPTH = 32  # component nesting; deeper is a cycle or a hostile file
 
 
@@ -82,8 +86,11 @@ class InvalidPackageError(UnreadableFileError):
 
 
 def _invalid(what: str, rule: str) -> InvalidPackageError:
-    return InvalidPackageError(f"the 3MF file is invalid: {what} ({rule} of the 3MF specification); "
-                               "re-export it from the program that made it", format="3mf", rule=rule)
+    return InvalidPackageError(
+        f"the 3MF file is invalid: {what} ({rule} of the 3MF specification); re-export it from the program that made it",
+        format="3mf",
+        rule=rule,
+    )
 
 
 @dataclass
@@ -118,8 +125,9 @@ def read_3mf(data: bytes) -> ThreeMF:
         archive = zipfile.ZipFile(io.BytesIO(data))
         names = {"/" + n.lstrip("/").lower(): n for n in archive.namelist()}
     except (zipfile.BadZipFile, OSError, ValueError, EOFError, NotImplementedError) as exc:
-        raise UnreadableFileError("the 3MF file is not a readable zip package (truncated or not a 3MF file); "
-                                  "check the file or re-export it", format="3mf") from exc
+        raise UnreadableFileError(
+            "the 3MF file is not a readable zip package (truncated or not a 3MF file); check the file or re-export it", format="3mf"
+        ) from exc
     reader = _Reader(archive, names)
     return reader.read()
 
@@ -139,8 +147,10 @@ class _Reader:
         try:
             return self.archive.read(name)
         except (zipfile.BadZipFile, OSError, ValueError, EOFError, NotImplementedError, RuntimeError) as exc:
-            raise UnreadableFileError(f"the 3MF file's part {path!r} cannot be decompressed (a corrupt or "
-                                      "encrypted zip entry); re-export the file", format="3mf") from exc
+            raise UnreadableFileError(
+                f"the 3MF file's part {path!r} cannot be decompressed (a corrupt or encrypted zip entry); re-export the file",
+                format="3mf",
+            ) from exc
 
     def exists(self, path: str) -> bool:
         return "/" + path.lstrip("/").lower() in self.names
@@ -154,10 +164,8 @@ class _Reader:
         for rel in root.iter(f"{{{RELS}}}Relationship"):
             attrs = {k: (v or "") for k, v in rel.attrib.items()}
             target = attrs.get("Target", "")
-            if attrs.get("TargetMode", "").lower() == "external" or ":" in target.split("/", 1)[0] or \
-                    target.startswith("//"):
-                raise _invalid(f"{rels_path} links to a file outside the package ({attrs.get('Target', '')[:80]!r})",
-                               "chapter 2.1")
+            if attrs.get("TargetMode", "").lower() == "external" or ":" in target.split("/", 1)[0] or target.startswith("//"):
+                raise _invalid(f"{rels_path} links to a file outside the package ({attrs.get('Target', '')[:80]!r})", "chapter 2.1")
             out.append(attrs)
         return out
 
@@ -167,8 +175,7 @@ class _Reader:
         rels = self.relationships("_rels/.rels")
         models = [r for r in rels if r.get("Type") == REL_MODEL]
         if len(models) != 1:
-            raise _invalid(f"the package names {len(models)} 3D model start parts; it must name exactly one",
-                           "chapter 2.1.1")
+            raise _invalid(f"the package names {len(models)} 3D model start parts; it must name exactly one", "chapter 2.1.1")
         root_path = _absolute(models[0].get("Target", ""), "/")
         for rel in rels:
             if rel.get("Type") == REL_THUMBNAIL and not self.exists(_absolute(rel.get("Target", ""), "/")):
@@ -179,8 +186,7 @@ class _Reader:
             if key.endswith(".rels"):
                 tickets = [r for r in self.relationships(name) if r.get("Type") == REL_PRINTTICKET]
                 if len(tickets) > 1:
-                    raise _invalid(f"{name} names {len(tickets)} print tickets; at most one is allowed",
-                                   "chapter 2.1.4")
+                    raise _invalid(f"{name} names {len(tickets)} print tickets; at most one is allowed", "chapter 2.1.4")
         root = self.part(root_path, is_root=True)
         return self.flatten(root)
 
@@ -217,8 +223,10 @@ class _Reader:
             if counts[name] > 1:
                 name = f"{name} #{counts[name]}"
             if obj.type != "model":
-                notes.append(f"3MF object {name!r} is of type {obj.type!r}: listed but not weighed "
-                             "(only objects of type 'model' are the part)")
+                notes.append(
+                    f"3MF object {name!r} is of type {obj.type!r}: listed but not weighed "
+                    "(only objects of type 'model' are the part)"
+                )
                 continue
             pieces = list(self.meshes(path, obj, transform, 0))
             if not pieces:
@@ -228,13 +236,17 @@ class _Reader:
             parts.append((name, np.concatenate(verts), np.concatenate([f + o for (_, f), o in zip(pieces, offsets)])))
         if not parts:
             if notes:
-                raise EmptyGeometryError("the 3MF file's build holds no object of type 'model' (only supports or "
-                                         "other objects), so there is no part to weigh", format="3mf")
+                raise EmptyGeometryError(
+                    "the 3MF file's build holds no object of type 'model' (only supports or "
+                    "other objects), so there is no part to weigh",
+                    format="3mf",
+                )
             raise EmptyGeometryError("the 3MF file's build holds no objects; add a build item", format="3mf")
         return ThreeMF(parts, root.unit, notes)
 
-    def meshes(self, path: str, obj: _Object, transform: NDArray[np.float64],
-               depth: int) -> Iterator[tuple[NDArray[np.float64], NDArray[np.int64]]]:
+    def meshes(
+        self, path: str, obj: _Object, transform: NDArray[np.float64], depth: int
+    ) -> Iterator[tuple[NDArray[np.float64], NDArray[np.int64]]]:
         if depth > _MAX_DEPTH:
             raise _invalid("components nest more than 32 deep (a cycle?)", "chapter 4.2")
         if obj.vertices is not None and obj.triangles is not None:
@@ -257,16 +269,25 @@ def _parse(raw: bytes, path: str) -> Any:
     from lxml import etree
 
     head = raw[:200].lstrip(b"\xef\xbb\xbf")
-    if head.startswith((b"\x00\x00\xfe\xff", b"\xff\xfe\x00\x00")) or b'encoding="UTF-32"' in head.upper() \
-            or b"encoding='UTF-32'" in head.upper().replace(b"\x00", b""):
+    if (
+        head.startswith((b"\x00\x00\xfe\xff", b"\xff\xfe\x00\x00"))
+        or b'encoding="UTF-32"' in head.upper()
+        or b"encoding='UTF-32'" in head.upper().replace(b"\x00", b"")
+    ):
         raise _invalid(f"{path} is not encoded in UTF-8 or UTF-16", "chapter 2.3")
-    parser = etree.XMLParser(resolve_entities=False, no_network=True, load_dtd=False, dtd_validation=False,
-                             huge_tree=False, remove_comments=True, remove_pis=True)
+    parser = etree.XMLParser(
+        resolve_entities=False,
+        no_network=True,
+        load_dtd=False,
+        dtd_validation=False,
+        huge_tree=False,
+        remove_comments=True,
+        remove_pis=True,
+    )
     try:
         tree = etree.parse(io.BytesIO(raw), parser)
     except etree.XMLSyntaxError as exc:
-        raise _invalid(f"{path} is not well-formed XML (line {exc.lineno}: {str(exc.msg)[:100]})", "chapter 2.3") \
-            from None
+        raise _invalid(f"{path} is not well-formed XML (line {exc.lineno}: {str(exc.msg)[:100]})", "chapter 2.3") from None
     info = tree.docinfo
     if info.internalDTD is not None or info.externalDTD is not None or info.doctype:
         raise _invalid(f"{path} declares a document type (DTD), which 3MF forbids", "chapter 2.3.2")
@@ -327,7 +348,9 @@ def _parse_model(model: Any, path: str, is_root: bool, reader: _Reader) -> _Part
             raise UnsupportedFormatError(
                 f"the 3MF file requires the extension {ns}, which this service does not implement (beam lattices, "
                 "volumetric or boolean geometry change the solid); export the part as a plain mesh",
-                format="3mf", extension=ns)
+                format="3mf",
+                extension=ns,
+            )
     _check_namespaces(model, path)
     children = list(model)
     metadata = [c for c in children if c.tag == f"{{{CORE}}}metadata"]
@@ -356,10 +379,8 @@ def _parse_model(model: Any, path: str, is_root: bool, reader: _Reader) -> _Part
             item_path = item.get(f"{{{PROD}}}path")
             target = _absolute(item_path, path) if item_path else path
             if item_path and not reader.exists(target):
-                raise _invalid(f"a build item's p:path {item_path!r} is not a part of the package",
-                               "production extension, ch. 3.1")
-            part.items.append((target, object_id, _transform(item.get("transform"), "a build item"),
-                               item.get("partnumber") or ""))
+                raise _invalid(f"a build item's p:path {item_path!r} is not a part of the package", "production extension, ch. 3.1")
+            part.items.append((target, object_id, _transform(item.get("transform"), "a build item"), item.get("partnumber") or ""))
     return part
 
 
@@ -389,15 +410,30 @@ def _check_namespaces(model: Any, path: str) -> None:
             continue
         bad = [el.tag] if unknown(el.tag) else [a for a in el.attrib if unknown(a)]
         if bad:
-            raise _invalid(f"{path} uses markup of the unknown namespace {bad[0][1:].split('}')[0]!r} without "
-                           "declaring it ignorable (mc:Ignorable)", "chapter 2.3.3")
+            raise _invalid(
+                f"{path} uses markup of the unknown namespace {bad[0][1:].split('}')[0]!r} without "
+                "declaring it ignorable (mc:Ignorable)",
+                "chapter 2.3.3",
+            )
 
 
 def _known_extension(ns: str) -> bool:
     """Published 3MF extension namespaces (their markup is understood, or refused where it matters)."""
-    return any(ns.startswith(_FAMILY + k) for k in ("material/", "production/", "slice/", "beamlattice/",
-                                                    "securecontent/", "trianglesets/", "volumetric/",
-                                                    "displacement/", "implicit/", "booleanoperations/"))
+    return any(
+        ns.startswith(_FAMILY + k)
+        for k in (
+            "material/",
+            "production/",
+            "slice/",
+            "beamlattice/",
+            "securecontent/",
+            "trianglesets/",
+            "volumetric/",
+            "displacement/",
+            "implicit/",
+            "booleanoperations/",
+        )
+    )
 
 
 def _parse_resources(resources: Any, part: _Part, is_root: bool) -> None:
@@ -427,8 +463,7 @@ def _parse_resources(resources: Any, part: _Part, is_root: bool) -> None:
             part.objects[obj.id] = obj
 
 
-def _check_property(res: Any, tag: str, where: str, sizes: dict[int, tuple[str, int]], part: _Part,
-                    ids: set[int]) -> int:
+def _check_property(res: Any, tag: str, where: str, sizes: dict[int, tuple[str, int]], part: _Part, ids: set[int]) -> int:
     child = _PROPERTY_TAGS[tag]
     ns = CORE if child == "base" else MAT
     entries = [c for c in res if c.tag == f"{{{ns}}}{child}"]
@@ -442,13 +477,16 @@ def _check_property(res: Any, tag: str, where: str, sizes: dict[int, tuple[str, 
     if child == "tex2coord":
         texid = _int(res, "texid", where)
         if texid not in sizes or sizes[texid][0] != f"{{{MAT}}}texture2d":
-            raise _invalid(f"{where} names texture {texid}, which is not a texture2d defined before it",
-                           "materials extension, ch. 3")
+            raise _invalid(
+                f"{where} names texture {texid}, which is not a texture2d defined before it", "materials extension, ch. 3"
+            )
     if child == "composite":
         matid = _int(res, "matid", where)
         if matid not in sizes or sizes[matid][0] != f"{{{CORE}}}basematerials":
-            raise _invalid(f"{where} names {matid} as its base materials, which is not a basematerials group "
-                           "defined before it", "materials extension, ch. 4")
+            raise _invalid(
+                f"{where} names {matid} as its base materials, which is not a basematerials group defined before it",
+                "materials extension, ch. 4",
+            )
         if res.get("matindices") is None:
             raise _invalid(f"{where} lacks matindices", "materials extension, ch. 4")
         for entry in entries:
@@ -463,16 +501,16 @@ def _check_property(res: Any, tag: str, where: str, sizes: dict[int, tuple[str, 
             try:
                 pid = int(token)
             except ValueError:
-                raise _invalid(f"{where} has a pid {token!r} that is not an integer", "materials extension, ch. 5") \
-                    from None
+                raise _invalid(f"{where} has a pid {token!r} that is not an integer", "materials extension, ch. 5") from None
             if pid not in sizes:
-                raise _invalid(f"{where} names property group {pid}, which is not defined before it",
-                               "materials extension, ch. 5")
+                raise _invalid(f"{where} names property group {pid}, which is not defined before it", "materials extension, ch. 5")
             kinds.append(sizes[pid][0])
         materials = sum(k in (f"{{{CORE}}}basematerials", f"{{{MAT}}}compositematerials") for k in kinds)
         if materials > 1 or kinds.count(f"{{{MAT}}}colorgroup") > 1 or f"{{{MAT}}}multiproperties" in kinds:
-            raise _invalid(f"{where} combines more than one material group or colour group, or another "
-                           "multiproperties", "materials extension, ch. 5")
+            raise _invalid(
+                f"{where} combines more than one material group or colour group, or another multiproperties",
+                "materials extension, ch. 5",
+            )
     return len(entries)
 
 
@@ -480,8 +518,10 @@ def _check_texture(res: Any, where: str) -> None:
     if not res.get("path"):
         raise _invalid(f"the texture {where} has no path", "materials extension, ch. 6")
     if res.get("contenttype") not in ("image/png", "image/jpeg"):
-        raise _invalid(f"the texture {where} has the content type {res.get('contenttype')!r}; it must be image/png "
-                       "or image/jpeg", "materials extension, ch. 6")
+        raise _invalid(
+            f"the texture {where} has the content type {res.get('contenttype')!r}; it must be image/png or image/jpeg",
+            "materials extension, ch. 6",
+        )
 
 
 def _check_pid(el: Any, where: str, sizes: dict[int, tuple[str, int]], pindex_attrs: tuple[str, ...]) -> int | None:
@@ -489,14 +529,12 @@ def _check_pid(el: Any, where: str, sizes: dict[int, tuple[str, int]], pindex_at
     if pid is None:
         return None
     if pid not in sizes or sizes[pid][0] == f"{{{MAT}}}texture2d":
-        raise _invalid(f"{where} names property group {pid}, which is not a property resource defined before it",
-                       "chapter 4 (pid)")
+        raise _invalid(f"{where} names property group {pid}, which is not a property resource defined before it", "chapter 4 (pid)")
     size = sizes[pid][1]
     for attr in pindex_attrs:
         index = _int(el, attr, where, required=False)
         if index is not None and index >= size:
-            raise _invalid(f"{where} has {attr}={index}, past the {size} entries of property group {pid}",
-                           "chapter 4 (pindex)")
+            raise _invalid(f"{where} has {attr}={index}, past the {size} entries of property group {pid}", "chapter 4 (pindex)")
     return pid
 
 
@@ -517,11 +555,17 @@ def _parse_object(res: Any, where: str, sizes: dict[int, tuple[str, int]], part:
     if meshes:
         mesh = meshes[0]
         if any(c.tag.startswith(f"{{{BEAM}}}") for c in mesh if isinstance(c.tag, str)):
-            raise UnsupportedFormatError(f"object {oid} of the 3MF file carries a beam lattice, whose beams this "
-                                         "service does not integrate; export the part as a plain mesh", format="3mf")
+            raise UnsupportedFormatError(
+                f"object {oid} of the 3MF file carries a beam lattice, whose beams this "
+                "service does not integrate; export the part as a plain mesh",
+                format="3mf",
+            )
         if res.get(f"{{{SLICE}}}meshresolution") == "lowres":
-            raise UnsupportedFormatError(f"object {oid} of the 3MF file holds only a low-resolution preview mesh "
-                                         "(its slices are the part); export the full-resolution mesh", format="3mf")
+            raise UnsupportedFormatError(
+                f"object {oid} of the 3MF file holds only a low-resolution preview mesh "
+                "(its slices are the part); export the full-resolution mesh",
+                format="3mf",
+            )
         obj.vertices, obj.triangles = _parse_mesh(mesh, oid, object_pid, sizes)
         if kind == "model":
             _check_closed(obj)
@@ -533,40 +577,45 @@ def _parse_object(res: Any, where: str, sizes: dict[int, tuple[str, int]], part:
             assert cid is not None
             comp_path = comp.get(f"{{{PROD}}}path")
             if not comp_path and cid not in part.objects:
-                raise _invalid(f"a component of object {oid} names object {cid}, which is not defined before it",
-                               "chapter 4.2")
-            obj.components.append((_absolute(comp_path, part.path) if comp_path else "", cid,
-                                   _transform(comp.get("transform"), f"a component of object {oid}")))
+                raise _invalid(f"a component of object {oid} names object {cid}, which is not defined before it", "chapter 4.2")
+            obj.components.append(
+                (
+                    _absolute(comp_path, part.path) if comp_path else "",
+                    cid,
+                    _transform(comp.get("transform"), f"a component of object {oid}"),
+                )
+            )
     return obj
 
 
-def _parse_mesh(mesh: Any, oid: int, object_pid: int | None,
-                sizes: dict[int, tuple[str, int]]) -> tuple[NDArray[np.float64], NDArray[np.int64]]:
+def _parse_mesh(
+    mesh: Any, oid: int, object_pid: int | None, sizes: dict[int, tuple[str, int]]
+) -> tuple[NDArray[np.float64], NDArray[np.int64]]:
     vertices_el = mesh.find(f"{{{CORE}}}vertices")
     triangles_el = mesh.find(f"{{{CORE}}}triangles")
     if vertices_el is None or triangles_el is None:
         raise _invalid(f"the mesh of object {oid} lacks its vertices or triangles", "chapter 4.1")
     try:
-        coords = [(v.attrib["x"], v.attrib["y"], v.attrib["z"]) for v in vertices_el
-                  if v.tag == f"{{{CORE}}}vertex"]
+        coords = [(v.attrib["x"], v.attrib["y"], v.attrib["z"]) for v in vertices_el if v.tag == f"{{{CORE}}}vertex"]
         vertices = np.array(coords, dtype=np.float64).reshape(-1, 3)
     except (KeyError, ValueError):
-        raise _invalid(f"a vertex of object {oid} lacks a coordinate or has one that is not a number",
-                       "chapter 4.1.1") from None
+        raise _invalid(f"a vertex of object {oid} lacks a coordinate or has one that is not a number", "chapter 4.1.1") from None
     if not np.all(np.isfinite(vertices)):
-        raise InvalidParameterError(f"a vertex of 3MF object {oid} has a coordinate that is not finite (NaN or "
-                                    "infinity); fix the file", field="vertex coordinates")
+        raise InvalidParameterError(
+            f"a vertex of 3MF object {oid} has a coordinate that is not finite (NaN or infinity); fix the file",
+            field="vertex coordinates",
+        )
     tris = [t for t in triangles_el if t.tag == f"{{{CORE}}}triangle"]
     try:
         triangles = np.array([(t.attrib["v1"], t.attrib["v2"], t.attrib["v3"]) for t in tris], dtype=np.int64)
     except (KeyError, ValueError, OverflowError):
-        raise _invalid(f"a triangle of object {oid} lacks a vertex index or has one that is not an integer",
-                       "chapter 4.1.2") from None
+        raise _invalid(
+            f"a triangle of object {oid} lacks a vertex index or has one that is not an integer", "chapter 4.1.2"
+        ) from None
     triangles = triangles.reshape(-1, 3)
     if len(triangles) and (triangles.min() < 0 or triangles.max() >= len(vertices)):
         raise _invalid(f"a triangle of object {oid} names a vertex that does not exist", "chapter 4.1.2")
-    if np.any((triangles[:, 0] == triangles[:, 1]) | (triangles[:, 1] == triangles[:, 2])
-              | (triangles[:, 0] == triangles[:, 2])):
+    if np.any((triangles[:, 0] == triangles[:, 1]) | (triangles[:, 1] == triangles[:, 2]) | (triangles[:, 0] == triangles[:, 2])):
         raise _invalid(f"a triangle of object {oid} uses one vertex twice", "chapter 4.1.2")
     for t in tris:
         if any(t.get(a) is not None for a in ("p1", "p2", "p3")):
@@ -578,8 +627,10 @@ def _parse_mesh(mesh: Any, oid: int, object_pid: int | None,
                 for a in ("p1", "p2", "p3"):
                     index = _int(t, a, f"a triangle of object {oid}", required=False)
                     if index is not None and index >= size:
-                        raise _invalid(f"a triangle of object {oid} has {a}={index}, past the {size} entries of "
-                                       f"property group {object_pid}", "chapter 4.1.2")
+                        raise _invalid(
+                            f"a triangle of object {oid} has {a}={index}, past the {size} entries of property group {object_pid}",
+                            "chapter 4.1.2",
+                        )
         elif t.get("pid") is not None:
             _check_pid(t, f"a triangle of object {oid}", sizes, ())
     return vertices, triangles
@@ -591,8 +642,7 @@ def _check_closed(obj: _Object) -> None:
 
     assert obj.triangles is not None and obj.vertices is not None
     if len(obj.triangles) == 0:
-        raise EmptyGeometryError(f"the 3MF object {obj.name or obj.id!r} of type model has no triangles",
-                                 format="3mf")
+        raise EmptyGeometryError(f"the 3MF object {obj.name or obj.id!r} of type model has no triangles", format="3mf")
     topo = surface_topology(obj.triangles, len(obj.vertices))
     if topo.open_edges or topo.unbalanced_edges:
         # a CAD exporter may write a seam's vertex twice (equal, or a rounding apart): judged after the same
@@ -609,5 +659,9 @@ def _check_closed(obj: _Object) -> None:
             f"the 3MF object {label!r} is of type model but its mesh is not a closed, consistently oriented "
             f"manifold ({topo.open_edges} open, {topo.nonmanifold_edges} non-manifold, {topo.unbalanced_edges} "
             "inconsistently wound edges), as the 3MF core specification requires (chapter 4.1); repair it in the "
-            "program that made it", open_edges=topo.open_edges, nonmanifold_edges=topo.nonmanifold_edges,
-            unbalanced_edges=topo.unbalanced_edges, part=label)
+            "program that made it",
+            open_edges=topo.open_edges,
+            nonmanifold_edges=topo.nonmanifold_edges,
+            unbalanced_edges=topo.unbalanced_edges,
+            part=label,
+        )

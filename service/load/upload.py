@@ -12,15 +12,35 @@ import io
 import posixpath
 import zipfile
 
-from ..errors import PayloadTooLargeError, UnreadableFileError, UnsupportedFormatError
+from ..errors import InputTooLargeError, UnreadableFileError, UnsupportedFormatError
 from .guard import inflate_budget
 from .sniff import FORMATS, POINT_FORMATS
 
 __all__ = ["unpack_zip", "pick_model_file", "COMPANION_EXTENSIONS", "MAX_FILES"]
 
 # files that only ever accompany a model: buffers, images, materials, TetGen's node/face/edge lists
-COMPANION_EXTENSIONS = frozenset({"bin", "png", "jpg", "jpeg", "webp", "ktx2", "dds", "mtl", "node", "face", "edge",
-                                  "neigh", "h5", "hdf5", "heavy", "txt", "md", "json_meta"})
+COMPANION_EXTENSIONS = frozenset(
+    {
+        "bin",
+        "png",
+        "jpg",
+        "jpeg",
+        "webp",
+        "ktx2",
+        "dds",
+        "mtl",
+        "node",
+        "face",
+        "edge",
+        "neigh",
+        "h5",
+        "hdf5",
+        "heavy",
+        "txt",
+        "md",
+        "json_meta",
+    }
+)
 MAX_FILES = 1000  # members of one upload; a model with its companions needs a handful
 
 
@@ -30,28 +50,33 @@ def unpack_zip(data: bytes) -> list[tuple[str, bytes]]:
         archive = zipfile.ZipFile(io.BytesIO(data))
         infos = [i for i in archive.infolist() if not i.is_dir()]
     except (zipfile.BadZipFile, OSError, ValueError, EOFError, NotImplementedError) as exc:
-        raise UnreadableFileError("the upload is not a readable zip archive (truncated or corrupt); check the file",
-                                  format="zip") from exc
+        raise UnreadableFileError(
+            "the upload is not a readable zip archive (truncated or corrupt); check the file", format="zip"
+        ) from exc
     infos = [i for i in infos if not any(p.startswith((".", "__MACOSX")) for p in i.filename.split("/"))]
     if len(infos) > MAX_FILES:
-        raise PayloadTooLargeError(f"the zip holds {len(infos)} files; at most {MAX_FILES} are accepted in one upload",
-                                   format="zip")
+        raise InputTooLargeError(f"the zip holds {len(infos)} files; at most {MAX_FILES} are accepted in one upload", format="zip")
     budget = inflate_budget(len(data))
     total = sum(i.file_size for i in infos)
     if total > budget:
-        raise PayloadTooLargeError(f"the zip would inflate to {total} bytes, more than the {budget} accepted for an "
-                                   f"upload of {len(data)} bytes", format="zip", limit_bytes=budget)
+        raise InputTooLargeError(
+            f"the zip would inflate to {total} bytes, more than the {budget} accepted for an upload of {len(data)} bytes",
+            format="zip",
+            limit_bytes=budget,
+        )
     files = []
     for info in infos:
         name = posixpath.normpath(info.filename.replace("\\", "/")).lstrip("/")
         if name.startswith("..") or not name:
-            raise UnreadableFileError(f"the zip holds a file named {info.filename[:80]!r} outside its own folder; "
-                                      "re-create the archive", format="zip")
+            raise UnreadableFileError(
+                f"the zip holds a file named {info.filename[:80]!r} outside its own folder; re-create the archive", format="zip"
+            )
         try:
             files.append((name, archive.read(info)))
         except (zipfile.BadZipFile, OSError, ValueError, EOFError, NotImplementedError, RuntimeError) as exc:
-            raise UnreadableFileError(f"the zip member {name[:80]!r} cannot be decompressed (corrupt or encrypted); "
-                                      "re-create the archive", format="zip") from exc
+            raise UnreadableFileError(
+                f"the zip member {name[:80]!r} cannot be decompressed (corrupt or encrypted); re-create the archive", format="zip"
+            ) from exc
     if not files:
         raise UnreadableFileError("the zip holds no files; put the model and its companion files in it", format="zip")
     return files
@@ -84,11 +109,15 @@ def pick_model_file(files: list[tuple[str, bytes]], format: str | None = None) -
     if not models:
         raise UnsupportedFormatError(
             f"the upload holds no model file ({', '.join(n[:60] for n in names[:8])}); include one of the readable "
-            f"formats ({', '.join(FORMATS)}) beside its companion files", files=names[:50])
+            f"formats ({', '.join(FORMATS)}) beside its companion files",
+            files=names[:50],
+        )
     if len(models) > 1:
         raise UnsupportedFormatError(
             f"the upload holds {len(models)} model files ({', '.join(m[:60] for m in models[:8])}); send one model "
-            "(with its companion files) per upload, or analyse them one by one with batch", files=models[:50])
+            "(with its companion files) per upload, or analyse them one by one with batch",
+            files=models[:50],
+        )
     main = models[0]
     companions: dict[str, bytes] = {}
     for name, data in files:

@@ -61,27 +61,75 @@ VTK_FORMATS = ("vtk", "vtu")
 
 # VTK cell type id -> our (meshio's) name; voxels become hexahedra
 VTK_CELL_TYPES = {
-    10: "tetra", 11: "voxel", 12: "hexahedron", 13: "wedge", 14: "pyramid",
-    24: "tetra10", 25: "hexahedron20", 26: "wedge15", 27: "pyramid13", 29: "hexahedron27", 32: "wedge18",
+    10: "tetra",
+    11: "voxel",
+    12: "hexahedron",
+    13: "wedge",
+    14: "pyramid",
+    24: "tetra10",
+    25: "hexahedron20",
+    26: "wedge15",
+    27: "pyramid13",
+    29: "hexahedron27",
+    32: "wedge18",
 }
 # 3-D VTK cells we cannot integrate (refused, never dropped)
 _VTK_OTHER_3D = {
-    15: "pentagonal prism", 16: "hexagonal prism", 33: "24-node hexahedron", 37: "19-node pyramid",
-    42: "polyhedron", 71: "Lagrange tetrahedron", 72: "Lagrange hexahedron", 73: "Lagrange wedge",
-    74: "Lagrange pyramid", 78: "Bezier tetrahedron", 79: "Bezier hexahedron", 80: "Bezier wedge",
+    15: "pentagonal prism",
+    16: "hexagonal prism",
+    33: "24-node hexahedron",
+    37: "19-node pyramid",
+    42: "polyhedron",
+    71: "Lagrange tetrahedron",
+    72: "Lagrange hexahedron",
+    73: "Lagrange wedge",
+    74: "Lagrange pyramid",
+    78: "Bezier tetrahedron",
+    79: "Bezier hexahedron",
+    80: "Bezier wedge",
     81: "Bezier pyramid",
 }
 _NODES = {**CELL_NODES, "tetra": 4, "voxel": 8}
 _ALIASES = {"tetra4": "tetra", "hexahedron8": "hexahedron", "wedge6": "wedge", "pyramid5": "pyramid"}
 # meshio names of 3-D cells we cannot integrate
-_MESHIO_OTHER_3D = ("pyramid14", "hexahedron24", "wedge12", "penta_prism", "hexa_prism", "polyhedron",
-                    "tetra20", "tetra35", "tetra56", "hexahedron64", "hexahedron125", "wedge40", "wedge75",
-                    "pyramid30", "pyramid55", "VTK_LAGRANGE_TETRAHEDRON", "VTK_LAGRANGE_HEXAHEDRON",
-                    "VTK_LAGRANGE_WEDGE", "VTK_LAGRANGE_PYRAMID", "VTK_BEZIER_TETRAHEDRON",
-                    "VTK_BEZIER_HEXAHEDRON", "VTK_BEZIER_WEDGE", "VTK_BEZIER_PYRAMID")
-_FORMAT_NAMES = {"vtk": "legacy VTK", "vtu": "VTK XML (.vtu)", "msh": "Gmsh", "mesh": "Medit", "inp": "Abaqus",
-                 "xdmf": "XDMF", "med": "MED", "f3grid": "FLAC3D", "dat": "Tecplot", "ugrid": "UGRID",
-                 "ele": "TetGen"}
+_MESHIO_OTHER_3D = (
+    "pyramid14",
+    "hexahedron24",
+    "wedge12",
+    "penta_prism",
+    "hexa_prism",
+    "polyhedron",
+    "tetra20",
+    "tetra35",
+    "tetra56",
+    "hexahedron64",
+    "hexahedron125",
+    "wedge40",
+    "wedge75",
+    "pyramid30",
+    "pyramid55",
+    "VTK_LAGRANGE_TETRAHEDRON",
+    "VTK_LAGRANGE_HEXAHEDRON",
+    "VTK_LAGRANGE_WEDGE",
+    "VTK_LAGRANGE_PYRAMID",
+    "VTK_BEZIER_TETRAHEDRON",
+    "VTK_BEZIER_HEXAHEDRON",
+    "VTK_BEZIER_WEDGE",
+    "VTK_BEZIER_PYRAMID",
+)
+_FORMAT_NAMES = {
+    "vtk": "legacy VTK",
+    "vtu": "VTK XML (.vtu)",
+    "msh": "Gmsh",
+    "mesh": "Medit",
+    "inp": "Abaqus",
+    "xdmf": "XDMF",
+    "med": "MED",
+    "f3grid": "FLAC3D",
+    "dat": "Tecplot",
+    "ugrid": "UGRID",
+    "ele": "TetGen",
+}
 
 
 @dataclass
@@ -103,8 +151,9 @@ class _Mesh:
     warnings: list[str] = field(default_factory=list)
 
 
-def read_volume_parts(data: bytes, fmt: str, length_scale: float, *, filename: str | None = None,
-                      companions: Mapping[str, bytes] | None = None) -> list[Part]:
+def read_volume_parts(
+    data: bytes, fmt: str, length_scale: float, *, filename: str | None = None, companions: Mapping[str, bytes] | None = None
+) -> list[Part]:
     """Parts of a volume mesh: one per block of 3-D cells.
 
     companions : other files of the same upload by name (a TetGen ``.node``
@@ -134,8 +183,7 @@ def _quiet() -> Iterator[io.StringIO]:
 
 
 @contextlib.contextmanager
-def _upload_dir(data: bytes, fmt: str, filename: str | None,
-                companions: Mapping[str, bytes] | None) -> Iterator[str]:
+def _upload_dir(data: bytes, fmt: str, filename: str | None, companions: Mapping[str, bytes] | None) -> Iterator[str]:
     """A private folder holding the upload (and its companion files); yields the main file's path."""
     stem = _safe_stem(filename)
     with tempfile.TemporaryDirectory() as tmp:
@@ -186,7 +234,8 @@ def _vtk_missing(label: str, fmt: str) -> UnsupportedFormatError:
     return UnsupportedFormatError(
         f"reading {label} needs VTK's own reader, the optional extra 'vtk': "
         "install it with pip install 'inertia-service[vtk]', or convert the mesh to Gmsh (.msh)",
-        format=fmt, extra="vtk",
+        format=fmt,
+        extra="vtk",
     )
 
 
@@ -222,14 +271,18 @@ def _read_vtk(data: bytes, fmt: str, label: str) -> _Mesh:
         except KeyboardInterrupt:
             raise
         except BaseException as exc:  # VTK's wrappers raise whatever the C++ side threw
-            raise UnreadableFileError(f"could not read {label}: {_reason(exc, _text(window.GetOutput()), (path,))}; "
-                                      "check that it is a complete VTK file", format=fmt) from exc
+            raise UnreadableFileError(
+                f"could not read {label}: {_reason(exc, _text(window.GetOutput()), (path,))}; check that it is a complete VTK file",
+                format=fmt,
+            ) from exc
         finally:
             vtkOutputWindow.SetInstance(previous)
         log = _vtk_errors(_text(window.GetOutput()), path)
     if grid is None or (log and grid.GetNumberOfCells() == 0):
-        raise UnreadableFileError(f"could not read {label}: {log or 'VTK found no data set in it'}; "
-                                  "check that it is a complete, uncorrupted VTK file", format=fmt)
+        raise UnreadableFileError(
+            f"could not read {label}: {log or 'VTK found no data set in it'}; check that it is a complete, uncorrupted VTK file",
+            format=fmt,
+        )
     if log:
         raise UnreadableFileError(f"{label} is damaged: VTK reported '{log}'; re-export it", format=fmt)
     return _mesh_from_grid(grid, vtk_to_numpy, label)
@@ -284,13 +337,26 @@ def _mesh_from_grid(grid: Any, to_numpy: Any, label: str) -> _Mesh:
     return mesh
 
 
-_VTK_2D_NAMES = {1: "vertex", 2: "polyvertex", 3: "line", 4: "polyline", 5: "triangle", 6: "triangle strip",
-                 7: "polygon", 8: "pixel", 9: "quad", 21: "quadratic edge", 22: "quadratic triangle",
-                 23: "quadratic quad", 28: "biquadratic quad"}
+_VTK_2D_NAMES = {
+    1: "vertex",
+    2: "polyvertex",
+    3: "line",
+    4: "polyline",
+    5: "triangle",
+    6: "triangle strip",
+    7: "polygon",
+    8: "pixel",
+    9: "quad",
+    21: "quadratic edge",
+    22: "quadratic triangle",
+    23: "quadratic quad",
+    28: "biquadratic quad",
+}
 
 
-def _fixed_width(conn: NDArray[np.int64], offsets: NDArray[np.int64], ids: NDArray[np.int64], width: int,
-                 name: str, label: str, notes: list[str]) -> NDArray[np.int64]:
+def _fixed_width(
+    conn: NDArray[np.int64], offsets: NDArray[np.int64], ids: NDArray[np.int64], width: int, name: str, label: str, notes: list[str]
+) -> NDArray[np.int64]:
     """The first ``width`` node ids of each cell, as VTK's cells use them; refuse too-short lists."""
     counts = offsets[ids + 1] - offsets[ids]
     if np.any(counts < width):
@@ -301,9 +367,11 @@ def _fixed_width(conn: NDArray[np.int64], offsets: NDArray[np.int64], ids: NDArr
         )
     longer = int(np.count_nonzero(counts > width))
     if longer:
-        notes.append(f"{longer} {name} cells list more node ids than a {name} has ({int(counts.max())} for {width}); "
-                     f"their first {width} were used, as VTK reads them: if the cells are meant to be quadratic, "
-                     "write them with the quadratic cell type")
+        notes.append(
+            f"{longer} {name} cells list more node ids than a {name} has ({int(counts.max())} for {width}); "
+            f"their first {width} were used, as VTK reads them: if the cells are meant to be quadratic, "
+            "write them with the quadratic cell type"
+        )
     nodes: NDArray[np.int64] = conn[offsets[ids][:, None] + np.arange(width)[None, :]]
     return nodes
 
@@ -314,8 +382,9 @@ def _vtk_density(grid: Any, to_numpy: Any, n_cells: int, label: str) -> NDArray[
         return None
     values = np.asarray(to_numpy(array), dtype=np.float64)
     if values.shape != (n_cells,):
-        raise UnreadableFileError(f"{label} has a 'density' cell array of shape {values.shape}; "
-                                  f"it needs one value per cell ({n_cells})", field="density")
+        raise UnreadableFileError(
+            f"{label} has a 'density' cell array of shape {values.shape}; it needs one value per cell ({n_cells})", field="density"
+        )
     return values
 
 
@@ -328,8 +397,7 @@ def _vtk_density(grid: Any, to_numpy: Any, n_cells: int, label: str) -> NDArray[
 _MESHIO_MISSING_DIMENSIONS = {"wedge15": 3, "pyramid13": 3, "hexahedron24": 3}
 
 
-def _read_meshio(data: bytes, fmt: str, label: str, filename: str | None,
-                 companions: Mapping[str, bytes] | None) -> _Mesh:
+def _read_meshio(data: bytes, fmt: str, label: str, filename: str | None, companions: Mapping[str, bytes] | None) -> _Mesh:
     import meshio
     from meshio import _mesh
 
@@ -344,17 +412,16 @@ def _read_meshio(data: bytes, fmt: str, label: str, filename: str | None,
         except KeyboardInterrupt:
             raise
         except BaseException as exc:  # meshio calls sys.exit(1) and raises KeyError, ValueError, ...
-            raise UnreadableFileError(_meshio_failure(exc, printed.getvalue(), path, fmt, label, companions),
-                                      format=fmt) from exc
+            raise UnreadableFileError(_meshio_failure(exc, printed.getvalue(), path, fmt, label, companions), format=fmt) from exc
     return _mesh_from_meshio(mesh, label)
 
 
-def _meshio_failure(exc: BaseException, printed: str, path: str, fmt: str, label: str,
-                    companions: Mapping[str, bytes] | None) -> str:
+def _meshio_failure(
+    exc: BaseException, printed: str, path: str, fmt: str, label: str, companions: Mapping[str, bytes] | None
+) -> str:
     reason = _reason(exc, printed, (path, os.path.dirname(path)))
     if fmt == "ele" and isinstance(exc, (FileNotFoundError, OSError)) and not companions:
-        return (f"{label} needs its companion .node file (the point coordinates): upload both, "
-                "as a .zip or as two files")
+        return f"{label} needs its companion .node file (the point coordinates): upload both, as a .zip or as two files"
     if isinstance(exc, (FileNotFoundError, OSError)) and ".node" in str(exc):
         return f"{label} refers to a companion file that was not uploaded ({reason}); upload it with the mesh"
     return f"could not read {label}: {reason}; check that the file is complete and of the format its name says"
@@ -388,8 +455,10 @@ def _mesh_from_meshio(mesh: Any, label: str) -> _Mesh:
             out.other[ctype] = out.other.get(ctype, 0) + len(nodes)
         elif len(nodes):
             if nodes.ndim != 2 or nodes.shape[1] != _NODES[ctype]:
-                raise UnreadableFileError(f"{label} has {ctype} cells with {nodes.shape[-1]} nodes each; "
-                                          f"a {ctype} has {_NODES[ctype]}: the file is inconsistent")
+                raise UnreadableFileError(
+                    f"{label} has {ctype} cells with {nodes.shape[-1]} nodes each; "
+                    f"a {ctype} has {_NODES[ctype]}: the file is inconsistent"
+                )
             if ctype == "voxel":
                 nodes, ctype = nodes[:, VOXEL_TO_HEXAHEDRON], "hexahedron"
             out.blocks.append(_Block(ctype, nodes, ids, names[i]))
@@ -398,8 +467,7 @@ def _mesh_from_meshio(mesh: Any, label: str) -> _Mesh:
     if densities is not None:
         values = np.concatenate(per_cell) if per_cell else np.empty(0)
         if len(values) != start:
-            raise UnreadableFileError(f"{label} has a 'density' cell array that does not give one value per cell",
-                                      field="density")
+            raise UnreadableFileError(f"{label} has a 'density' cell array that does not give one value per cell", field="density")
         out.density = values
     return out
 
@@ -422,8 +490,10 @@ def _block_names(mesh: Any) -> list[str]:
 
 def _unsupported_cells(label: str, counts: Mapping[str, int]) -> str:
     listed = ", ".join(f"{n} {t}" for t, n in sorted(counts.items()))
-    return (f"{label} holds 3-D cells we cannot integrate exactly ({listed}); convert them to tetrahedra, "
-            "hexahedra, wedges or pyramids (linear or quadratic), for example with Gmsh")
+    return (
+        f"{label} holds 3-D cells we cannot integrate exactly ({listed}); convert them to tetrahedra, "
+        "hexahedra, wedges or pyramids (linear or quadratic), for example with Gmsh"
+    )
 
 
 def _parts(mesh: _Mesh, label: str, length_scale: float) -> list[Part]:
@@ -436,12 +506,14 @@ def _parts(mesh: _Mesh, label: str, length_scale: float) -> list[Part]:
     if not np.all(np.isfinite(mesh.points)):
         raise UnreadableFileError(f"{label} has point coordinates that are NaN or infinite; fix the mesh")
     if mesh.density is not None and mesh.blocks and np.any(mesh.density[np.concatenate([b.cell_ids for b in mesh.blocks])] <= 0):
-        raise UnreadableFileError(f"{label} has cells whose 'density' is zero or negative; densities must be "
-                                  "positive (kg/m^3)", field="density")
+        raise UnreadableFileError(
+            f"{label} has cells whose 'density' is zero or negative; densities must be positive (kg/m^3)", field="density"
+        )
     for b in mesh.blocks:
         if b.nodes.size and (b.nodes.min() < 0 or b.nodes.max() >= len(mesh.points)):
-            raise UnreadableFileError(f"{label} has a {b.type} cell that refers to a point that does not exist; "
-                                      "the file is corrupt")
+            raise UnreadableFileError(
+                f"{label} has a {b.type} cell that refers to a point that does not exist; the file is corrupt"
+            )
     parts: list[Part] = []
     for i, b in enumerate(mesh.blocks):
         notes = tuple(mesh.warnings) if i == 0 else ()  # file-wide notes, said once
@@ -449,7 +521,8 @@ def _parts(mesh: _Mesh, label: str, length_scale: float) -> list[Part]:
         if b.type == "tetra":
             body = VolumeBody(mesh.points, b.nodes, rho, length_scale, b.name, notes)
         else:
-            body = VolumeBody(mesh.points, np.empty((0, 4), np.int64), None, length_scale, b.name, notes,
-                              (CellBlock(b.type, b.nodes, rho),))
+            body = VolumeBody(
+                mesh.points, np.empty((0, 4), np.int64), None, length_scale, b.name, notes, (CellBlock(b.type, b.nodes, rho),)
+            )
         parts.append(Part(b.name, body))
     return parts

@@ -165,14 +165,18 @@ def _check_scale(frame: PrincipalFrame, omega: Array) -> None:
     """The body must have inertia, and |M| and E must stay well inside float64."""
     largest = float(frame.moments[-1])
     if not largest > 0:
-        raise InvalidParameterError("the body has no rotational inertia (all its mass is at one point), "
-                                    "so its free rotation is undefined; leave out omega", parameter="omega")
+        raise InvalidParameterError(
+            "the body has no rotational inertia (all its mass is at one point), so its free rotation is undefined; leave out omega",
+            parameter="omega",
+        )
     # |M| <= I3 |omega| and 2E <= I3 |omega|^2; the motion squares and multiplies these
     speed2 = float(omega @ omega)
     if not (largest * np.sqrt(speed2) <= MAX_MOMENTUM and largest * speed2 <= MAX_MOMENTUM):
-        raise InvalidParameterError("omega and the moments of inertia are so large that the angular momentum "
-                                    "or energy would overflow float64; rescale them (other units)",
-                                    parameter="omega")
+        raise InvalidParameterError(
+            "omega and the moments of inertia are so large that the angular momentum "
+            "or energy would overflow float64; rescale them (other units)",
+            parameter="omega",
+        )
 
 
 def _parse_times(duration: float | None, samples: int | None) -> Array | None:
@@ -185,9 +189,7 @@ def _parse_times(duration: float | None, samples: int | None) -> Array | None:
     if not (number and np.isfinite(duration) and duration > 0):
         raise InvalidParameterError(f"duration must be a finite number of seconds > 0, got {duration!r}", parameter="duration")
     if isinstance(samples, bool) or not isinstance(samples, (int, np.integer)) or not 2 <= samples <= MAX_SAMPLES:
-        raise InvalidParameterError(
-            f"samples must be an integer from 2 to {MAX_SAMPLES}, got {samples!r}", parameter="samples"
-        )
+        raise InvalidParameterError(f"samples must be an integer from 2 to {MAX_SAMPLES}, got {samples!r}", parameter="samples")
     return np.linspace(0.0, float(duration), int(samples))
 
 

@@ -61,9 +61,7 @@ def _landen_moduli(m1: float) -> tuple[list[float], list[float]]:
     return ks, m1s
 
 
-def jacobi_sncndn(
-    u: NDArray[np.float64], m1: float
-) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+def jacobi_sncndn(u: NDArray[np.float64], m1: float) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
     """sn(u|m), cn(u|m), dn(u|m) for 0 < m1 = 1 - m <= 1, any real u (best |u| <= K).
 
     Descending Landen transformation (A&S 16.12.2-16.12.4) down to a modulus
@@ -117,9 +115,7 @@ def incomplete_first_kind(sin_phi: float, cos_phi: float, m1: float) -> float:
     return float(sin_phi * elliprf(cos_phi * cos_phi, delta2, 1.0))
 
 
-def third_kind_rj(
-    sn: NDArray[np.float64], cn: NDArray[np.float64], dn: NDArray[np.float64], b: float
-) -> NDArray[np.float64]:
+def third_kind_rj(sn: NDArray[np.float64], cn: NDArray[np.float64], dn: NDArray[np.float64], b: float) -> NDArray[np.float64]:
     """sn^3 R_J(cn^2, dn^2, 1, 1 + b sn^2) for the reduced argument (cn >= 0).
 
     With n = -b, DLMF 19.25.14 gives Pi(n; am u | m) = u + (n/3) times this.

@@ -64,9 +64,7 @@ def kinetic_energy(moments: Array, omega_body: Array) -> float:
     return float(0.5 * np.sum(moments * omega_body * omega_body))
 
 
-def invariant_drifts(
-    problem: RigidProblem, omega_body: Array, quaternion: Array
-) -> tuple[float, float]:
+def invariant_drifts(problem: RigidProblem, omega_body: Array, quaternion: Array) -> tuple[float, float]:
     """Max relative drift of the energy and of M in the input frame along a trajectory.
 
     M(t) is rebuilt as the client would: the attitude ``quaternion`` (t=0 ->

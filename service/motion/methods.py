@@ -78,8 +78,9 @@ class _Scipy(PropagationMethod):
     def propagate(self, setup: Setup, t: Array, tol: Tolerances) -> tuple[Array, Array]:
         from .integrators import integrate_scipy
 
-        return integrate_scipy(setup.problem, t, self.name.value, tol.integrator_rtol, tol.integrator_atol_rel,
-                               tol.max_integration_steps)
+        return integrate_scipy(
+            setup.problem, t, self.name.value, tol.integrator_rtol, tol.integrator_atol_rel, tol.max_integration_steps
+        )
 
 
 class Dop853(_Scipy):

@@ -15,6 +15,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..arrays import frozen_array
+from ..vocabulary import MotionMethod
 
 __all__ = ["Regime", "MotionMethod", "Trajectory", "MotionDiagnostics", "FreeMotion"]
 
@@ -30,15 +31,6 @@ class Regime(enum.Enum):
     REGULAR_PRECESSION = "regular_precession"
     ASYMMETRIC = "asymmetric"
     ROTATOR = "rotator"
-
-
-class MotionMethod(enum.Enum):
-    """The API's ``method``: how Omega(t) and the attitude are computed."""
-
-    EXACT = "exact"
-    DOP853 = "dop853"
-    RK45 = "rk45"
-    SPLITTING = "splitting"
 
 
 @dataclass(frozen=True, slots=True)

@@ -11,7 +11,8 @@ import pytest
 
 from inertia.api.compute import ComputePool
 from inertia.api.jobs import MeshJob
-from inertia.errors import ComputeTimeoutError, NotWatertightError
+from inertia.api.transport import ComputeTimeoutError
+from inertia.errors import NotWatertightError
 from inertia.pipeline import AnalysisOptions
 from tests.support.meshes import box_stl, torus_stl
 
@@ -19,7 +20,7 @@ from tests.support.meshes import box_stl, torus_stl
 def open_box() -> bytes:
     """The unit box without its last triangle (binary STL: 80-byte header, count, 50-byte records)."""
     data = box_stl(1, 1, 1)
-    return data[:80] + struct.pack("<I", 11) + data[84:84 + 50 * 11]
+    return data[:80] + struct.pack("<I", 11) + data[84 : 84 + 50 * 11]
 
 
 def pool_processes(pool: ComputePool) -> list[multiprocessing.process.BaseProcess]:

@@ -47,8 +47,15 @@ def test_box_mass_centre_and_tensor_match_closed_form(client: TestClient) -> Non
     assert close(doc["principal"]["moments"], [2500, 5000, 6500])
     assert np.linalg.det(np.array(doc["principal"]["axes"])) == pytest.approx(1, rel=1e-12)
     assert doc["classification"]["kind"] == "asymmetric_top"
-    assert doc["source"] == {**doc["source"], "filename": "box.stl", "format": "stl", "kind": "mesh",
-                             "vertices": 8, "triangles": 12, "watertight": True}
+    assert doc["source"] == {
+        **doc["source"],
+        "filename": "box.stl",
+        "format": "stl",
+        "kind": "mesh",
+        "vertices": 8,
+        "triangles": 12,
+        "watertight": True,
+    }
 
 
 def test_response_holds_only_sections_asked_for(client: TestClient) -> None:
@@ -96,8 +103,9 @@ def test_omega_with_duration_and_samples_adds_a_trajectory(client: TestClient) -
 
 
 def test_points_dumbbell_is_a_linear_rotator(client: TestClient) -> None:
-    r = client.post("/v1/analyze/points", json={"points": [
-        {"mass": 1.0, "position": [0, 0, 0]}, {"mass": 1.0, "position": [1, 0, 0]}]})
+    r = client.post(
+        "/v1/analyze/points", json={"points": [{"mass": 1.0, "position": [0, 0, 0]}, {"mass": 1.0, "position": [1, 0, 0]}]}
+    )
     assert r.status_code == 200, r.text
     doc = r.json()
     # two masses m at distance d: I = m d^2 / 2 about the centre, perpendicular to the rod
@@ -108,9 +116,16 @@ def test_points_dumbbell_is_a_linear_rotator(client: TestClient) -> None:
 
 
 def test_points_example_of_the_contract_works(client: TestClient) -> None:
-    body = {"points": [{"mass": 1.0, "position": [0, 0, 0]}, {"mass": 2.0, "position": [1, 0, 0]}],
-            "units": "m", "tolerance": 1e-6, "reference": [0, 0, 0], "omega": [0, 0, 1],
-            "duration": 10.0, "samples": 100, "method": "exact"}
+    body = {
+        "points": [{"mass": 1.0, "position": [0, 0, 0]}, {"mass": 2.0, "position": [1, 0, 0]}],
+        "units": "m",
+        "tolerance": 1e-6,
+        "reference": [0, 0, 0],
+        "omega": [0, 0, 1],
+        "duration": 10.0,
+        "samples": 100,
+        "method": "exact",
+    }
     doc = client.post("/v1/analyze/points", json=body).json()
     # I about the centre: m1 m2 d^2 / (m1 + m2) = 2/3
     assert close(doc["principal"]["moments"], [0, 2 / 3, 2 / 3])
@@ -137,8 +152,10 @@ def test_precession_of_symmetric_top_matches_landau_lifshitz(client: TestClient)
 
 
 def test_precession_from_a_tensor_rotates_into_the_input_frame(client: TestClient) -> None:
-    r = client.post("/v1/precession", json={"inertia_tensor": [[3, 0, 0], [0, 2, 0], [0, 0, 4]],
-                                            "omega": [0, 0, 1], "duration": 1, "samples": 3})
+    r = client.post(
+        "/v1/precession",
+        json={"inertia_tensor": [[3, 0, 0], [0, 2, 0], [0, 0, 4]], "omega": [0, 0, 1], "duration": 1, "samples": 3},
+    )
     doc = r.json()
     assert close(doc["principal"]["moments"], [2, 3, 4])
     assert doc["precession"]["regime"] == "permanent_rotation"
@@ -161,8 +178,12 @@ def _lines(response: Any) -> list[dict[str, Any]]:
 
 
 def test_batch_streams_one_line_per_file_in_upload_order(client: TestClient) -> None:
-    files = [("files", ("a.stl", box_stl(1, 2, 3))), ("files", ("notes.txt", b"hello")),
-             ("files", ("empty.stl", b"")), ("files", ("b.stl", box_stl(2, 2, 2)))]
+    files = [
+        ("files", ("a.stl", box_stl(1, 2, 3))),
+        ("files", ("notes.txt", b"hello")),
+        ("files", ("empty.stl", b"")),
+        ("files", ("b.stl", box_stl(2, 2, 2))),
+    ]
     lines = _lines(client.post("/v1/batch", files=files, params={"density": 500}))
     assert [line["source"]["filename"] for line in lines] == ["a.stl", "notes.txt", "empty.stl", "b.stl"]
     assert lines[0]["mass"] == pytest.approx(3000) and lines[3]["mass"] == pytest.approx(4000)
@@ -180,8 +201,7 @@ def test_batch_of_a_zip_expands_members_in_archive_order(client: TestClient) -> 
         zf.writestr("parts/two.stl", box_stl(1, 1, 2))
     files = [("files", ("parts.zip", buf.getvalue())), ("files", ("broken.zip", b"PK not really"))]
     lines = _lines(client.post("/v1/batch", files=files))
-    assert [line["source"]["filename"] for line in lines] == ["parts/one.stl", "readme.md", "parts/two.stl",
-                                                             "broken.zip"]
+    assert [line["source"]["filename"] for line in lines] == ["parts/one.stl", "readme.md", "parts/two.stl", "broken.zip"]
     assert lines[0]["mass"] == pytest.approx(1000) and lines[2]["mass"] == pytest.approx(2000)
     assert lines[1]["error"]["code"] == "unsupported_format"
     assert lines[3]["error"]["code"] == "unreadable_file"

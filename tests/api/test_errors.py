@@ -18,6 +18,7 @@ from pytest import LogCaptureFixture
 
 from inertia import errors as E
 from inertia.api import Settings, create_app
+from inertia.api import transport as T
 from inertia.api.errors import STATUS
 from tests.support.meshes import box_stl, stl_bytes, torus_stl
 
@@ -54,8 +55,7 @@ CASES: list[tuple[type[E.ServiceError], str, int, Callable[[Any], Any]]] = [
     (E.UnsupportedFormatError, "unsupported_format", 415, mesh(BOX, "part.xyz123")),
     (E.UnsupportedFormatError, "unsupported_format", 415, mesh(BOX, format="dwg")),
     (E.UnreadableFileError, "unreadable_file", 422, mesh(TRUNCATED)),
-    (E.ExternalReferenceError, "external_reference", 422,
-     mesh(b"*NODE\n1, 0, 0, 0\n*INCLUDE, INPUT=/etc/passwd\n", "deck.inp")),
+    (E.ExternalReferenceError, "external_reference", 422, mesh(b"*NODE\n1, 0, 0, 0\n*INCLUDE, INPUT=/etc/passwd\n", "deck.inp")),
     (E.EmptyGeometryError, "empty_geometry", 422, mesh(b"")),
     (E.NotWatertightError, "not_watertight", 422, mesh(OPEN)),
     (E.ZeroVolumeError, "zero_volume", 422, mesh(FLAT)),
@@ -70,27 +70,40 @@ CASES: list[tuple[type[E.ServiceError], str, int, Callable[[Any], Any]]] = [
     (E.InvalidParameterError, "invalid_parameter", 422, mesh(BOX, method="euler")),
     (E.InvalidParameterError, "invalid_parameter", 422, mesh(BOX, densities='{"a": NaN}')),
     (E.InvalidParameterError, "invalid_parameter", 422, mesh(BOX, unknown_option=1)),
-    (E.InvalidParameterError, "invalid_parameter", 422,
-     lambda c: c.post("/v1/analyze/mesh", files={"other": ("a.stl", BOX)})),
+    (E.InvalidParameterError, "invalid_parameter", 422, lambda c: c.post("/v1/analyze/mesh", files={"other": ("a.stl", BOX)})),
     (E.InvalidParameterError, "invalid_parameter", 422, points({"points": []})),
     (E.InvalidParameterError, "invalid_parameter", 422, points({"points": [{"mass": -1, "position": [0, 0, 0]}]})),
     (E.InvalidParameterError, "invalid_parameter", 422, points({"points": ONE, "extra": 1})),
     (E.InvalidParameterError, "invalid_parameter", 422, points({"points": [{"mass": 1, "position": [0, 0]}]})),
-    (E.InvalidParameterError, "invalid_parameter", 422,
-     raw("/v1/analyze/points", b'{"points": [{"mass": NaN, "position": [0, 0, 0]}]}')),
-    (E.InvalidParameterError, "invalid_parameter", 422,
-     raw("/v1/analyze/points", b'{"points": [{"mass": 1, "position": [Infinity, 0, 0]}]}')),
+    (
+        E.InvalidParameterError,
+        "invalid_parameter",
+        422,
+        raw("/v1/analyze/points", b'{"points": [{"mass": NaN, "position": [0, 0, 0]}]}'),
+    ),
+    (
+        E.InvalidParameterError,
+        "invalid_parameter",
+        422,
+        raw("/v1/analyze/points", b'{"points": [{"mass": 1, "position": [Infinity, 0, 0]}]}'),
+    ),
     (E.InvalidParameterError, "invalid_parameter", 422, raw("/v1/analyze/points", b'{"points": [')),
-    (E.InvalidParameterError, "invalid_parameter", 422,
-     raw("/v1/analyze/mesh", b"--x\r\nnot multipart", "multipart/form-data; boundary=y")),
+    (
+        E.InvalidParameterError,
+        "invalid_parameter",
+        422,
+        raw("/v1/analyze/mesh", b"--x\r\nnot multipart", "multipart/form-data; boundary=y"),
+    ),
     (E.InvalidInertiaError, "invalid_inertia", 422, points({"points": ONE, "export": "mjcf"})),
     (E.InvalidParameterError, "invalid_parameter", 422, prec({"omega": [0, 0, 1]})),
-    (E.InvalidParameterError, "invalid_parameter", 422,
-     prec({"principal_moments": [1, 1, 5], "omega": [0, 0, 1]})),
-    (E.InvalidParameterError, "invalid_parameter", 422,
-     prec({"inertia_tensor": [[1, 2, 0], [0, 1, 0], [0, 0, 1]], "omega": [0, 0, 1]})),
-    (E.InvalidParameterError, "invalid_parameter", 422,
-     prec({"principal_moments": [1, 2, 3], "omega": [0, 0, 1], "duration": 1})),
+    (E.InvalidParameterError, "invalid_parameter", 422, prec({"principal_moments": [1, 1, 5], "omega": [0, 0, 1]})),
+    (
+        E.InvalidParameterError,
+        "invalid_parameter",
+        422,
+        prec({"inertia_tensor": [[1, 2, 0], [0, 1, 0], [0, 0, 1]], "omega": [0, 0, 1]}),
+    ),
+    (E.InvalidParameterError, "invalid_parameter", 422, prec({"principal_moments": [1, 2, 3], "omega": [0, 0, 1], "duration": 1})),
 ]
 
 
@@ -105,8 +118,7 @@ def assert_envelope(response: Any, code: str, status: int) -> dict[str, Any]:
     return body["error"]  # type: ignore[no-any-return]
 
 
-@pytest.mark.parametrize(("cls", "code", "status", "request_"), CASES,
-                         ids=[f"{c[1]}-{i}" for i, c in enumerate(CASES)])
+@pytest.mark.parametrize(("cls", "code", "status", "request_"), CASES, ids=[f"{c[1]}-{i}" for i, c in enumerate(CASES)])
 def test_bad_request_gets_its_code_and_status(client: TestClient, cls, code: str, status: int, request_: Any) -> None:  # type: ignore[no-untyped-def]
     assert cls.code == code and STATUS[next(k for k in type.mro(cls) if k in STATUS)] == status
     assert_envelope(request_(client), code, status)
@@ -129,17 +141,26 @@ def busy(c: Any) -> Any:
 
 
 LIMITED = [
-    (E.PayloadTooLargeError, "payload_too_large", 413, Settings(max_upload_bytes=1000, compute_processes=1),  # type: ignore[call-arg]  # fields come from INERTIA_* variables
-     mesh(box_stl(1, 2, 3) * 10)),
-    (E.UnauthorizedError, "unauthorized", 401, Settings(api_key="s3cret", compute_processes=1), mesh(BOX)),  # type: ignore[call-arg]  # fields come from INERTIA_* variables
-    (E.ComputeTimeoutError, "timeout", 503, Settings(timeout_s=0.05, compute_processes=1),  # type: ignore[call-arg]  # fields come from INERTIA_* variables
-     mesh(torus_stl(500, 500))),
+    (
+        T.PayloadTooLargeError,
+        "payload_too_large",
+        413,
+        Settings(max_upload_bytes=1000, compute_processes=1),  # type: ignore[call-arg]  # fields come from INERTIA_* variables
+        mesh(box_stl(1, 2, 3) * 10),
+    ),
+    (T.UnauthorizedError, "unauthorized", 401, Settings(api_key="s3cret", compute_processes=1), mesh(BOX)),  # type: ignore[call-arg]  # fields come from INERTIA_* variables
+    (
+        T.ComputeTimeoutError,
+        "timeout",
+        503,
+        Settings(timeout_s=0.05, compute_processes=1),  # type: ignore[call-arg]  # fields come from INERTIA_* variables
+        mesh(torus_stl(500, 500)),
+    ),
     (E.ServerBusyError, "server_busy", 503, Settings(max_waiting=0, compute_processes=1), busy),  # type: ignore[call-arg]  # fields come from INERTIA_* variables
 ]
 
 
-@pytest.mark.parametrize(("cls", "code", "status", "settings", "request_"), LIMITED,
-                         ids=[c[1] for c in LIMITED])
+@pytest.mark.parametrize(("cls", "code", "status", "settings", "request_"), LIMITED, ids=[c[1] for c in LIMITED])
 def test_limits_get_their_code_and_status(cls, code: str, status: int, settings: dict[str, str], request_: Any) -> None:  # type: ignore[no-untyped-def]
     assert cls.code == code
     with TestClient(create_app(settings)) as c:  # type: ignore[arg-type]
@@ -165,14 +186,12 @@ def test_unexpected_exception_is_500_envelope_with_logged_traceback(caplog: LogC
     async def boom() -> None:
         raise RuntimeError("secret internal detail")
 
-    with caplog.at_level(logging.ERROR, logger="inertia.api"), \
-            TestClient(app, raise_server_exceptions=False) as c:
+    with caplog.at_level(logging.ERROR, logger="inertia.api"), TestClient(app, raise_server_exceptions=False) as c:
         error = assert_envelope(c.get("/boom"), "internal_error", 500)
     assert "secret" not in error["message"]
     assert any(r.exc_info and "secret internal detail" in str(r.exc_info[1]) for r in caplog.records)
 
 
 def test_validation_error_names_the_field(client: TestClient) -> None:
-    error = assert_envelope(points({"points": [{"mass": 1, "position": [0, 0, "x"]}]})(client),
-                            "invalid_parameter", 422)
+    error = assert_envelope(points({"points": [{"mass": 1, "position": [0, 0, "x"]}]})(client), "invalid_parameter", 422)
     assert "points.0.position" in error["message"] and error["details"]["errors"][0]["loc"][0] == "body"

@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import json
 import os
-import socket
 import threading
 import time
 import warnings
@@ -25,6 +24,7 @@ import pytest
 from inertia.api import Settings, create_app
 from tests.fuzz import hostile as H
 from tests.support.meshes import box_stl, torus_stl
+from tests.support.server import free_port
 
 with warnings.catch_warnings():
     warnings.filterwarnings("ignore", message="Using `httpx` with `starlette.testclient`")
@@ -47,6 +47,7 @@ def error_of(response: Any, status: int, code: str) -> dict[str, Any]:
 
 # --- no file opened on the client's say-so ------------------------------------------------------------
 
+
 def test_abaqus_include_of_a_server_file_is_refused(client: Any, tmp_path: Path) -> None:
     # a valid deck placed on the server: a reader that follows the include would analyse it
     name, deck = H.abaqus()
@@ -59,18 +60,28 @@ def test_abaqus_include_of_a_server_file_is_refused(client: Any, tmp_path: Path)
 
 
 def test_every_external_reference_is_refused_over_http(client: Any) -> None:
-    for name, data in (H.abaqus(keyword_input="/dev/zero"), H.gltf(uri="/etc/passwd"),
-                       H.gltf(image_uri="http://127.0.0.1:9/a.png"), H.glb(uri="file:///etc/passwd"),
-                       H.vtu(piece_source="/etc/passwd"), H.vtu(doctype=True), H.threemf(doctype=True)):
+    for name, data in (
+        H.abaqus(keyword_input="/dev/zero"),
+        H.gltf(uri="/etc/passwd"),
+        H.gltf(image_uri="http://127.0.0.1:9/a.png"),
+        H.glb(uri="file:///etc/passwd"),
+        H.vtu(piece_source="/etc/passwd"),
+        H.vtu(doctype=True),
+        H.threemf(doctype=True),
+    ):
         error_of(post_mesh(client, name, data), 422, "external_reference")
 
 
 # --- bombs and lies --------------------------------------------------------------------------------------
 
+
 @pytest.mark.parametrize("attack", ["3mf", "vtu", "vtu-lie"])
 def test_decompression_bomb_is_413(client: Any, attack: str) -> None:
-    name, data = {"3mf": lambda: H.threemf(bomb=200 * MIB), "vtu": lambda: H.vtu(bomb=128 * MIB),
-                  "vtu-lie": lambda: H.vtu(bomb=16 * MIB, declared=96)}[attack]()
+    name, data = {
+        "3mf": lambda: H.threemf(bomb=200 * MIB),
+        "vtu": lambda: H.vtu(bomb=128 * MIB),
+        "vtu-lie": lambda: H.vtu(bomb=16 * MIB, declared=96),
+    }[attack]()
     assert len(data) < 1 * MIB
     error = error_of(post_mesh(client, name, data), 413, "payload_too_large")
     assert "inflate" in error["message"]
@@ -119,6 +130,7 @@ def test_error_messages_name_no_server_path(client: Any) -> None:
 
 # --- batches ---------------------------------------------------------------------------------------------
 
+
 def test_corrupt_zip_member_is_one_error_line_of_a_complete_batch(client: Any) -> None:
     members = [("a.stl", BOX), ("b.stl", box_stl(2, 2, 2) + b"\0" * 4000), ("c.stl", box_stl(1, 1, 1))]
     archive = H.zip_of(members, corrupt="b.stl")
@@ -146,6 +158,7 @@ def test_zip_bomb_member_is_an_error_line_and_the_batch_goes_on(client: Any) -> 
 
 
 # --- memory ----------------------------------------------------------------------------------------------
+
 
 def test_job_past_its_memory_allowance_is_413_and_the_worker_serves_on() -> None:
     # a cap below what a 500 x 500 torus needs (>100 MiB of arrays): the job fails in its process only
@@ -182,8 +195,7 @@ def test_small_points_requests_run_without_the_compute_pool(client: Any, monkeyp
         raise AssertionError("a 3-point request went to the compute pool")
 
     monkeypatch.setattr(pool, "run", no_pool)
-    body = {"points": [{"mass": 1, "position": [0, 0, 0]}, {"mass": 2, "position": [1, 0, 0]},
-                       {"mass": 1, "position": [0, 1, 0]}]}
+    body = {"points": [{"mass": 1, "position": [0, 0, 0]}, {"mass": 2, "position": [1, 0, 0]}, {"mass": 1, "position": [0, 1, 0]}]}
     response = client.post("/v1/analyze/points", json=body)
     assert response.status_code == 200 and response.json()["mass"] == 4.0
 
@@ -203,11 +215,6 @@ def test_formats_lists_only_readable_formats(client: Any) -> None:
 
 # --- a real server: connections, temporary files, memory ------------------------------------------------
 
-def _free_port() -> int:
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return int(s.getsockname()[1])
-
 
 @pytest.fixture
 def buggy_server() -> Iterator[str]:
@@ -220,7 +227,7 @@ def buggy_server() -> Iterator[str]:
     async def boom() -> None:
         raise RuntimeError("a bug")
 
-    port = _free_port()
+    port = free_port()
     server = uvicorn.Server(uvicorn.Config(app, host="127.0.0.1", port=port, log_level="critical"))
     thread = threading.Thread(target=server.run, daemon=True)
     thread.start()
@@ -256,10 +263,22 @@ def _slow_volume_mesh() -> bytes:
     grid = np.stack(np.meshgrid(*[np.arange(n + 1.0)] * 3, indexing="ij"), -1).reshape(-1, 3)
     idx = np.arange((n + 1) ** 3).reshape(n + 1, n + 1, n + 1)
     c0 = idx[:-1, :-1, :-1].ravel()
-    hexes = np.stack([c0, c0 + (n + 1) ** 2, c0 + (n + 1) ** 2 + n + 1, c0 + n + 1,
-                      c0 + 1, c0 + (n + 1) ** 2 + 1, c0 + (n + 1) ** 2 + n + 2, c0 + n + 2], 1)
-    lines = ["# vtk DataFile Version 2.0", "grid", "ASCII", "DATASET UNSTRUCTURED_GRID",
-             f"POINTS {len(grid)} double"] + [f"{x} {y} {z}" for x, y, z in grid]
+    hexes = np.stack(
+        [
+            c0,
+            c0 + (n + 1) ** 2,
+            c0 + (n + 1) ** 2 + n + 1,
+            c0 + n + 1,
+            c0 + 1,
+            c0 + (n + 1) ** 2 + 1,
+            c0 + (n + 1) ** 2 + n + 2,
+            c0 + n + 2,
+        ],
+        1,
+    )
+    lines = ["# vtk DataFile Version 2.0", "grid", "ASCII", "DATASET UNSTRUCTURED_GRID", f"POINTS {len(grid)} double"] + [
+        f"{x} {y} {z}" for x, y, z in grid
+    ]
     lines += [f"CELLS {len(hexes)} {9 * len(hexes)}"] + ["8 " + " ".join(map(str, h)) for h in hexes]
     lines += [f"CELL_TYPES {len(hexes)}"] + ["12"] * len(hexes)
     return ("\n".join(lines) + "\n").encode()
@@ -309,8 +328,15 @@ def test_concurrent_large_uploads_stay_within_a_memory_bound(live_server: Any) -
 
 
 def test_no_500_from_a_batch_of_hostile_files(client: Any) -> None:
-    files = [H.abaqus(include="/etc/passwd"), H.threemf(bomb=64 * MIB), H.gltf(depth=10_000), H.glb(chunk_lie=99),
-             ("junk.msh", b"garbage"), ("bad.obj", b"v 0 0\nf 1 2 3\n"), ("box.stl", BOX)]
+    files = [
+        H.abaqus(include="/etc/passwd"),
+        H.threemf(bomb=64 * MIB),
+        H.gltf(depth=10_000),
+        H.glb(chunk_lie=99),
+        ("junk.msh", b"garbage"),
+        ("bad.obj", b"v 0 0\nf 1 2 3\n"),
+        ("box.stl", BOX),
+    ]
     response = client.post("/v1/batch", files=[("files", f) for f in files])
     assert response.status_code == 200
     lines = [json.loads(line) for line in response.text.splitlines()]
@@ -328,6 +354,7 @@ def test_workspace_is_empty_after_requests(client: Any) -> None:
 
 
 # --- several files in one upload --------------------------------------------------------------------------
+
 
 def test_gltf_with_its_buffer_as_a_second_file_part_is_read(client: Any) -> None:
     import base64

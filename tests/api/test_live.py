@@ -17,10 +17,10 @@ from tests.support.meshes import box_stl, torus_stl
 BOX = box_stl(1, 2, 3)
 
 
-def post_mesh(url: str, data: bytes, name: str = "box.stl", headers: dict[str, str] | None = None,
-              timeout: float = 60.0, **params: Any) -> httpx.Response:
-    return httpx.post(f"{url}/v1/analyze/mesh", files={"file": (name, data)}, params=params,
-                      headers=headers, timeout=timeout)
+def post_mesh(
+    url: str, data: bytes, name: str = "box.stl", headers: dict[str, str] | None = None, timeout: float = 60.0, **params: Any
+) -> httpx.Response:
+    return httpx.post(f"{url}/v1/analyze/mesh", files={"file": (name, data)}, params=params, headers=headers, timeout=timeout)
 
 
 def without_timing(doc: Any) -> Any:
@@ -38,8 +38,9 @@ def test_every_endpoint_answers_over_http(server: Any) -> None:
     assert "stl" in httpx.get(f"{url}/v1/formats").json()["surface"]
     doc = post_mesh(url, BOX, omega="0,0,1").json()
     assert doc["mass"] == pytest.approx(6000, rel=1e-12) and doc["precession"]["regime"] == "permanent_rotation"
-    pts = httpx.post(f"{url}/v1/analyze/points", json={"points": [
-        {"mass": 1, "position": [0, 0, -1]}, {"mass": 1, "position": [0, 0, 1]}]}).json()
+    pts = httpx.post(
+        f"{url}/v1/analyze/points", json={"points": [{"mass": 1, "position": [0, 0, -1]}, {"mass": 1, "position": [0, 0, 1]}]}
+    ).json()
     assert pts["mass"] == 2 and pts["classification"]["kind"] == "linear_rotator"
     pr = httpx.post(f"{url}/v1/precession", json={"principal_moments": [1, 2, 3], "omega": [1, 0, 0]}).json()
     assert pr["precession"]["regime"] == "permanent_rotation"
@@ -53,18 +54,19 @@ def test_every_endpoint_answers_over_http(server: Any) -> None:
 def test_access_log_has_method_path_status_elapsed(server: Any) -> None:
     httpx.get(f"{server.url}/v1/formats?probe=1")
     time.sleep(0.2)
-    records = [json.loads(line[line.index("{"):]) for line in server.output().splitlines()
-               if '"event": "access"' in line]
+    records = [json.loads(line[line.index("{") :]) for line in server.output().splitlines() if '"event": "access"' in line]
     formats = [r for r in records if r["path"] == "/v1/formats"]
     assert formats and formats[-1]["method"] == "GET" and formats[-1]["status"] == 200
     assert formats[-1]["elapsed_ms"] >= 0
 
 
 def _multipart_chunks(data: bytes, chunk: int = 64 * 1024) -> Iterator[bytes]:
-    yield (b'--BOUNDARY\r\nContent-Disposition: form-data; name="file"; filename="big.stl"\r\n'
-           b"Content-Type: application/octet-stream\r\n\r\n")
+    yield (
+        b'--BOUNDARY\r\nContent-Disposition: form-data; name="file"; filename="big.stl"\r\n'
+        b"Content-Type: application/octet-stream\r\n\r\n"
+    )
     for i in range(0, len(data), chunk):
-        yield data[i:i + chunk]
+        yield data[i : i + chunk]
     yield b"\r\n--BOUNDARY--\r\n"
 
 
@@ -74,11 +76,16 @@ def test_upload_limit_refuses_large_bodies_with_413(live_server: Any) -> None:
     declared = post_mesh(url, big)
     assert declared.status_code == 413 and declared.json()["error"]["code"] == "payload_too_large"
     assert declared.json()["error"]["details"]["content_length"] > 200_000
-    chunked = httpx.post(f"{url}/v1/analyze/mesh", content=_multipart_chunks(big), timeout=30,
-                         headers={"content-type": "multipart/form-data; boundary=BOUNDARY"})
+    chunked = httpx.post(
+        f"{url}/v1/analyze/mesh",
+        content=_multipart_chunks(big),
+        timeout=30,
+        headers={"content-type": "multipart/form-data; boundary=BOUNDARY"},
+    )
     assert chunked.status_code == 413 and chunked.json()["error"]["code"] == "payload_too_large"
-    small = httpx.post(f"{url}/v1/analyze/mesh", content=_multipart_chunks(BOX),
-                       headers={"content-type": "multipart/form-data; boundary=BOUNDARY"})
+    small = httpx.post(
+        f"{url}/v1/analyze/mesh", content=_multipart_chunks(BOX), headers={"content-type": "multipart/form-data; boundary=BOUNDARY"}
+    )
     assert small.status_code == 200 and small.json()["source"]["filename"] == "big.stl"
 
 

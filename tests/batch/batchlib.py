@@ -11,8 +11,11 @@ import numpy as np
 from benchmarks import cases
 
 N_FILES = 50
-BROKEN = {"broken/truncated.stl": "unreadable_file", "broken/open_box.stl": "not_watertight",
-          "broken/garbage.stl": "unreadable_file"}
+BROKEN = {
+    "broken/truncated.stl": "unreadable_file",
+    "broken/open_box.stl": "not_watertight",
+    "broken/garbage.stl": "unreadable_file",
+}
 
 
 def box(size: tuple[float, float, float], angle: float, offset: tuple[float, float, float]) -> np.ndarray:
@@ -100,5 +103,5 @@ def cli_error(stderr: str) -> dict[str, str]:
     if text.startswith("{"):
         return dict(json.loads(text)["error"])
     assert text.startswith("error: ") and text.endswith(")"), text
-    message, code = text[len("error: "):-1].rsplit(" (", 1)
+    message, code = text[len("error: ") : -1].rsplit(" (", 1)
     return {"code": code, "message": message}

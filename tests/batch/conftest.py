@@ -32,6 +32,7 @@ def fresh_library(library: tuple[Path, dict[str, str | None]], tmp_path: Path) -
 def cluster() -> Iterator[Any]:
     """A real scheduler and two worker processes on loopback, started once."""
     distributed = pytest.importorskip("distributed")
-    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None,
-                                  silence_logs=logging.ERROR) as lc:
+    with distributed.LocalCluster(
+        n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None, silence_logs=logging.ERROR
+    ) as lc:
         yield lc

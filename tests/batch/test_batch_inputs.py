@@ -51,20 +51,31 @@ def test_a_missing_path_fails_before_any_work(tmp_path: Path, capsys: pytest.Cap
     assert err["code"] == "invalid_parameter" and "no such file or folder" in err["message"]
 
 
-def test_an_unknown_output_extension_is_invalid_parameter(library: Library, tmp_path: Path,
-                                                          capsys: pytest.CaptureFixture[str]) -> None:
+def test_an_unknown_output_extension_is_invalid_parameter(
+    library: Library, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     code = main(["batch", str(library[0]), "--out", str(tmp_path / "o.xlsx"), "--no-progress"])
     assert code == 2
     assert ".jsonl, .csv or .parquet" in cli_error(capsys.readouterr().err)["message"]
 
 
-@pytest.mark.parametrize(("module", "out", "more", "hint"), [
-    ("distributed", "o.jsonl", ["--scheduler", "tcp://127.0.0.1:9"], "pip install 'inertia-service[batch]'"),
-    ("pyarrow", "o.parquet", [], "pip install 'inertia-service[parquet]'"),
-])
-def test_a_missing_extra_says_what_to_install(module: str, out: str, more: list[str], hint: str, library: Library,
-                                              tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
-                                              capsys: pytest.CaptureFixture[str]) -> None:
+@pytest.mark.parametrize(
+    ("module", "out", "more", "hint"),
+    [
+        ("distributed", "o.jsonl", ["--scheduler", "tcp://127.0.0.1:9"], "pip install 'inertia-service[batch]'"),
+        ("pyarrow", "o.parquet", [], "pip install 'inertia-service[parquet]'"),
+    ],
+)
+def test_a_missing_extra_says_what_to_install(
+    module: str,
+    out: str,
+    more: list[str],
+    hint: str,
+    library: Library,
+    tmp_path: Path,
+    monkeypatch: pytest.MonkeyPatch,
+    capsys: pytest.CaptureFixture[str],
+) -> None:
     monkeypatch.setitem(sys.modules, module, None)  # import raises ImportError
     code = main(["batch", str(library[0]), "--out", str(tmp_path / out), "--no-progress", *more])
     assert code == 2
@@ -80,9 +91,11 @@ def test_the_local_pool_needs_no_dask(library: Library, tmp_path: Path, monkeypa
 
 
 def test_importing_the_service_and_the_sources_imports_no_dask() -> None:
-    code = ("import sys, inertia, inertia.cli, inertia.batch, inertia.batch.sources; "
-            "bad = [m for m in ('dask', 'distributed', 'tqdm', 'pyarrow', 'fsspec') if m in sys.modules]; "
-            "assert not bad, bad")
+    code = (
+        "import sys, inertia, inertia.cli, inertia.batch, inertia.batch.sources; "
+        "bad = [m for m in ('dask', 'distributed', 'tqdm', 'pyarrow', 'fsspec') if m in sys.modules]; "
+        "assert not bad, bad"
+    )
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=False)
     assert done.returncode == 0, done.stderr
 
@@ -140,8 +153,11 @@ def test_groups_are_sized_by_bytes_largest_files_first() -> None:
     assert all(w >= runner.MIN_TASK_BYTES["pool"] for w in work[:-1])
     # a few files, a larger minimum per task: fewer, bigger tasks
     assert len(list(runner._groups(small, threads=2, min_bytes=runner.MIN_TASK_BYTES["dask"]))) < len(groups)
-    mixed = [Source("big.stl", "/big", None, 3 * runner.MAX_TASK_BYTES), *small[:10],
-             Source("mid.stl", "/mid", None, runner.MAX_TASK_BYTES)]
+    mixed = [
+        Source("big.stl", "/big", None, 3 * runner.MAX_TASK_BYTES),
+        *small[:10],
+        Source("mid.stl", "/mid", None, runner.MAX_TASK_BYTES),
+    ]
     first, second, *rest = runner._groups(mixed, threads=2, min_bytes=runner.MIN_TASK_BYTES["pool"])
     assert [s.name for s in first] == ["big.stl"] and [s.name for s in second] == ["mid.stl"]
     assert [s.name for g in rest for s in g] == [s.name for s in small[:10]]  # equal sizes keep their order
@@ -211,8 +227,7 @@ def test_head_start_analyses_small_files_until_the_cluster_is_ready(library: Lib
     assert [without_timing(r) for r in out.rows] == [without_timing(r) for r in expected]
 
 
-def test_head_start_hands_everything_over_when_no_file_is_small_enough(library: Library,
-                                                                         monkeypatch: pytest.MonkeyPatch) -> None:
+def test_head_start_hands_everything_over_when_no_file_is_small_enough(library: Library, monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.setattr(runner, "HEAD_START_BYTES", -1)
     sources = list_sources([str(library[0])])
     out = _Collect()
@@ -227,8 +242,7 @@ class _FakeCluster:
         self.closed = True
 
 
-def test_an_interrupted_head_start_still_closes_the_cluster_it_started(library: Library,
-                                                                        monkeypatch: pytest.MonkeyPatch) -> None:
+def test_an_interrupted_head_start_still_closes_the_cluster_it_started(library: Library, monkeypatch: pytest.MonkeyPatch) -> None:
     cluster = _FakeCluster()
 
     def slow_start(workers: int | None) -> _FakeCluster:
@@ -264,8 +278,7 @@ print(json.dumps([seen, [os.getenv(k) for k in workers.WORKER_THREAD_LIMITS], fr
 def test_local_workers_fork_from_a_frozen_server_with_one_thread_per_numeric_library() -> None:
     env = {k: v for k, v in os.environ.items() if k not in workers.WORKER_THREAD_LIMITS}
     env["OMP_NUM_THREADS"] = "3"  # a value the user set wins
-    done = subprocess.run([sys.executable, "-c", FORKSERVER_ENV], env=env, capture_output=True, text=True,
-                          check=True, timeout=60)
+    done = subprocess.run([sys.executable, "-c", FORKSERVER_ENV], env=env, capture_output=True, text=True, check=True, timeout=60)
     in_forkserver, in_client, frozen = json.loads(done.stdout)
     assert in_forkserver == ["3", "1", "1"]
     assert in_client == ["3", None, None]  # this process's environment is left as it was

@@ -85,15 +85,15 @@ def test_numbers_equal_analyze_of_the_path(local_rows: Path, library: Library) -
     assert row == doc
 
 
-def test_existing_cluster_gives_the_same_rows(local_rows: Path, library: Library, cluster: Any,
-                                              tmp_path: Path) -> None:
+def test_existing_cluster_gives_the_same_rows(local_rows: Path, library: Library, cluster: Any, tmp_path: Path) -> None:
     out = tmp_path / "rows.jsonl"
     assert batch(str(library[0]), "--out", str(out), "--scheduler", cluster.scheduler_address) == 0
     assert by_name(read_jsonl(out)) == by_name(read_jsonl(local_rows))
 
 
-def test_resume_skips_rows_already_written(fresh_library: Path, cluster: Any, tmp_path: Path,
-                                           capsys: pytest.CaptureFixture[str]) -> None:
+def test_resume_skips_rows_already_written(
+    fresh_library: Path, cluster: Any, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     out = tmp_path / "rows.jsonl"
     address = cluster.scheduler_address
     assert batch(str(fresh_library), "--out", str(out), "--scheduler", address) == 0
@@ -110,12 +110,13 @@ def test_resume_skips_rows_already_written(fresh_library: Path, cluster: Any, tm
     assert "5 files analysed" in capsys.readouterr().err
     after = out.read_text().splitlines(keepends=True)
     assert after[: len(kept)] == kept  # untouched, byte for byte
-    assert by_name([json.loads(x) for x in after[len(kept):]]) == by_name([json.loads(x) for x in dropped])
+    assert by_name([json.loads(x) for x in after[len(kept) :]]) == by_name([json.loads(x) for x in dropped])
     assert len(by_name([json.loads(x) for x in after])) == N_FILES
 
 
-def test_resume_of_a_complete_output_submits_nothing(local_rows: Path, library: Library, cluster: Any,
-                                                     tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+def test_resume_of_a_complete_output_submits_nothing(
+    local_rows: Path, library: Library, cluster: Any, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     out = tmp_path / "rows.jsonl"
     shutil.copy(local_rows, out)
     capsys.readouterr()
@@ -124,8 +125,9 @@ def test_resume_of_a_complete_output_submits_nothing(local_rows: Path, library: 
     assert out.read_bytes() == local_rows.read_bytes()
 
 
-def test_resume_drops_a_line_cut_short_and_redoes_its_file(local_rows: Path, library: Library, cluster: Any,
-                                                           tmp_path: Path) -> None:
+def test_resume_drops_a_line_cut_short_and_redoes_its_file(
+    local_rows: Path, library: Library, cluster: Any, tmp_path: Path
+) -> None:
     out = tmp_path / "rows.jsonl"
     text = local_rows.read_text()
     out.write_text(text[: len(text) - 200])  # a crash in the middle of the last line
@@ -164,8 +166,7 @@ def test_csv_rows_flatten_the_json_lines(local_rows: Path, library: Library, clu
     assert box_row["class"] == "asymmetric_top" and math.isfinite(float(box_row["kappa"]))
 
 
-def test_csv_resume_appends_the_missing_rows(local_rows: Path, library: Library, cluster: Any,
-                                             tmp_path: Path) -> None:
+def test_csv_resume_appends_the_missing_rows(local_rows: Path, library: Library, cluster: Any, tmp_path: Path) -> None:
     out = tmp_path / "rows.csv"
     address = cluster.scheduler_address
     assert batch(str(library[0]), "--out", str(out), "--scheduler", address) == 0
@@ -176,8 +177,7 @@ def test_csv_resume_appends_the_missing_rows(local_rows: Path, library: Library,
     assert sorted(r["name"] for r in got) == sorted(by_name(read_jsonl(local_rows)))
 
 
-def test_parquet_holds_the_same_rows_and_resumes(local_rows: Path, library: Library, cluster: Any,
-                                                 tmp_path: Path) -> None:
+def test_parquet_holds_the_same_rows_and_resumes(local_rows: Path, library: Library, cluster: Any, tmp_path: Path) -> None:
     pq = pytest.importorskip("pyarrow.parquet")
     out = tmp_path / "rows.parquet"
     address = cluster.scheduler_address
@@ -195,8 +195,7 @@ def test_parquet_holds_the_same_rows_and_resumes(local_rows: Path, library: Libr
     assert not (tmp_path / "rows.parquet.partial").exists()
 
 
-def test_zip_members_are_named_archive_slash_member(local_rows: Path, library: Library, cluster: Any,
-                                                    tmp_path: Path) -> None:
+def test_zip_members_are_named_archive_slash_member(local_rows: Path, library: Library, cluster: Any, tmp_path: Path) -> None:
     archive = tmp_path / "parts.zip"
     with zipfile.ZipFile(archive, "w", zipfile.ZIP_DEFLATED) as zf:
         for name in library[1]:
@@ -224,11 +223,9 @@ def test_options_pass_through_unchanged(library: Library, cluster: Any, tmp_path
     densities.write_text(json.dumps({"part_00": 2700.0}))
     names = ["part_00.stl", "a/part_01.stl", "objs/part_03.obj"]
     paths = [str(library[0] / n) for n in names]
-    args = ["--units", "mm", "--density", "7850", "--reference", "1,2,3", "--tolerance", "1e-9",
-            "--densities", str(densities)]
+    args = ["--units", "mm", "--density", "7850", "--reference", "1,2,3", "--tolerance", "1e-9", "--densities", str(densities)]
     assert batch(*paths, "--out", str(out), "--scheduler", cluster.scheduler_address, *args) == 0
-    options = AnalysisOptions(units="mm", density=7850.0, reference=(1.0, 2.0, 3.0), tolerance=1e-9,
-                              densities={"part_00": 2700.0})
+    options = AnalysisOptions(units="mm", density=7850.0, reference=(1.0, 2.0, 3.0), tolerance=1e-9, densities={"part_00": 2700.0})
     rows = by_name(read_jsonl(out))
     for path, name in zip(paths, names):
         base = name.rsplit("/", 1)[-1]  # a file given by itself is named by its base name
@@ -238,8 +235,9 @@ def test_options_pass_through_unchanged(library: Library, cluster: Any, tmp_path
     assert rows["part_01.stl"]["error"]["details"]["parameter"] == "densities"
 
 
-def test_progress_bar_shows_rate_on_stderr(library: Library, cluster: Any, tmp_path: Path,
-                                           capsys: pytest.CaptureFixture[str]) -> None:
+def test_progress_bar_shows_rate_on_stderr(
+    library: Library, cluster: Any, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     out = tmp_path / "rows.jsonl"
     code = main(["batch", str(library[0] / "a"), "--out", str(out), "--scheduler", cluster.scheduler_address])
     assert code == 0
@@ -272,8 +270,9 @@ class _CountingClient:
         self.outstanding -= 1
 
 
-def test_tasks_in_flight_stay_within_the_window(library: Library, cluster: Any, tmp_path: Path,
-                                                monkeypatch: pytest.MonkeyPatch) -> None:
+def test_tasks_in_flight_stay_within_the_window(
+    library: Library, cluster: Any, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
     from distributed import Client
 
     from inertia.batch import runner
@@ -288,15 +287,13 @@ def test_tasks_in_flight_stay_within_the_window(library: Library, cluster: Any, 
     assert counting.most <= 2 * 2
 
 
-def test_workers_and_scheduler_together_are_refused(library: Library, tmp_path: Path,
-                                                    capsys: pytest.CaptureFixture[str]) -> None:
+def test_workers_and_scheduler_together_are_refused(library: Library, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     code = batch(str(library[0]), "--out", str(tmp_path / "o.jsonl"), "--workers", "2", "--scheduler", "tcp://x:1")
     assert code == 2
     assert "not both" in cli_error(capsys.readouterr().err)["message"]
 
 
-def test_a_file_that_kills_its_worker_is_one_error_row_and_the_rest_complete(library: Library,
-                                                                              tmp_path: Path) -> None:
+def test_a_file_that_kills_its_worker_is_one_error_row_and_the_rest_complete(library: Library, tmp_path: Path) -> None:
     from inertia.batch import runner
     from inertia.batch.pool import run_pool
     from inertia.batch.sources import list_sources
@@ -318,8 +315,9 @@ def test_a_file_that_kills_its_worker_is_one_error_row_and_the_rest_complete(lib
         assert rows[name] == reference(folder / name, name), name
 
 
-def test_the_pool_writes_each_task_as_it_finishes_within_the_window(library: Library, tmp_path: Path,
-                                                                     monkeypatch: pytest.MonkeyPatch) -> None:
+def test_the_pool_writes_each_task_as_it_finishes_within_the_window(
+    library: Library, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
     from inertia.batch import pool, runner
 
     seen: list[int] = []

@@ -115,8 +115,9 @@ def test_error_estimate_covers_a_spline_cylinder() -> None:
     data = write_step([("rod", nurbs(cylinder(*CYL, BASE)))])
     doc = analyze(data, filename="rod.step").as_dict()
     ref = cylinder_reference(*CYL, BASE)
-    true_error = max(abs(doc["mass"] - ref["mass"]) / ref["mass"],
-                     *(abs(a - b) / b for a, b in zip(doc["principal"]["moments"], ref["moments"])))
+    true_error = max(
+        abs(doc["mass"] - ref["mass"]) / ref["mass"], *(abs(a - b) / b for a, b in zip(doc["principal"]["moments"], ref["moments"]))
+    )
     estimate = doc["diagnostics"]["relative_error_estimate"]
     assert true_error <= estimate <= 1e-6
 
@@ -142,8 +143,7 @@ def test_assembly_parts_are_named_solids(step_assembly: bytes) -> None:
 
 
 def test_assembly_densities_by_part_name(step_assembly: bytes) -> None:
-    doc = analyze(step_assembly, filename="bracket.step",
-                  options=AnalysisOptions(densities={"rod": 7850.0})).as_dict()
+    doc = analyze(step_assembly, filename="bracket.step", options=AnalysisOptions(densities={"rod": 7850.0})).as_dict()
     rod = cylinder_reference(*CYL, BASE)
     assert_close(doc["parts"][1]["mass"], rod["mass"] * 7.85)
     assert_close(doc["mass"], box_reference(*BOX, CORNER)["mass"] + rod["mass"] * 7.85)
@@ -187,11 +187,12 @@ def test_mesh_geometry_converges_to_the_brep(step_assembly: bytes) -> None:
     data = write_step([("rod", cylinder(*CYL, BASE))])
     errors, reported = [], []
     for deflection in (1e-2, 1e-3, 1e-4):
-        doc = analyze(data, filename="rod.step",
-                      options=AnalysisOptions(geometry="mesh", deflection=deflection)).as_dict()
+        doc = analyze(data, filename="rod.step", options=AnalysisOptions(geometry="mesh", deflection=deflection)).as_dict()
         assert doc["source"]["geometry"] == "mesh" and doc["source"]["triangles"] > 0
-        true = max(abs(doc["mass"] - ref["mass"]) / ref["mass"],
-                   *(abs(a - b) / b for a, b in zip(doc["principal"]["moments"], ref["moments"])))
+        true = max(
+            abs(doc["mass"] - ref["mass"]) / ref["mass"],
+            *(abs(a - b) / b for a, b in zip(doc["principal"]["moments"], ref["moments"])),
+        )
         errors.append(true)
         reported.append(doc["diagnostics"]["tessellation_error"])
         # the B-rep is exact to ~1e-15 here, so the reported difference is the true one
@@ -250,10 +251,19 @@ def test_missing_extra_is_415_naming_it(tmp_path: Path, step_assembly: bytes) ->
     blocker = tmp_path / "OCP"
     blocker.mkdir()
     (blocker / "__init__.py").write_text("raise ImportError('OCP is blocked for this test')\n")
-    env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(tmp_path), os.environ.get("PYTHONPATH", "")]),
-           "INERTIA_COMPUTE_PROCESSES": "1"}
-    out = subprocess.run([sys.executable, "-c", textwrap.dedent(_BLOCKED)], input=step_assembly, env=env,
-                         capture_output=True, timeout=120, check=True)
+    env = {
+        **os.environ,
+        "PYTHONPATH": os.pathsep.join([str(tmp_path), os.environ.get("PYTHONPATH", "")]),
+        "INERTIA_COMPUTE_PROCESSES": "1",
+    }
+    out = subprocess.run(
+        [sys.executable, "-c", textwrap.dedent(_BLOCKED)],
+        input=step_assembly,
+        env=env,
+        capture_output=True,
+        timeout=120,
+        check=True,
+    )
     reply = json.loads(out.stdout.decode().strip().splitlines()[-1])
     assert reply["status"] == 415
     assert reply["body"]["error"]["code"] == "unsupported_format"
@@ -271,8 +281,12 @@ def test_missing_extra_error_in_the_library(monkeypatch: pytest.MonkeyPatch) -> 
 def test_cli_reads_step_and_deflection_implies_mesh(tmp_path: Path, step_assembly: bytes) -> None:
     path = tmp_path / "bracket.step"
     path.write_bytes(step_assembly)
-    out = subprocess.run([sys.executable, "-m", "inertia", "analyze", str(path), "--deflection", "1e-3", "--json"],
-                         capture_output=True, timeout=120, check=True)
+    out = subprocess.run(
+        [sys.executable, "-m", "inertia", "analyze", str(path), "--deflection", "1e-3", "--json"],
+        capture_output=True,
+        timeout=120,
+        check=True,
+    )
     doc = json.loads(out.stdout)
     assert doc["source"]["kind"] == "cad" and doc["source"]["geometry"] == "mesh"
     assert [p["name"] for p in doc["parts"]] == ["plate", "rod"]

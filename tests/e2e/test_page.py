@@ -87,9 +87,18 @@ def at(result: Any, key: str) -> Any:
 
 def assert_numbers_match(page: Any, result: dict[str, Any]) -> dict[str, tuple[str, str]]:
     shown = shown_numbers(page)
-    required = ["mass", "center_of_mass.0", "center_of_mass.2", "inertia_tensor.0.1", "inertia_tensor.2.2",
-                "principal.moments.0", "principal.moments.2", "principal.axes.1.1",
-                "diagnostics.relative_error_estimate", "diagnostics.elapsed_s"]
+    required = [
+        "mass",
+        "center_of_mass.0",
+        "center_of_mass.2",
+        "inertia_tensor.0.1",
+        "inertia_tensor.2.2",
+        "principal.moments.0",
+        "principal.moments.2",
+        "principal.axes.1.1",
+        "diagnostics.relative_error_estimate",
+        "diagnostics.elapsed_s",
+    ]
     if "volume" in result:
         required.append("volume")
     assert set(required) <= set(shown), sorted(set(required) - set(shown))
@@ -161,19 +170,29 @@ def test_view_draws_the_body_axes_and_ellipsoid(console_page: tuple[Any, Console
 def test_assembly_parts_get_distinct_colours(console_page: tuple[Any, Console], server: Server, tmp_path: Path) -> None:
     trimesh = pytest.importorskip("trimesh")
     scene = trimesh.Scene()
-    scene.add_geometry(trimesh.creation.box((1, 1, 1)), node_name="left", geom_name="left",
-                       transform=trimesh.transformations.translation_matrix((-1, 0, 0)))
-    scene.add_geometry(trimesh.creation.box((1, 2, 1)), node_name="right", geom_name="right",
-                       transform=trimesh.transformations.translation_matrix((1.5, 0, 0)))
+    scene.add_geometry(
+        trimesh.creation.box((1, 1, 1)),
+        node_name="left",
+        geom_name="left",
+        transform=trimesh.transformations.translation_matrix((-1, 0, 0)),
+    )
+    scene.add_geometry(
+        trimesh.creation.box((1, 2, 1)),
+        node_name="right",
+        geom_name="right",
+        transform=trimesh.transformations.translation_matrix((1.5, 0, 0)),
+    )
     path = tmp_path / "pair.glb"
     path.write_bytes(scene.export(file_type="glb"))
     page, _ = console_page
     open_page(page, server)
     assert analyze(page, path) == "ready"
     assert_numbers_match(page, api_mesh(server, path))
-    colours = page.evaluate("window.inertiaPage.viewer.layers.body.children"
-                            ".filter(o => o.isMesh && o.geometry.type !== 'SphereGeometry')"
-                            ".map(o => o.material.color.getHexString())")
+    colours = page.evaluate(
+        "window.inertiaPage.viewer.layers.body.children"
+        ".filter(o => o.isMesh && o.geometry.type !== 'SphereGeometry')"
+        ".map(o => o.material.color.getHexString())"
+    )
     assert len(colours) == 2 and len(set(colours)) == 2
     assert page.locator("[data-row=parts] li").count() == 2
 
@@ -239,16 +258,20 @@ def test_motion_without_duration_asks_for_a_few_periods(console_page: tuple[Any,
     assert len(page.evaluate("window.inertiaPage.viewer.spaceCone.children")) > 0  # the cones are drawn
 
 
-@pytest.mark.parametrize(("name", "fields", "where", "words"), [
-    ("open_box.stl", {}, "#file-error", "watertight"),
-    ("box.stl", {"density": "-1"}, "#density-error", "density"),
-    ("box.stl", {"model": "shell"}, "#thickness-error", "thickness"),
-    ("box.stl", {"units": "furlong"}, "#units-error", "unit"),
-    ("box.stl", {"omega": "1,2"}, "#omega-error", "three numbers"),
-    ("box.stl", {"omega": "0,1,0", "samples": "0", "duration": "1"}, "#samples-error", "samples"),
-])
+@pytest.mark.parametrize(
+    ("name", "fields", "where", "words"),
+    [
+        ("open_box.stl", {}, "#file-error", "watertight"),
+        ("box.stl", {"density": "-1"}, "#density-error", "density"),
+        ("box.stl", {"model": "shell"}, "#thickness-error", "thickness"),
+        ("box.stl", {"units": "furlong"}, "#units-error", "unit"),
+        ("box.stl", {"omega": "1,2"}, "#omega-error", "three numbers"),
+        ("box.stl", {"omega": "0,1,0", "samples": "0", "duration": "1"}, "#samples-error", "samples"),
+    ],
+)
 def test_errors_appear_next_to_the_input_that_caused_them(
-        console_page: tuple[Any, Console], server: Server, name: str, fields: dict[str, str], where: str, words: str) -> None:
+    console_page: tuple[Any, Console], server: Server, name: str, fields: dict[str, str], where: str, words: str
+) -> None:
     page, console = console_page
     console.expect_http_errors = True
     open_page(page, server)
@@ -263,7 +286,8 @@ def test_errors_appear_next_to_the_input_that_caused_them(
 
 
 def test_an_unreadable_file_and_bad_pasted_text_get_readable_messages(
-        console_page: tuple[Any, Console], server: Server, tmp_path: Path) -> None:
+    console_page: tuple[Any, Console], server: Server, tmp_path: Path
+) -> None:
     page, console = console_page
     console.expect_http_errors = True
     open_page(page, server)
@@ -385,11 +409,14 @@ def test_a_dropped_file_is_analysed(console_page: tuple[Any, Console], server: S
     page, _ = console_page
     open_page(page, server)
     data = list((SAMPLES / "tetrahedron.stl").read_bytes())
-    transfer = page.evaluate_handle("""(bytes) => {
+    transfer = page.evaluate_handle(
+        """(bytes) => {
       const dt = new DataTransfer();
       dt.items.add(new File([new Uint8Array(bytes)], 'tetrahedron.stl'));
       return dt;
-    }""", data)
+    }""",
+        data,
+    )
     page.dispatch_event("#drop", "dragover", {"dataTransfer": transfer})
     page.dispatch_event("#drop", "drop", {"dataTransfer": transfer})
     page.wait_for_selector("body[data-state=ready]")

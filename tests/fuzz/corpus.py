@@ -24,8 +24,16 @@ from . import hostile as H
 __all__ = ["seeds", "mutate", "MUTATIONS"]
 
 ROOT = Path(__file__).resolve().parents[2]
-MESHIO_FORMATS = {"vtu": "vtu", "vtk": "vtk", "msh": "gmsh", "mesh": "medit", "inp": "abaqus",
-                  "f3grid": "flac3d", "dat": "tecplot", "ugrid": "ugrid"}
+MESHIO_FORMATS = {
+    "vtu": "vtu",
+    "vtk": "vtk",
+    "msh": "gmsh",
+    "mesh": "medit",
+    "inp": "abaqus",
+    "f3grid": "flac3d",
+    "dat": "tecplot",
+    "ugrid": "ugrid",
+}
 
 
 def _meshio_seeds() -> list[tuple[str, bytes]]:
@@ -63,14 +71,29 @@ def _trimesh_seeds() -> list[tuple[str, bytes]]:
 
 def seeds() -> list[tuple[str, bytes]]:
     """Every seed file as (name, bytes)."""
-    files = [(p.name, p.read_bytes()) for p in sorted((ROOT / "sample_meshes").iterdir())
-             if p.suffix not in (".py", ".md")]
+    files = [(p.name, p.read_bytes()) for p in sorted((ROOT / "sample_meshes").iterdir()) if p.suffix not in (".py", ".md")]
     files += _meshio_seeds() + _trimesh_seeds()
     files += [("points.csv", b"mass,x,y,z\n1,0,0,0\n2,1,0,0\n1,0,1,0\n")]
-    files += [H.abaqus(), H.nastran(), H.xdmf(), H.vtu(), H.gltf(), H.glb(), H.threemf(), H.ply(),
-              H.ply(binary=False), H.off(), H.obj_with_mtllib("/etc/passwd"), H.abaqus(include="/etc/passwd"),
-              H.vtu(piece_source="/etc/passwd"), H.gltf(uri="/etc/passwd"), H.xdmf("Binary", "/dev/zero"),
-              H.vtu(bomb=16 * 1024 * 1024), H.threemf(bomb=32 * 1024 * 1024), H.vtu(bomb=4 << 20, declared=96)]
+    files += [
+        H.abaqus(),
+        H.nastran(),
+        H.xdmf(),
+        H.vtu(),
+        H.gltf(),
+        H.glb(),
+        H.threemf(),
+        H.ply(),
+        H.ply(binary=False),
+        H.off(),
+        H.obj_with_mtllib("/etc/passwd"),
+        H.abaqus(include="/etc/passwd"),
+        H.vtu(piece_source="/etc/passwd"),
+        H.gltf(uri="/etc/passwd"),
+        H.xdmf("Binary", "/dev/zero"),
+        H.vtu(bomb=16 * 1024 * 1024),
+        H.threemf(bomb=32 * 1024 * 1024),
+        H.vtu(bomb=4 << 20, declared=96),
+    ]
     return files
 
 
@@ -95,8 +118,21 @@ def _duplicate(data: bytes, rng: random.Random) -> bytes:
 
 
 _NUMBER = re.compile(rb"-?\d+(?:\.\d+)?(?:[eE][-+]?\d+)?")
-_EXTREMES = [b"1e308", b"-1e308", b"1e-320", b"nan", b"inf", b"-1", b"0", b"4294967295", b"18446744073709551615",
-             b"99999999999", b"2147483648", b"-2147483649", b"1" * 400]
+_EXTREMES = [
+    b"1e308",
+    b"-1e308",
+    b"1e-320",
+    b"nan",
+    b"inf",
+    b"-1",
+    b"0",
+    b"4294967295",
+    b"18446744073709551615",
+    b"99999999999",
+    b"2147483648",
+    b"-2147483649",
+    b"1" * 400,
+]
 
 
 def _extreme_number(data: bytes, rng: random.Random) -> bytes:
@@ -104,14 +140,22 @@ def _extreme_number(data: bytes, rng: random.Random) -> bytes:
     if not matches:
         return _flip(data, rng)
     for m in rng.sample(matches, min(len(matches), rng.randint(1, 4))):
-        data = data[: m.start()] + rng.choice(_EXTREMES) + data[m.end():]
+        data = data[: m.start()] + rng.choice(_EXTREMES) + data[m.end() :]
         break  # offsets shift after one replacement
     return data
 
 
-_INSERTS = [b"\n*INCLUDE, INPUT=/etc/passwd\n", b"\nmtllib /etc/passwd\n", b"\nINCLUDE '/etc/passwd'\n",
-            b'<!DOCTYPE x [<!ENTITY e SYSTEM "file:///etc/passwd">]>', b'<Piece Source="/etc/passwd"/>',
-            b'"uri": "/etc/passwd", ', b"\x00" * 64, b"\xff\xfe", b"[" * 3000]
+_INSERTS = [
+    b"\n*INCLUDE, INPUT=/etc/passwd\n",
+    b"\nmtllib /etc/passwd\n",
+    b"\nINCLUDE '/etc/passwd'\n",
+    b'<!DOCTYPE x [<!ENTITY e SYSTEM "file:///etc/passwd">]>',
+    b'<Piece Source="/etc/passwd"/>',
+    b'"uri": "/etc/passwd", ',
+    b"\x00" * 64,
+    b"\xff\xfe",
+    b"[" * 3000,
+]
 
 
 def _insert(data: bytes, rng: random.Random) -> bytes:
@@ -148,7 +192,13 @@ def _nest(data: bytes, rng: random.Random) -> bytes:
 
 
 MUTATIONS: list[Callable[[bytes, random.Random], bytes]] = [
-    _flip, _truncate, _duplicate, _extreme_number, _insert, _header_lie, _nest,
+    _flip,
+    _truncate,
+    _duplicate,
+    _extreme_number,
+    _insert,
+    _header_lie,
+    _nest,
 ]
 
 

@@ -17,8 +17,19 @@ import zlib
 import numpy as np
 
 __all__ = [
-    "TET_POINTS", "abaqus", "nastran", "xdmf", "vtu", "gltf", "glb", "threemf", "ply", "off", "zip_of",
-    "deep_json", "obj_with_mtllib",
+    "TET_POINTS",
+    "abaqus",
+    "nastran",
+    "xdmf",
+    "vtu",
+    "gltf",
+    "glb",
+    "threemf",
+    "ply",
+    "off",
+    "zip_of",
+    "deep_json",
+    "obj_with_mtllib",
 ]
 
 # a unit right tetrahedron: volume 1/6
@@ -30,8 +41,11 @@ MIB = 1024 * 1024
 def abaqus(include: str | None = None, keyword_input: str | None = None) -> tuple[str, bytes]:
     """An Abaqus deck of one C3D4 element, optionally with ``*INCLUDE, INPUT=`` or ``*NODE, INPUT=``."""
     lines = ["*HEADING", "one tetrahedron"]
-    lines += [f"*NODE, INPUT={keyword_input}"] if keyword_input else \
-        ["*NODE"] + [f"{i + 1}, {x}, {y}, {z}" for i, (x, y, z) in enumerate(TET_POINTS)]
+    lines += (
+        [f"*NODE, INPUT={keyword_input}"]
+        if keyword_input
+        else ["*NODE"] + [f"{i + 1}, {x}, {y}, {z}" for i, (x, y, z) in enumerate(TET_POINTS)]
+    )
     lines += ["*ELEMENT, TYPE=C3D4, ELSET=EALL", "1, 1, 2, 3, 4"]
     if include:
         lines.append(f"*INCLUDE, INPUT={include}")
@@ -70,9 +84,16 @@ def _vtk_blocks(raw: bytes, *, declared: int | None = None, bomb: int = 0, lie_b
     return struct.pack("<4I", nblocks, size, size, len(block)) + block
 
 
-def vtu(*, bomb: int = 0, declared: int | None = None, piece_source: str | None = None, doctype: bool = False,
-        lie_blocks: int | None = None) -> tuple[str, bytes]:
+def vtu(
+    *,
+    bomb: int = 0,
+    declared: int | None = None,
+    piece_source: str | None = None,
+    doctype: bool = False,
+    lie_blocks: int | None = None,
+) -> tuple[str, bytes]:
     """A one-tetrahedron VTU with zlib-compressed base64 arrays (as VTK writes them), or an attack on it."""
+
     def array(values: np.ndarray, vtk_type: str, components: int, attack: bool = False) -> str:
         raw = values.tobytes()
         packed = _vtk_blocks(raw, declared=declared, bomb=bomb, lie_blocks=lie_blocks) if attack else _vtk_blocks(raw)
@@ -101,15 +122,16 @@ def vtu(*, bomb: int = 0, declared: int | None = None, piece_source: str | None 
 def _gltf_doc(buffer_uri: str, image_uri: str | None = None) -> dict[str, object]:
     doc: dict[str, object] = {
         "asset": {"version": "2.0"},
-        "scene": 0, "scenes": [{"nodes": [0]}], "nodes": [{"mesh": 0}],
+        "scene": 0,
+        "scenes": [{"nodes": [0]}],
+        "nodes": [{"mesh": 0}],
         "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "indices": 1}]}],
         "buffers": [{"uri": buffer_uri, "byteLength": 96 + 48}],
-        "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": 48},
-                        {"buffer": 0, "byteOffset": 48, "byteLength": 48}],
+        "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": 48}, {"buffer": 0, "byteOffset": 48, "byteLength": 48}],
         "accessors": [
-            {"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3",
-             "min": [0, 0, 0], "max": [1, 1, 1]},
-            {"bufferView": 1, "componentType": 5125, "count": 12, "type": "SCALAR"}],
+            {"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 1]},
+            {"bufferView": 1, "componentType": 5125, "count": 12, "type": "SCALAR"},
+        ],
     }
     if image_uri:
         doc["images"] = [{"uri": image_uri}]
@@ -187,7 +209,7 @@ def _lie_about_sizes(data: bytes, name: str | bytes, size: int) -> bytes:
             name_len_at = pos + (26 if sig == b"PK\x03\x04" else 28)
             name_len = struct.unpack_from("<H", buf, name_len_at)[0]
             name_at = pos + (30 if sig == b"PK\x03\x04" else 46)
-            if bytes(buf[name_at: name_at + name_len]) == target:
+            if bytes(buf[name_at : name_at + name_len]) == target:
                 struct.pack_into("<I", buf, pos + field, size)
             start = pos + 4
     return bytes(buf)
@@ -196,14 +218,17 @@ def _lie_about_sizes(data: bytes, name: str | bytes, size: int) -> bytes:
 def ply(vertices: int = 4, faces: int = 4, binary: bool = True) -> tuple[str, bytes]:
     """A PLY tetrahedron whose header declares ``vertices`` and ``faces`` (a lie when not 4)."""
     fmt = "binary_little_endian" if binary else "ascii"
-    header = (f"ply\nformat {fmt} 1.0\nelement vertex {vertices}\nproperty float x\nproperty float y\n"
-              f"property float z\nelement face {faces}\nproperty list uchar int vertex_indices\nend_header\n").encode()
+    header = (
+        f"ply\nformat {fmt} 1.0\nelement vertex {vertices}\nproperty float x\nproperty float y\n"
+        f"property float z\nelement face {faces}\nproperty list uchar int vertex_indices\nend_header\n"
+    ).encode()
     if binary:
-        body = TET_POINTS.astype("<f4").tobytes() + b"".join(
-            struct.pack("<B3i", 3, *map(int, f)) for f in TET_FACES)
+        body = TET_POINTS.astype("<f4").tobytes() + b"".join(struct.pack("<B3i", 3, *map(int, f)) for f in TET_FACES)
     else:
-        body = "".join(f"{x} {y} {z}\n" for x, y, z in TET_POINTS).encode() + "".join(
-            f"3 {a} {b} {c}\n" for a, b, c in TET_FACES).encode()
+        body = (
+            "".join(f"{x} {y} {z}\n" for x, y, z in TET_POINTS).encode()
+            + "".join(f"3 {a} {b} {c}\n" for a, b, c in TET_FACES).encode()
+        )
     return "tet.ply", header + body
 
 

@@ -83,13 +83,19 @@ def _descendants(pid: int) -> list[int]:
 
 @pytest.fixture(scope="module")
 def fuzz_server(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Any]:
-    from api.conftest import LiveServer
+    from tests.api.conftest import LiveServer
 
     tmp = tmp_path_factory.mktemp("fuzz-tmp")
     (Path(__file__).resolve().parents[2] / ".pytest_cache").mkdir(exist_ok=True)
-    server = LiveServer({"INERTIA_TIMEOUT_S": str(TIMEOUT_S), "INERTIA_COMPUTE_PROCESSES": "2",
-                         "INERTIA_MAX_UPLOAD_BYTES": str(MAX_UPLOAD), "TMPDIR": str(tmp)})
-    server.tmp = tmp
+    server = LiveServer(
+        {
+            "INERTIA_TIMEOUT_S": str(TIMEOUT_S),
+            "INERTIA_COMPUTE_PROCESSES": "2",
+            "INERTIA_MAX_UPLOAD_BYTES": str(MAX_UPLOAD),
+            "TMPDIR": str(tmp),
+        }
+    )
+    server.tmp = tmp  # type: ignore[attr-defined]  # where the test looks for leftover files
     try:
         yield server
     finally:
@@ -133,8 +139,7 @@ def test_mutated_files_of_every_format_never_break_the_server(fuzz_server: Any) 
             while time.monotonic() < stop:
                 name, seed = rng.choice(corpus)
                 data = mutate(seed, rng, corpus) if rng.random() < 0.9 else seed
-                params = {"format": rng.choice(["stl", "obj", "vtu", "3mf", "inp", "gltf"])} \
-                    if rng.random() < 0.05 else {}
+                params = {"format": rng.choice(["stl", "obj", "vtu", "3mf", "inp", "gltf"])} if rng.random() < 0.05 else {}
                 try:
                     response = c.post("/v1/analyze/mesh", files={"file": (name, data)}, params=params)
                 except httpx.TimeoutException:
@@ -160,11 +165,18 @@ def test_mutated_files_of_every_format_never_break_the_server(fuzz_server: Any) 
     server_growth = _peak_rss(pid) - server_before
     time.sleep(0.5)
     left = [str(p) for p in fuzz_server.tmp.rglob("*") if p.is_file()]
-    summary = {"requests": sent, "seconds": FUZZ_SECONDS, "clients": CLIENTS, "seed": FUZZ_SEED,
-               "seed_files": len(corpus), "statuses_and_codes": dict(sorted(counts.items())),
-               "server_peak_growth_mib": round(server_growth / MIB, 1),
-               "worker_peak_rss_mib": round(worker_peak / MIB, 1), "problems": problems[:50],
-               "temp_files_left": left[:20]}
+    summary = {
+        "requests": sent,
+        "seconds": FUZZ_SECONDS,
+        "clients": CLIENTS,
+        "seed": FUZZ_SEED,
+        "seed_files": len(corpus),
+        "statuses_and_codes": dict(sorted(counts.items())),
+        "server_peak_growth_mib": round(server_growth / MIB, 1),
+        "worker_peak_rss_mib": round(worker_peak / MIB, 1),
+        "problems": problems[:50],
+        "temp_files_left": left[:20],
+    }
     if REPORT:
         Path(REPORT).write_text(json.dumps(summary, indent=2))
     assert sent > 0
@@ -176,14 +188,43 @@ def test_mutated_files_of_every_format_never_break_the_server(fuzz_server: Any) 
 
 # --- in process, hypothesis ------------------------------------------------------------------------------
 
-EXTENSIONS = ["stl", "obj", "ply", "off", "glb", "gltf", "3mf", "vtu", "vtk", "msh", "mesh", "inp", "f3grid",
-              "dat", "ugrid", "ele", "json", "csv", "xdmf", "med", "zip", ""]
+EXTENSIONS = [
+    "stl",
+    "obj",
+    "ply",
+    "off",
+    "glb",
+    "gltf",
+    "3mf",
+    "vtu",
+    "vtk",
+    "msh",
+    "mesh",
+    "inp",
+    "f3grid",
+    "dat",
+    "ugrid",
+    "ele",
+    "json",
+    "csv",
+    "xdmf",
+    "med",
+    "zip",
+    "",
+]
 
 
 @pytest.fixture(scope="module")
 def app_client() -> Iterator[TestClient]:
-    with TestClient(create_app(Settings(compute_processes=1, timeout_s=TIMEOUT_S,  # type: ignore[call-arg]  # fields come from INERTIA_* variables
-                                        max_upload_bytes=MAX_UPLOAD))) as c:
+    with TestClient(
+        create_app(
+            Settings(
+                compute_processes=1,
+                timeout_s=TIMEOUT_S,  # type: ignore[call-arg]  # fields come from INERTIA_* variables
+                max_upload_bytes=MAX_UPLOAD,
+            )
+        )
+    ) as c:
         yield c
 
 
@@ -195,39 +236,50 @@ def _assert_no_500(response: Any) -> None:
 
 @settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
 @given(data=st.binary(max_size=2048), ext=st.sampled_from(EXTENSIONS))
-def test_arbitrary_bytes_under_any_format_name_are_never_a_500(app_client: TestClient, data: bytes,
-                                                               ext: str) -> None:
+def test_arbitrary_bytes_under_any_format_name_are_never_a_500(app_client: TestClient, data: bytes, ext: str) -> None:
     name = f"file.{ext}" if ext else "file"
     _assert_no_500(app_client.post("/v1/analyze/mesh", files={"file": (name, data)}))
 
 
-JSON = st.recursive(st.none() | st.booleans() | st.floats() | st.integers() | st.text(max_size=8),
-                    lambda inner: st.lists(inner, max_size=4) | st.dictionaries(st.text(max_size=6), inner,
-                                                                                max_size=4), max_leaves=20)
+JSON = st.recursive(
+    st.none() | st.booleans() | st.floats() | st.integers() | st.text(max_size=8),
+    lambda inner: st.lists(inner, max_size=4) | st.dictionaries(st.text(max_size=6), inner, max_size=4),
+    max_leaves=20,
+)
 
 
 @settings(max_examples=50, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
-@given(body=JSON | st.fixed_dictionaries({"points": st.lists(st.fixed_dictionaries(
-    {"mass": st.floats(), "position": st.lists(st.floats(), min_size=3, max_size=3)}), max_size=4)}),
-    depth=st.sampled_from([0, 0, 0, 50, 5000]))
+@given(
+    body=JSON
+    | st.fixed_dictionaries(
+        {
+            "points": st.lists(
+                st.fixed_dictionaries({"mass": st.floats(), "position": st.lists(st.floats(), min_size=3, max_size=3)}), max_size=4
+            )
+        }
+    ),
+    depth=st.sampled_from([0, 0, 0, 50, 5000]),
+)
 def test_arbitrary_json_bodies_and_parameters_are_never_a_500(app_client: TestClient, body: Any, depth: int) -> None:
     text = "[" * depth + json.dumps(body) + "]" * depth
-    _assert_no_500(app_client.post("/v1/analyze/points", content=text,
-                                   headers={"content-type": "application/json"}))
+    _assert_no_500(app_client.post("/v1/analyze/points", content=text, headers={"content-type": "application/json"}))
     _assert_no_500(app_client.post("/v1/precession", content=text, headers={"content-type": "application/json"}))
     box = H.off()
     _assert_no_500(app_client.post("/v1/analyze/mesh", files={"file": box}, params={"densities": text[:4000]}))
 
 
 @settings(max_examples=10, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
-@given(pick=st.lists(st.integers(0, 10_000), min_size=1, max_size=5), corrupt=st.integers(0, 5),
-       seed=st.integers(0, 2**32))
-def test_batch_of_a_zip_with_bad_members_ends_well_formed(app_client: TestClient, pick: list[int], corrupt: int,
-                                                          seed: int) -> None:
+@given(pick=st.lists(st.integers(0, 10_000), min_size=1, max_size=5), corrupt=st.integers(0, 5), seed=st.integers(0, 2**32))
+def test_batch_of_a_zip_with_bad_members_ends_well_formed(app_client: TestClient, pick: list[int], corrupt: int, seed: int) -> None:
     rng = random.Random(seed)
     corpus = _small_corpus()
-    members = [(f"{i}-{corpus[k % len(corpus)][0]}", mutate(corpus[k % len(corpus)][1], rng, corpus)
-                if rng.random() < 0.5 else corpus[k % len(corpus)][1]) for i, k in enumerate(pick)]
+    members = [
+        (
+            f"{i}-{corpus[k % len(corpus)][0]}",
+            mutate(corpus[k % len(corpus)][1], rng, corpus) if rng.random() < 0.5 else corpus[k % len(corpus)][1],
+        )
+        for i, k in enumerate(pick)
+    ]
     bad = members[corrupt][0] if corrupt < len(members) else None
     archive = H.zip_of(members, corrupt=bad)
     response = app_client.post("/v1/batch", files={"files": ("batch.zip", archive)})

@@ -12,7 +12,8 @@ import time
 
 import pytest
 
-from inertia.errors import ExternalReferenceError, PayloadTooLargeError, ServiceError, UnreadableFileError
+from inertia.errors import ExternalReferenceError, ServiceError, UnreadableFileError
+from inertia.errors import InputTooLargeError as PayloadTooLargeError
 from inertia.load import load_body
 from inertia.load.guard import check_upload, inflate_budget
 
@@ -49,8 +50,14 @@ ATTACKS = {
 }
 
 HONEST = {
-    "abaqus": H.abaqus(), "vtu": H.vtu(), "gltf": H.gltf(), "glb": H.glb(), "3mf": H.threemf(),
-    "ply": H.ply(), "ply ascii": H.ply(binary=False), "off": H.off(),
+    "abaqus": H.abaqus(),
+    "vtu": H.vtu(),
+    "gltf": H.gltf(),
+    "glb": H.glb(),
+    "3mf": H.threemf(),
+    "ply": H.ply(),
+    "ply ascii": H.ply(binary=False),
+    "off": H.off(),
 }
 
 

@@ -42,8 +42,11 @@ def compare(props: Any, m0: float, m1: np.ndarray, m2: np.ndarray, rel: float) -
     mass, com, tensor = volref.inertia_about_centre(m0, m1, m2, density=1000.0)
     scale = np.abs(tensor).max()
     size = np.sqrt(scale / mass)  # radius of gyration: the length scale of the centre's error
-    actual = max(abs(props.mass - mass) / mass, np.abs(props.center_of_mass - com).max() / size,
-                 np.abs(props.inertia.matrix - tensor).max() / scale)
+    actual = max(
+        abs(props.mass - mass) / mass,
+        np.abs(props.center_of_mass - com).max() / size,
+        np.abs(props.inertia.matrix - tensor).max() / scale,
+    )
     assert actual <= rel
     # the error estimate is honest: never below the error against the reference (whose own rounding,
     # ~1e-14 of the largest moment, is allowed for)
@@ -114,8 +117,14 @@ def test_shape_functions_are_vtks(name: str) -> None:
 @pytest.mark.parametrize("name", QUADRATIC)
 def test_quadratic_cell_with_straight_edges_equals_its_linear_cell(name: str) -> None:
     """Mid-edge (and face, centre) nodes where the linear cell's map puts them: the same body."""
-    linear = {"tetra10": "tetra", "hexahedron20": "hexahedron", "hexahedron27": "hexahedron", "wedge15": "wedge",
-              "wedge18": "wedge", "pyramid13": "pyramid"}[name]
+    linear = {
+        "tetra10": "tetra",
+        "hexahedron20": "hexahedron",
+        "hexahedron27": "hexahedron",
+        "wedge15": "wedge",
+        "wedge18": "wedge",
+        "pyramid13": "pyramid",
+    }[name]
     corners = curved(linear, seed=3, amplitude=0.15)
     xi = volref.parametric_nodes(name)
     if name == "pyramid13":  # VTK puts the apex at (0, 0, 1): any point of the cube's top face maps there
@@ -127,8 +136,9 @@ def test_quadratic_cell_with_straight_edges_equals_its_linear_cell(name: str) ->
     else:
         straight = mass_properties(body_of(linear, corners))
     assert quadratic.mass == pytest.approx(straight.mass, rel=1e-13)
-    np.testing.assert_allclose(quadratic.inertia.matrix, straight.inertia.matrix, rtol=0,
-                               atol=1e-13 * np.abs(straight.inertia.matrix).max())
+    np.testing.assert_allclose(
+        quadratic.inertia.matrix, straight.inertia.matrix, rtol=0, atol=1e-13 * np.abs(straight.inertia.matrix).max()
+    )
 
 
 def test_straight_tetra10_matches_the_exact_tetrahedron() -> None:
@@ -139,8 +149,10 @@ def test_straight_tetra10_matches_the_exact_tetrahedron() -> None:
     vol, m1, m2 = volref.tet_moments_exact(corners)
     c = [v / vol for v in m1]
     cov = [[m2[i][j] - vol * c[i] * c[j] for j in range(3)] for i in range(3)]
-    exact_tensor = [[(cov[(i + 1) % 3][(i + 1) % 3] + cov[(i + 2) % 3][(i + 2) % 3]) if i == j else -cov[i][j]
-                     for j in range(3)] for i in range(3)]
+    exact_tensor = [
+        [(cov[(i + 1) % 3][(i + 1) % 3] + cov[(i + 2) % 3][(i + 2) % 3]) if i == j else -cov[i][j] for j in range(3)]
+        for i in range(3)
+    ]
     assert props.mass == pytest.approx(float(vol), rel=1e-14)
     np.testing.assert_allclose(props.center_of_mass, [float(v) for v in c], rtol=1e-14)
     np.testing.assert_allclose(props.inertia.matrix, np.array(exact_tensor, dtype=float), rtol=1e-13)
@@ -149,16 +161,20 @@ def test_straight_tetra10_matches_the_exact_tetrahedron() -> None:
 HEX = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0], [0, 0, 1], [1, 0, 1], [1, 1, 1], [0, 1, 1]], dtype=float)
 
 
-@pytest.mark.parametrize("nodes, tets", [
-    ([0, 1, 2, 3, 4, 4, 4, 4], [[0, 1, 2, 4], [0, 2, 3, 4]]),  # top face to one apex: a pyramid
-    ([0, 1, 2, 3, 4, 5, 5, 4], [[0, 3, 4, 1], [3, 4, 1, 2], [4, 1, 2, 5]]),  # top face to an edge: a wedge
-    ([0, 1, 2, 2, 4, 4, 4, 4], [[0, 1, 2, 4]]),  # base to a triangle, top to a point: a tetrahedron
-])
+@pytest.mark.parametrize(
+    "nodes, tets",
+    [
+        ([0, 1, 2, 3, 4, 4, 4, 4], [[0, 1, 2, 4], [0, 2, 3, 4]]),  # top face to one apex: a pyramid
+        ([0, 1, 2, 3, 4, 5, 5, 4], [[0, 3, 4, 1], [3, 4, 1, 2], [4, 1, 2, 5]]),  # top face to an edge: a wedge
+        ([0, 1, 2, 2, 4, 4, 4, 4], [[0, 1, 2, 4]]),  # base to a triangle, top to a point: a tetrahedron
+    ],
+)
 def test_collapsed_hexahedron_is_its_true_shape(nodes: list[int], tets: list[list[int]]) -> None:
     affine = np.array([[1.3, 0.2, 0.1], [0.1, 0.9, -0.2], [0.05, 0.1, 1.1]])
     points = HEX @ affine.T + (0.5, -1.0, 2.0)  # planar faces, so the true shape is the union of the tetrahedra
-    props = mass_properties(VolumeBody(points, np.empty((0, 4), np.int64),
-                                       cells=(CellBlock("hexahedron", np.array([nodes])),)), density=1.0)
+    props = mass_properties(
+        VolumeBody(points, np.empty((0, 4), np.int64), cells=(CellBlock("hexahedron", np.array([nodes])),)), density=1.0
+    )
     split = mass_properties(VolumeBody(points, np.array(tets)), density=1.0)
     assert props.mass == pytest.approx(split.mass, rel=1e-14)
     np.testing.assert_allclose(props.inertia.matrix, split.inertia.matrix, atol=1e-14 * np.abs(split.inertia.matrix).max())
@@ -168,8 +184,7 @@ def test_collapsed_hexahedron_is_not_twice_the_volume() -> None:
     """A wedge written as a hexahedron with repeated nodes, as meshers do: volume of the wedge."""
     points = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1], [1, 0, 1], [0, 1, 1]], dtype=float)
     nodes = np.array([[0, 1, 2, 2, 3, 4, 5, 5]])
-    props = mass_properties(VolumeBody(points, np.empty((0, 4), np.int64), cells=(CellBlock("hexahedron", nodes),)),
-                            density=1.0)
+    props = mass_properties(VolumeBody(points, np.empty((0, 4), np.int64), cells=(CellBlock("hexahedron", nodes),)), density=1.0)
     assert props.mass == pytest.approx(0.5, rel=1e-15)
 
 
@@ -228,8 +243,7 @@ def _renumbering(name: str, symmetry: np.ndarray) -> np.ndarray:
 
 
 @settings(max_examples=25, deadline=None)
-@given(st.sampled_from(["hexahedron", "hexahedron20", "hexahedron27"]), st.sampled_from(range(48)),
-       st.integers(0, 2**32 - 1))
+@given(st.sampled_from(["hexahedron", "hexahedron20", "hexahedron27"]), st.sampled_from(range(48)), st.integers(0, 2**32 - 1))
 def test_renumbering_a_cell_changes_nothing(name: str, which: int, seed: int) -> None:
     nodes = curved(name, seed % 1000)
     perm = _renumbering(name, CUBE_SYMMETRIES[which])
@@ -238,11 +252,14 @@ def test_renumbering_a_cell_changes_nothing(name: str, which: int, seed: int) ->
     base = mass_properties(body_of(name, nodes))
     stored = np.empty_like(nodes)
     stored[shuffle] = nodes  # node i of the cell now lives at index shuffle[i]
-    renumbered = mass_properties(VolumeBody(stored, np.empty((0, 4), np.int64),
-                                            cells=(CellBlock(name, shuffle[perm][None, :]),)))
+    renumbered = mass_properties(VolumeBody(stored, np.empty((0, 4), np.int64), cells=(CellBlock(name, shuffle[perm][None, :]),)))
     assert renumbered.mass == pytest.approx(base.mass, rel=1e-14)
-    np.testing.assert_allclose(renumbered.inertia.matrix, base.inertia.matrix, rtol=0,
-                               atol=4 * base.relative_error_estimate * np.abs(base.inertia.matrix).max())
+    np.testing.assert_allclose(
+        renumbered.inertia.matrix,
+        base.inertia.matrix,
+        rtol=0,
+        atol=4 * base.relative_error_estimate * np.abs(base.inertia.matrix).max(),
+    )
 
 
 def test_mirrored_cells_count_positive() -> None:
@@ -273,8 +290,9 @@ def test_cells_far_from_the_origin_keep_their_precision() -> None:
 def test_cell_densities_weight_each_cell() -> None:
     two = np.vstack([HEX, HEX[4:] + np.array([0.0, 0.0, 1.0])])
     cells = np.array([[0, 1, 2, 3, 4, 5, 6, 7], [4, 5, 6, 7, 8, 9, 10, 11]])
-    props = mass_properties(VolumeBody(two, np.empty((0, 4), np.int64),
-                                       cells=(CellBlock("hexahedron", cells, np.array([1000.0, 3000.0])),)))
+    props = mass_properties(
+        VolumeBody(two, np.empty((0, 4), np.int64), cells=(CellBlock("hexahedron", cells, np.array([1000.0, 3000.0])),))
+    )
     assert props.mass == pytest.approx(4000.0, rel=1e-14)
     assert props.center_of_mass[2] == pytest.approx((0.5 * 1000 + 1.5 * 3000) / 4000, rel=1e-14)
 

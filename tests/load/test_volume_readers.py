@@ -58,8 +58,12 @@ def write_vtu(ug: float, path: Path, mode: str = "appended", compressor: str | N
     w.SetInputData(ug)
     {"appended": w.SetDataModeToAppended, "binary": w.SetDataModeToBinary, "ascii": w.SetDataModeToAscii}[mode]()
     w.SetEncodeAppendedData(encode)
-    {None: w.SetCompressorTypeToNone, "zlib": w.SetCompressorTypeToZLib, "lz4": w.SetCompressorTypeToLZ4,
-     "lzma": w.SetCompressorTypeToLZMA}[compressor]()
+    {
+        None: w.SetCompressorTypeToNone,
+        "zlib": w.SetCompressorTypeToZLib,
+        "lz4": w.SetCompressorTypeToLZ4,
+        "lzma": w.SetCompressorTypeToLZMA,
+    }[compressor]()
     assert w.Write() == 1
     return path.read_bytes()
 
@@ -151,8 +155,9 @@ def test_voxels_are_read_in_vtks_node_order(tmp_path: Path, ext: str) -> None:
     props = mass_properties(load_body(data, filename=f"v.{ext}").body, density=1.0)  # type: ignore[arg-type]
     assert props.mass == pytest.approx(30.0, rel=1e-15) == vtk_volume(ug)
     # a box 2 x 3 x 5: I_xx = m (b^2 + c^2) / 12
-    np.testing.assert_allclose(np.diag(props.inertia.matrix), 30 * np.array([3**2 + 5**2, 2**2 + 5**2, 2**2 + 3**2]) / 12,
-                               rtol=1e-14)
+    np.testing.assert_allclose(
+        np.diag(props.inertia.matrix), 30 * np.array([3**2 + 5**2, 2**2 + 5**2, 2**2 + 3**2]) / 12, rtol=1e-14
+    )
 
 
 @pytest.mark.parametrize("name", ["tetra10", "hexahedron20", "hexahedron27", "wedge15", "wedge18", "pyramid13"])
@@ -175,9 +180,19 @@ def test_legacy_cell_lists_longer_than_the_type_use_vtks_first_ids(tmp_path: Pat
     corners = np.array(HEX, dtype=float) * 2
     edges = [(0, 1), (1, 2), (2, 3), (3, 0), (4, 5), (5, 6), (6, 7), (7, 4), (0, 4), (1, 5), (2, 6), (3, 7)]
     pts = np.vstack([corners, [(corners[a] + corners[b]) / 2 for a, b in edges]])
-    text = ["# vtk DataFile Version 3.0", "hex20 as type 12", "ASCII", "DATASET UNSTRUCTURED_GRID",
-            f"POINTS {len(pts)} double", *(" ".join(repr(float(v)) for v in p) for p in pts),
-            "CELLS 1 21", "20 " + " ".join(map(str, range(20))), "CELL_TYPES 1", "12", ""]
+    text = [
+        "# vtk DataFile Version 3.0",
+        "hex20 as type 12",
+        "ASCII",
+        "DATASET UNSTRUCTURED_GRID",
+        f"POINTS {len(pts)} double",
+        *(" ".join(repr(float(v)) for v in p) for p in pts),
+        "CELLS 1 21",
+        "20 " + " ".join(map(str, range(20))),
+        "CELL_TYPES 1",
+        "12",
+        "",
+    ]
     data = "\n".join(text).encode()
     path = tmp_path / "long.vtk"
     path.write_bytes(data)
@@ -191,8 +206,24 @@ def test_legacy_cell_lists_longer_than_the_type_use_vtks_first_ids(tmp_path: Pat
 
 
 def test_legacy_cell_lists_shorter_than_the_type_are_refused() -> None:
-    text = "\n".join(["# vtk DataFile Version 3.0", "short", "ASCII", "DATASET UNSTRUCTURED_GRID", "POINTS 4 double",
-                      "0 0 0", "1 0 0", "0 1 0", "0 0 1", "CELLS 1 5", "4 0 1 2 3", "CELL_TYPES 1", "12", ""])
+    text = "\n".join(
+        [
+            "# vtk DataFile Version 3.0",
+            "short",
+            "ASCII",
+            "DATASET UNSTRUCTURED_GRID",
+            "POINTS 4 double",
+            "0 0 0",
+            "1 0 0",
+            "0 1 0",
+            "0 0 1",
+            "CELLS 1 5",
+            "4 0 1 2 3",
+            "CELL_TYPES 1",
+            "12",
+            "",
+        ]
+    )
     with pytest.raises(LoadError) as info:
         load_body(text.encode(), filename="short.vtk")
     assert "hexahedron" in info.value.message
@@ -251,11 +282,16 @@ def test_without_the_vtk_extra_vtk_files_get_a_message_naming_it(monkeypatch: py
 # never a crash, never chatter
 
 
-GARBAGE = [b"", b"\x00\x01\x02garbage" * 50, b"$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Nodes\n1 2 3\n",
-           b"# vtk DataFile Version 3.0\nx\nASCII\nDATASET UNSTRUCTURED_GRID\nPOINTS 3 double\n0 0",
-           b'<?xml version="1.0"?><VTKFile type="UnstructuredGrid"><UnstructuredGrid><Piece NumberOfPoints="2"',
-           "caf\u00e9 \u2603".encode("utf-16"), b"*NODE\n1, 0, 0\n*ELEMENT, TYPE=C3D8\n1, 1, 2\n",
-           b"MeshVersionFormatted 2\nDimension 3\nVertices\n2\n0 0 0 1\n"]
+GARBAGE = [
+    b"",
+    b"\x00\x01\x02garbage" * 50,
+    b"$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Nodes\n1 2 3\n",
+    b"# vtk DataFile Version 3.0\nx\nASCII\nDATASET UNSTRUCTURED_GRID\nPOINTS 3 double\n0 0",
+    b'<?xml version="1.0"?><VTKFile type="UnstructuredGrid"><UnstructuredGrid><Piece NumberOfPoints="2"',
+    "caf\u00e9 \u2603".encode("utf-16"),
+    b"*NODE\n1, 0, 0\n*ELEMENT, TYPE=C3D8\n1, 1, 2\n",
+    b"MeshVersionFormatted 2\nDimension 3\nVertices\n2\n0 0 0 1\n",
+]
 
 
 @pytest.mark.parametrize("ext", ["vtu", "vtk", "msh", "mesh", "inp", "xdmf", "med", "f3grid", "dat", "ugrid", "ele"])
@@ -358,8 +394,7 @@ def test_structured_vtk_data_sets_are_their_voxels_and_hexahedra(tmp_path: Path,
     elif kind == "rectilinear":
         data_set = vtk.vtkRectilinearGrid()
         data_set.SetDimensions(len(xs), len(ys), len(zs))
-        for setter, values in ((data_set.SetXCoordinates, xs), (data_set.SetYCoordinates, ys),
-                               (data_set.SetZCoordinates, zs)):
+        for setter, values in ((data_set.SetXCoordinates, xs), (data_set.SetYCoordinates, ys), (data_set.SetZCoordinates, zs)):
             arr = vtk.vtkDoubleArray()
             for v in values:
                 arr.InsertNextValue(v)

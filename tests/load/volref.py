@@ -21,13 +21,31 @@ import pytest
 vtk = pytest.importorskip("vtk")
 
 VTK_CELLS = {
-    "tetra": "vtkTetra", "tetra10": "vtkQuadraticTetra", "hexahedron": "vtkHexahedron",
-    "hexahedron20": "vtkQuadraticHexahedron", "hexahedron27": "vtkTriQuadraticHexahedron", "wedge": "vtkWedge",
-    "wedge15": "vtkQuadraticWedge", "wedge18": "vtkBiQuadraticQuadraticWedge", "pyramid": "vtkPyramid",
-    "pyramid13": "vtkQuadraticPyramid", "voxel": "vtkVoxel",
+    "tetra": "vtkTetra",
+    "tetra10": "vtkQuadraticTetra",
+    "hexahedron": "vtkHexahedron",
+    "hexahedron20": "vtkQuadraticHexahedron",
+    "hexahedron27": "vtkTriQuadraticHexahedron",
+    "wedge": "vtkWedge",
+    "wedge15": "vtkQuadraticWedge",
+    "wedge18": "vtkBiQuadraticQuadraticWedge",
+    "pyramid": "vtkPyramid",
+    "pyramid13": "vtkQuadraticPyramid",
+    "voxel": "vtkVoxel",
 }
-VTK_TYPE_IDS = {"tetra": 10, "voxel": 11, "hexahedron": 12, "wedge": 13, "pyramid": 14, "tetra10": 24,
-                "hexahedron20": 25, "wedge15": 26, "pyramid13": 27, "hexahedron27": 29, "wedge18": 32}
+VTK_TYPE_IDS = {
+    "tetra": 10,
+    "voxel": 11,
+    "hexahedron": 12,
+    "wedge": 13,
+    "pyramid": 14,
+    "tetra10": 24,
+    "hexahedron20": 25,
+    "wedge15": 26,
+    "pyramid13": 27,
+    "hexahedron27": 29,
+    "wedge18": 32,
+}
 
 
 def vtk_cell(name: str) -> Any:
@@ -102,8 +120,11 @@ def tet_moments_exact(p: np.ndarray) -> tuple[Fraction, list[Fraction], list[lis
     """Exact integrals of a linear tetrahedron (Tonon 2004, eqs. 7-8) in fractions."""
     q = [[Fraction(float(v)) for v in row] for row in p]
     e = [[q[k][i] - q[0][i] for i in range(3)] for k in (1, 2, 3)]
-    det = (e[0][0] * (e[1][1] * e[2][2] - e[1][2] * e[2][1]) - e[0][1] * (e[1][0] * e[2][2] - e[1][2] * e[2][0])
-           + e[0][2] * (e[1][0] * e[2][1] - e[1][1] * e[2][0]))
+    det = (
+        e[0][0] * (e[1][1] * e[2][2] - e[1][2] * e[2][1])
+        - e[0][1] * (e[1][0] * e[2][2] - e[1][2] * e[2][0])
+        + e[0][2] * (e[1][0] * e[2][1] - e[1][1] * e[2][0])
+    )
     vol = abs(det) / 6
     s = [sum(q[k][i] for k in range(4)) for i in range(3)]
     m1 = [vol * s[i] / 4 for i in range(3)]

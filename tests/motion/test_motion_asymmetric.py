@@ -26,7 +26,7 @@ GENERIC = [
 ]
 
 
-def _predict(moments: Any, omega_body: Any, rotation: Any=ROT, tolerance: float=1e-6, **kw: Any) -> Any:
+def _predict(moments: Any, omega_body: Any, rotation: Any = ROT, tolerance: float = 1e-6, **kw: Any) -> Any:
     frame, cls = body(moments, rotation, tolerance)
     return predict_motion(frame, cls, np.asarray(rotation).T @ np.asarray(omega_body, dtype=float), **kw)
 

@@ -32,8 +32,9 @@ def _exact(moments: Any, omega: Any, duration: float, samples: int, **kw: Any) -
 
 
 @pytest.mark.parametrize("method, tol", [("dop853", 1e-8), ("rk45", 1e-7), ("splitting", 1e-5)])
-@pytest.mark.parametrize("moments, omega", [(MOMENTS, OMEGA), ((1.0, 2.0, 3.0), (1.0, 0.4, 0.1)),
-                                           ((2.0, 2.0, 3.0), (0.3, -0.4, 1.2))])
+@pytest.mark.parametrize(
+    "moments, omega", [(MOMENTS, OMEGA), ((1.0, 2.0, 3.0), (1.0, 0.4, 0.1)), ((2.0, 2.0, 3.0), (0.3, -0.4, 1.2))]
+)
 def test_numerical_methods_agree_with_exact(method: str, tol: float, moments: Any, omega: Any) -> None:
     frame, cls = body(moments)
     numeric = predict_motion(frame, cls, omega, duration=20.0, samples=41, method=method)
@@ -103,9 +104,11 @@ def test_elliptic_integrals_match_mpmath(m1: float, b: float) -> None:
     assert quarter_period(m1) - b / 3 * complete_third_kind_rj(m1, b) == pytest.approx(float(Pic), rel=1e-14)
 
 
-moments_st = st.tuples(
-    st.floats(0.1, 10.0), st.floats(0.1, 10.0), st.floats(0.1, 10.0)
-).map(sorted).filter(lambda m: m[1] - m[0] > 1e-3 * m[2] and m[2] - m[1] > 1e-3 * m[2] and m[0] + m[1] >= m[2])
+moments_st = (
+    st.tuples(st.floats(0.1, 10.0), st.floats(0.1, 10.0), st.floats(0.1, 10.0))
+    .map(sorted)
+    .filter(lambda m: m[1] - m[0] > 1e-3 * m[2] and m[2] - m[1] > 1e-3 * m[2] and m[0] + m[1] >= m[2])
+)
 omega_st = st.tuples(st.floats(-5.0, 5.0), st.floats(-5.0, 5.0), st.floats(-5.0, 5.0)).filter(
     lambda w: sorted(abs(x) for x in w)[1] > 1e-3
 )

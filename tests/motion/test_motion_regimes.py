@@ -24,7 +24,7 @@ BASE_KEYS = {"regime", "angular_momentum", "angular_momentum_magnitude", "kineti
 SYMMETRIC_KEYS = BASE_KEYS | {"body_precession_rate", "space_precession_rate", "spin_rate", "nutation_angle", "period", "stable"}
 
 
-def _predict(moments: Any, omega_body: Any, rotation: Any=ROT, tolerance: float=1e-6, **kw: Any) -> Any:
+def _predict(moments: Any, omega_body: Any, rotation: Any = ROT, tolerance: float = 1e-6, **kw: Any) -> Any:
     frame, cls = body(moments, rotation, tolerance)
     return predict_motion(frame, cls, np.asarray(rotation).T @ np.asarray(omega_body, dtype=float), **kw)
 

@@ -34,8 +34,10 @@ def _tops(seed: int, count: int) -> Any:
 def test_the_elliptic_reference_solves_eulers_equations() -> None:
     t = np.linspace(0.0, 10.0, 6)
     for moments, omega in _tops(7, 3):
-        assert np.max(np.abs(elliptic_reference(moments, omega, t) - euler_taylor_reference(moments, omega, t))) \
+        assert (
+            np.max(np.abs(elliptic_reference(moments, omega, t) - euler_taylor_reference(moments, omega, t)))
             <= 1e-20 * np.linalg.norm(omega) + 1e-300
+        )
 
 
 @pytest.mark.parametrize("duration", [10.0, 1000.0])

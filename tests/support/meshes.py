@@ -6,8 +6,19 @@ import numpy as np
 
 from benchmarks.cases import BOX_FACES, box, icosahedron, l_bracket, prism, stl_bytes, triangles_stl_bytes, write_obj, write_stl
 
-__all__ = ["BOX_FACES", "box", "box_stl", "icosahedron", "l_bracket", "prism", "stl_bytes", "torus_stl",
-           "triangles_stl_bytes", "write_obj", "write_stl"]
+__all__ = [
+    "BOX_FACES",
+    "box",
+    "box_stl",
+    "icosahedron",
+    "l_bracket",
+    "prism",
+    "stl_bytes",
+    "torus_stl",
+    "triangles_stl_bytes",
+    "write_obj",
+    "write_stl",
+]
 
 
 def box_stl(a: float, b: float, c: float, origin: tuple[float, float, float] = (0.0, 0.0, 0.0)) -> bytes:

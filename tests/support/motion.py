@@ -18,7 +18,7 @@ from inertia.classification import Classification, classify
 from inertia.principal import PrincipalFrame
 
 
-def body(moments: Any, rotation: Any=None, tolerance: float=1e-6) -> tuple[PrincipalFrame, Classification]:
+def body(moments: Any, rotation: Any = None, tolerance: float = 1e-6) -> tuple[PrincipalFrame, Classification]:
     """Principal frame and classification of a body with these principal moments,
     its principal axes the rows of ``rotation`` (identity by default)."""
     axes = np.eye(3) if rotation is None else np.asarray(rotation, dtype=float)
@@ -27,7 +27,7 @@ def body(moments: Any, rotation: Any=None, tolerance: float=1e-6) -> tuple[Princ
     return frame, classify(frame)
 
 
-def euler_reference(moments: Any, omega_body: Any, t: Any, rtol: float=1e-12) -> Any:
+def euler_reference(moments: Any, omega_body: Any, t: Any, rtol: float = 1e-12) -> Any:
     """Omega(t) (N, 3) in the body and R(t) (N, 3, 3), the rotation since t = 0 in the body frame at 0."""
     I1, I2, I3 = (float(x) for x in moments)
 
@@ -73,7 +73,7 @@ def quaternion_matrix(q: Any) -> Any:
     )
 
 
-def elliptic_reference(moments: Any, omega_body: Any, t: Any, dps: int=50) -> Any:
+def elliptic_reference(moments: Any, omega_body: Any, t: Any, dps: int = 50) -> Any:
     """Omega(t) (N, 3) in the body frame of an asymmetric top (I1 < I2 < I3), from the
     closed form of L&L §37 (eqs. 37.10-37.12) evaluated with mpmath's Jacobi
     functions at ``dps`` digits, for the moments exactly as given.
@@ -104,8 +104,7 @@ def elliptic_reference(moments: Any, omega_body: Any, t: Any, dps: int=50) -> An
         u0 = mp.ellipf(mp.asin(sn0), m)
 
         def euler(w: Any) -> Any:
-            return [(I[1] - I[2]) / I[0] * w[1] * w[2], (I[2] - I[0]) / I[1] * w[2] * w[0],
-                    (I[0] - I[1]) / I[2] * w[0] * w[1]]
+            return [(I[1] - I[2]) / I[0] * w[1] * w[2], (I[2] - I[0]) / I[1] * w[2] * w[0], (I[0] - I[1]) / I[2] * w[0] * w[1]]
 
         rhs = euler(W)
         # d/du of the formula at u0, component by component; the sign of lambda matches Euler
@@ -127,7 +126,7 @@ def elliptic_reference(moments: Any, omega_body: Any, t: Any, dps: int=50) -> An
         return out
 
 
-def euler_taylor_reference(moments: Any, omega_body: Any, t: Any, dps: int=30) -> Any:
+def euler_taylor_reference(moments: Any, omega_body: Any, t: Any, dps: int = 30) -> Any:
     """Omega(t) (N, 3) from Euler's equations integrated by mpmath's Taylor-series solver
     (``mpmath.odefun``) at ``dps`` digits: slow, for short horizons."""
     with mp.workdps(dps):

@@ -1,0 +1,69 @@
+"""Exit codes of the command line are chosen by the error's class, so a new subclass inherits its family's."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from inertia import errors as E
+from inertia.api import transport
+from inertia.cli import EXIT_INTERNAL, exit_code
+
+
+@pytest.mark.parametrize(
+    ("error", "status"),
+    [
+        (E.InvalidParameterError("x"), 2),
+        (E.MotionError("x"), 2),
+        (E.UnsupportedFormatError("x"), 3),
+        (E.UnreadableFileError("x"), 3),
+        (E.ExternalReferenceError("x"), 3),
+        (E.EmptyGeometryError("x"), 3),
+        (E.InputTooLargeError("x"), 3),
+        (E.NotWatertightError("x"), 4),
+        (E.ZeroVolumeError("x"), 4),
+        (E.InsufficientPrecisionError("x"), 4),
+        (E.InvalidInertiaError("x"), 4),
+        (E.ServerBusyError("x"), EXIT_INTERNAL),
+    ],
+)
+def test_exit_code_by_class(error: E.ServiceError, status: int) -> None:
+    assert exit_code(error) == status
+
+
+def test_every_core_error_has_an_exit_code() -> None:
+    for name in E.__all__:
+        cls = getattr(E, name)
+        assert isinstance(exit_code(cls("x")), int)
+
+
+def test_transport_errors_live_in_the_api_package() -> None:
+    for name in ("PayloadTooLargeError", "ComputeTimeoutError", "UnauthorizedError"):
+        assert not hasattr(E, name)
+        assert issubclass(getattr(transport, name), E.ServiceError)
+    assert issubclass(transport.PayloadTooLargeError, E.InputTooLargeError)
+
+
+def test_an_external_reference_is_a_file_that_cannot_be_read(tmp_path: Path) -> None:
+    # a glTF whose buffer is another file: the code is external_reference, a subclass of unreadable_file
+    doc = {
+        "asset": {"version": "2.0"},
+        "buffers": [{"uri": "missing.bin", "byteLength": 36}],
+        "bufferViews": [{"buffer": 0, "byteLength": 36}],
+        "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 0]}],
+        "meshes": [{"primitives": [{"attributes": {"POSITION": 0}}]}],
+        "nodes": [{"mesh": 0}],
+        "scenes": [{"nodes": [0]}],
+        "scene": 0,
+    }
+    path = tmp_path / "ext.gltf"
+    path.write_text(json.dumps(doc), encoding="utf-8")
+    out = subprocess.run(
+        [sys.executable, "-m", "inertia", "analyze", "--json", str(path)], capture_output=True, text=True, timeout=120
+    )
+    assert out.returncode == 3, out.stderr
+    assert json.loads(out.stderr)["error"]["code"] == "external_reference"
