@@ -11,6 +11,8 @@ refines with it and the principal stage orders its output.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 from numpy.typing import NDArray
 
@@ -50,12 +52,14 @@ def _off_diagonal_negligible(a: NDArray[np.float64], rel: float) -> bool:
 
 
 def _rotate(a: NDArray[np.float64], v: NDArray[np.float64], p: int, q: int) -> None:
-    apq = a[p, q]
+    apq = float(a[p, q])
     if apq == 0.0:
         return
-    theta = (a[q, q] - a[p, p]) / (2.0 * apq)
-    t = np.copysign(1.0, theta) / (abs(theta) + np.sqrt(theta * theta + 1.0))
-    c = 1.0 / np.sqrt(t * t + 1.0)
+    # Python floats, the same IEEE arithmetic as numpy's scalars: where a[p, q] is negligible theta * theta
+    # overflows and t goes to 0 as it should, without numpy's overflow warning
+    theta = (float(a[q, q]) - float(a[p, p])) / (2.0 * apq)
+    t = math.copysign(1.0, theta) / (abs(theta) + math.sqrt(theta * theta + 1.0))
+    c = 1.0 / math.sqrt(t * t + 1.0)
     s = t * c
     rot = np.eye(3)
     rot[p, p] = c
