@@ -51,6 +51,7 @@ from __future__ import annotations
 
 import math
 import warnings
+from collections.abc import Callable
 from typing import Any, cast
 
 import numpy as np
@@ -143,7 +144,7 @@ def _analyze(client: Any, atoms: Atoms) -> dict[str, Any]:
 
 # name: (builder, published geometry, last place of each geometry digit, published constants [cm^-1],
 #        last place of the constants, rotor kind, shape); source and reference at the top of the file
-PAIRED = {
+PAIRED: dict[str, tuple[Callable[..., Atoms], list[float], list[float], list[float], float, str, str | None]] = {
     # CCCBDB expgeom2x.asp?casno=124389: rCO 1.162 A and B 0.39021 cm^-1, both Herzberg 1966
     "carbon dioxide": (carbon_dioxide, [1.162], [0.001], [0.39021], 0.00001, "linear_rotator", None),
     # CCCBDB expgeom2x.asp?casno=71432: rCC 1.397, rCH 1.084 A; A B C 0.18960 0.18960 0.09480; Herzberg 1966
