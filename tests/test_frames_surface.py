@@ -177,7 +177,10 @@ def test_any_rotation_of_points_seen_in_its_frame_is_invariant() -> None:
 
     import inertia
 
-    coords = st.lists(st.tuples(*(st.floats(-5, 5, allow_nan=False),) * 3), min_size=3, max_size=6)
+    # Coordinates of at least 1e-100 m (or exactly 0): a point set spanning less than ~1e-146 m has moments
+    # below float64's normal range, where they underflow; that regime is outside what this invariant checks.
+    coordinate = st.floats(-5, 5, allow_nan=False).filter(lambda v: v == 0.0 or abs(v) >= 1e-100)
+    coords = st.lists(st.tuples(coordinate, coordinate, coordinate), min_size=3, max_size=6)
 
     @settings(max_examples=40, deadline=None)
     @given(q=_unit_quaternions(), positions=coords)
