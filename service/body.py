@@ -168,8 +168,24 @@ class PointBody:
             raise InvalidParameterError(
                 f"masses must be positive; {int(np.count_nonzero(m <= 0))} are zero or negative", field="mass"
             )
+        _check_span(m, x, self.length_scale)
         object.__setattr__(self, "masses", m)
         object.__setattr__(self, "positions", x)
+
+
+# Moments of a point set are ~ mass x span^2 [kg m^2]; below float64's smallest normal number over eps they
+# lose digits to underflow (subnormals, then 0), so no number with the promised precision can come back.
+_MIN_MOMENT_SCALE = float(np.finfo(np.float64).tiny) / float(np.finfo(np.float64).eps)
+
+
+def _check_span(masses: NDArray[np.float64], positions: NDArray[np.float64], length_scale: float) -> None:
+    """Refuse a point set so small that its moments underflow float64 (a single point is fine: its moments are 0)."""
+    span = float(np.max(positions.max(axis=0) - positions.min(axis=0))) * length_scale
+    if span > 0.0 and float(masses.sum()) * span * span < _MIN_MOMENT_SCALE:
+        raise InvalidParameterError(
+            f"the points span only {span:.3g} m, so their moments (~ mass x span^2) would underflow float64; "
+            "give the positions in a smaller length unit (units) or scale them up", field="position"
+        )
 
 
 Body = MeshBody | VolumeBody | PointBody

@@ -200,3 +200,22 @@ def test_any_rotation_of_points_seen_in_its_frame_is_invariant() -> None:
         np.testing.assert_allclose(frame["center_of_mass"], base["center_of_mass"], rtol=0, atol=1e-12 * 5)
 
     check()
+
+
+def test_points_whose_moments_would_underflow_are_refused() -> None:
+    """A set spanning 1e-170 m has moments ~1e-340 kg m^2, below float64's normal range: refused, never 0."""
+    import inertia
+    from inertia.errors import InvalidParameterError
+
+    tiny: list[dict[str, Any]] = [
+        {"mass": 1.0, "position": [0, 0, 0]},
+        {"mass": 2.0, "position": [1e-170, 0, 0]},
+        {"mass": 3.0, "position": [0, 1e-170, 0]},
+    ]
+    with pytest.raises(InvalidParameterError, match="underflow"):
+        inertia.analyze_points(tiny)
+    small = [{**p, "position": [c * 1e70 for c in p["position"]]} for p in tiny]  # spans 1e-100 m: fine
+    moments = inertia.analyze_points(small).frame.moments
+    assert float(moments[2]) > 0.0
+    single = inertia.analyze_points([{"mass": 1.0, "position": [1e-170, 0, 0]}])
+    assert list(single.frame.moments) == [0.0, 0.0, 0.0]
