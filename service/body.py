@@ -184,7 +184,8 @@ def _check_span(masses: NDArray[np.float64], positions: NDArray[np.float64], len
     if span > 0.0 and float(masses.sum()) * span * span < _MIN_MOMENT_SCALE:
         raise InvalidParameterError(
             f"the points span only {span:.3g} m, so their moments (~ mass x span^2) would underflow float64; "
-            "give the positions in a smaller length unit (units) or scale them up", field="position"
+            "give the positions in a smaller length unit (units) or scale them up",
+            field="position",
         )
 
 
