@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 
 import inertia
-from benchmarks.cases import stl_bytes
+from benchmarks.cases import box, stl_bytes
 from inertia import AnalysisOptions, analyze
 from inertia.errors import InvalidParameterError
 
@@ -26,24 +26,7 @@ SAMPLES = ROOT / "sample_meshes"
 
 def cube(side: float, offset: tuple[float, float, float] = (0.0, 0.0, 0.0)) -> tuple[np.ndarray, np.ndarray]:
     """An axis-aligned cube as (vertices, faces), outward winding."""
-    v = np.array([[x, y, z] for x in (0, side) for y in (0, side) for z in (0, side)], dtype=float) + offset
-    f = np.array(
-        [
-            [0, 1, 3],
-            [0, 3, 2],
-            [4, 6, 7],
-            [4, 7, 5],
-            [0, 4, 5],
-            [0, 5, 1],
-            [2, 3, 7],
-            [2, 7, 6],
-            [0, 2, 6],
-            [0, 6, 4],
-            [1, 5, 7],
-            [1, 7, 3],
-        ]
-    )
-    return v, f
+    return box(side, side, side, offset)
 
 
 def obj_two_boxes() -> bytes:
