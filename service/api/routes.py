@@ -91,7 +91,7 @@ async def formats() -> FormatsOut:
     kinds = [(f, "surface") for f in surface] + [(f, "volume") for f in volume] + [(f, "points") for f in points]
     kinds += [(f, "cad") for f in cad]
     table = [
-        FormatOut(format=f, kind=k, parts=f in SCENE_FORMATS)  # type: ignore[arg-type]
+        FormatOut(format=f, kind=k, parts=f in SCENE_FORMATS)
         for f, k in kinds
     ]
     return FormatsOut(

@@ -145,18 +145,18 @@ LIMITED = [
         T.PayloadTooLargeError,
         "payload_too_large",
         413,
-        Settings(max_upload_bytes=1000, compute_processes=1),  # type: ignore[call-arg]  # fields come from INERTIA_* variables
+        Settings(max_upload_bytes=1000, compute_processes=1),
         mesh(box_stl(1, 2, 3) * 10),
     ),
-    (T.UnauthorizedError, "unauthorized", 401, Settings(api_key="s3cret", compute_processes=1), mesh(BOX)),  # type: ignore[call-arg]  # fields come from INERTIA_* variables
+    (T.UnauthorizedError, "unauthorized", 401, Settings(api_key="s3cret", compute_processes=1), mesh(BOX)),
     (
         T.ComputeTimeoutError,
         "timeout",
         503,
-        Settings(timeout_s=0.05, compute_processes=1),  # type: ignore[call-arg]  # fields come from INERTIA_* variables
+        Settings(timeout_s=0.05, compute_processes=1),
         mesh(torus_stl(500, 500)),
     ),
-    (E.ServerBusyError, "server_busy", 503, Settings(max_waiting=0, compute_processes=1), busy),  # type: ignore[call-arg]  # fields come from INERTIA_* variables
+    (E.ServerBusyError, "server_busy", 503, Settings(max_waiting=0, compute_processes=1), busy),
 ]
 
 
@@ -180,7 +180,7 @@ def test_unknown_path_and_method_use_the_envelope(client: TestClient) -> None:
 
 
 def test_unexpected_exception_is_500_envelope_with_logged_traceback(caplog: LogCaptureFixture) -> None:
-    app = create_app(Settings(compute_processes=1))  # type: ignore[call-arg]  # fields come from INERTIA_* variables
+    app = create_app(Settings(compute_processes=1))
 
     @app.get("/boom")
     async def boom() -> None:

@@ -21,7 +21,7 @@ from inertia.api import Settings, create_app
 
 with warnings.catch_warnings():
     warnings.filterwarnings("ignore", message="Using `httpx` with `starlette.testclient`")
-    app = create_app(Settings(compute_processes=2, timeout_s=20))  # type: ignore[call-arg]  # fields come from INERTIA_* variables
+    app = create_app(Settings(compute_processes=2, timeout_s=20))
 
 CHECKS = [
     checks.not_a_server_error,

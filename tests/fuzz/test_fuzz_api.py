@@ -220,7 +220,7 @@ def app_client() -> Iterator[TestClient]:
         create_app(
             Settings(
                 compute_processes=1,
-                timeout_s=TIMEOUT_S,  # type: ignore[call-arg]  # fields come from INERTIA_* variables
+                timeout_s=TIMEOUT_S,
                 max_upload_bytes=MAX_UPLOAD,
             )
         )
