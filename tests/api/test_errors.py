@@ -9,7 +9,7 @@ from __future__ import annotations
 import logging
 import warnings
 from collections.abc import Callable
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
 import pytest
@@ -115,11 +115,13 @@ def assert_envelope(response: Any, code: str, status: int) -> dict[str, Any]:
     assert body["error"]["code"] == code
     assert isinstance(body["error"]["message"], str) and len(body["error"]["message"]) > 10
     assert isinstance(body["error"]["details"], dict)
-    return body["error"]  # type: ignore[no-any-return]
+    return cast("dict[str, Any]", body["error"])
 
 
 @pytest.mark.parametrize(("cls", "code", "status", "request_"), CASES, ids=[f"{c[1]}-{i}" for i, c in enumerate(CASES)])
-def test_bad_request_gets_its_code_and_status(client: TestClient, cls, code: str, status: int, request_: Any) -> None:  # type: ignore[no-untyped-def]
+def test_bad_request_gets_its_code_and_status(
+    client: TestClient, cls: type[E.ServiceError], code: str, status: int, request_: Any
+) -> None:
     assert cls.code == code and STATUS[next(k for k in type.mro(cls) if k in STATUS)] == status
     assert_envelope(request_(client), code, status)
 
@@ -161,9 +163,11 @@ LIMITED = [
 
 
 @pytest.mark.parametrize(("cls", "code", "status", "settings", "request_"), LIMITED, ids=[c[1] for c in LIMITED])
-def test_limits_get_their_code_and_status(cls, code: str, status: int, settings: dict[str, str], request_: Any) -> None:  # type: ignore[no-untyped-def]
+def test_limits_get_their_code_and_status(
+    cls: type[E.ServiceError], code: str, status: int, settings: Settings, request_: Any
+) -> None:
     assert cls.code == code
-    with TestClient(create_app(settings)) as c:  # type: ignore[arg-type]
+    with TestClient(create_app(settings)) as c:
         assert_envelope(request_(c), code, status)
 
 
