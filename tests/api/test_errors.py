@@ -156,7 +156,7 @@ LIMITED = [
         Settings(timeout_s=0.05, compute_processes=1),  # type: ignore[call-arg]  # fields come from INERTIA_* variables
         mesh(torus_stl(500, 500)),
     ),
-    (E.ServerBusyError, "server_busy", 503, Settings(max_waiting=0, compute_processes=1), busy),  # type: ignore[call-arg]  # fields come from INERTIA_* variables
+    (T.ServerBusyError, "server_busy", 503, Settings(max_waiting=0, compute_processes=1), busy),  # type: ignore[call-arg]  # fields come from INERTIA_* variables
 ]
 
 
