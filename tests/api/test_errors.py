@@ -158,7 +158,7 @@ LIMITED = [
         Settings(timeout_s=0.05, compute_processes=1),
         mesh(torus_stl(500, 500)),
     ),
-    (E.ServerBusyError, "server_busy", 503, Settings(max_waiting=0, compute_processes=1), busy),
+    (T.ServerBusyError, "server_busy", 503, Settings(max_waiting=0, compute_processes=1), busy),
 ]
 
 
