@@ -3,6 +3,7 @@
 Every benchmark under ``benchmarks/`` measures with these and writes its document through them,
 so that each one states the same things the same way:
 
+- ``Stopwatch()``: wall and CPU seconds since it was started (for a stretch of code);
 - ``timed(call)``: wall and CPU seconds of an in-process call (``time.perf_counter`` and
   ``time.process_time``), and this process's peak resident set after it;
 - ``best_of(call, repeat, budget_s)``: the least disturbed of several runs (timeit's rule: the
@@ -44,6 +45,7 @@ __all__ = [
     "SAMPLE_S",
     "START",
     "END",
+    "Stopwatch",
     "Timing",
     "timed",
     "best_of",
@@ -84,6 +86,21 @@ class Timing:
     peak_rss_bytes: int
 
 
+class Stopwatch:
+    """Wall seconds (``time.perf_counter``) and CPU seconds of this process (``time.process_time``) since creation."""
+
+    def __init__(self) -> None:
+        self._wall0, self._cpu0 = time.perf_counter(), time.process_time()
+
+    @property
+    def wall_s(self) -> float:
+        return time.perf_counter() - self._wall0
+
+    @property
+    def cpu_s(self) -> float:
+        return time.process_time() - self._cpu0
+
+
 def peak_rss_bytes() -> int:
     """This process's peak resident set so far (``ru_maxrss``, KiB on Linux)."""
     return int(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss) * 1024
@@ -91,9 +108,9 @@ def peak_rss_bytes() -> int:
 
 def timed(call: Callable[[], T]) -> tuple[T, Timing]:
     """``call()`` and its wall time, CPU time (this process, all threads) and the peak RSS after it."""
-    wall0, cpu0 = time.perf_counter(), time.process_time()
+    clock = Stopwatch()
     out = call()
-    wall, cpu = time.perf_counter() - wall0, time.process_time() - cpu0
+    wall, cpu = clock.wall_s, clock.cpu_s
     return out, Timing(wall, cpu, peak_rss_bytes())
 
 
@@ -252,7 +269,7 @@ def run_process(
     log = TreeLog()
     if extra_roots:
         log.sample(extra_roots)
-    t0 = time.perf_counter()
+    clock = Stopwatch()
     proc = subprocess.Popen(
         list(args), cwd=cwd, env=None if env is None else dict(env), stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True
     )
@@ -263,7 +280,7 @@ def run_process(
             proc.kill()
             out, err = proc.communicate()
             raise RuntimeError(f"`{command_line(args)}` ran past {timeout_s} s:\n{err[-3000:]}") from None
-    wall = time.perf_counter() - t0
+    wall = clock.wall_s
     if check and proc.returncode != 0:
         raise RuntimeError(f"`{command_line(args)}` failed (exit {proc.returncode}):\n{err[-3000:]}")
     return ProcessRun(tuple(args), proc.pid, proc.returncode, wall, log.cpu(), out, err, log)
