@@ -15,6 +15,8 @@ so that each one states the same things the same way:
 - ``interleaved(contenders, rounds)``: rounds in which every contender runs once, their order
   rotated from round to round, and the best run of each kept: robust to a machine that is
   busy with other work for part of the time;
+- ``Server``: a real ``python -m inertia serve`` process on a free loopback port, ready when
+  ``/healthz`` answers (the tests' live servers are built on it);
 - ``available_cores()`` and ``machine()``: what the run had to work with;
 - ``Report``: a markdown document with a title, a header line that names the command that
   regenerates it and the machine, and ``write`` (the whole file, or only the section between
@@ -31,14 +33,18 @@ import os
 import platform
 import resource
 import shlex
+import socket
 import subprocess
 import sys
 import threading
 import time
+import urllib.error
+import urllib.request
 from collections.abc import Callable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Generic, TypeVar
+from types import TracebackType
+from typing import IO, Generic, TypeVar
 
 __all__ = [
     "ROOT",
@@ -56,6 +62,8 @@ __all__ = [
     "run_process",
     "Best",
     "interleaved",
+    "free_port",
+    "Server",
     "peak_rss_bytes",
     "available_cores",
     "load_average",
@@ -319,6 +327,100 @@ def interleaved(
         if after_round is not None:
             after_round(r, got)
     return out
+
+
+# ---------------------------------------------------------------------------
+# a live server
+
+
+def free_port(host: str = "127.0.0.1") -> int:
+    """A port nobody listens on right now."""
+    with socket.socket() as s:
+        s.bind((host, 0))
+        return int(s.getsockname()[1])
+
+
+def serve_command(host: str, port: int) -> list[str]:
+    """``python -m inertia serve`` on ``host:port``."""
+    return [sys.executable, "-m", "inertia", "serve", "--host", host, "--port", str(port)]
+
+
+class Server:
+    """A server process on a free loopback port, with the given ``INERTIA_*`` environment (the
+    caller's own ``INERTIA_*`` variables are dropped), ready once ``/healthz`` answers 200.
+
+    Its output goes to ``log_dir/<log_name>-<port>.log`` (read back by :meth:`output`), or nowhere
+    without ``log_dir``. ``command(host, port)`` gives its command line (``python -m inertia serve``
+    by default). A server that does not come up leaves no process or open file behind.
+    """
+
+    def __init__(
+        self,
+        env: Mapping[str, str] | None = None,
+        *,
+        startup_s: float = 30.0,
+        log_dir: Path | None = None,
+        log_name: str = "serve",
+        command: Callable[[str, int], list[str]] = serve_command,
+        host: str = "127.0.0.1",
+    ) -> None:
+        self.port = free_port(host)
+        self.url = f"http://{host}:{self.port}"
+        full_env = {k: v for k, v in os.environ.items() if not k.startswith("INERTIA_")}
+        full_env.update(env or {})
+        self.log: IO[bytes] | None = None
+        if log_dir is not None:
+            log_dir.mkdir(parents=True, exist_ok=True)
+            self.log = open(log_dir / f"{log_name}-{self.port}.log", "w+b")  # noqa: SIM115  (open until stop())
+        self.process = subprocess.Popen(
+            command(host, self.port),
+            cwd=ROOT,
+            env=full_env,
+            stdout=self.log if self.log is not None else subprocess.DEVNULL,
+            stderr=subprocess.STDOUT,
+        )
+        try:
+            self._wait_ready(startup_s)
+        except BaseException:
+            self.stop()
+            raise
+
+    def _wait_ready(self, startup_s: float) -> None:
+        deadline = time.monotonic() + startup_s
+        while time.monotonic() < deadline:
+            if self.process.poll() is not None:
+                raise RuntimeError(f"server exited: {self.output()}")
+            try:
+                with urllib.request.urlopen(f"{self.url}/healthz", timeout=1.0) as reply:
+                    if reply.status == 200:
+                        return
+            except (urllib.error.URLError, OSError):
+                time.sleep(0.1)
+        raise RuntimeError(f"server did not start in {startup_s} s: {self.output()}")
+
+    def output(self) -> str:
+        """What the server wrote so far (empty without a log)."""
+        if self.log is None:
+            return ""
+        self.log.flush()
+        self.log.seek(0)
+        return self.log.read().decode(errors="replace")
+
+    def stop(self) -> None:
+        self.process.terminate()
+        try:
+            self.process.wait(10)
+        except subprocess.TimeoutExpired:
+            self.process.kill()
+            self.process.wait()
+        if self.log is not None:
+            self.log.close()
+
+    def __enter__(self) -> Server:
+        return self
+
+    def __exit__(self, kind: type[BaseException] | None, exc: BaseException | None, tb: TracebackType | None) -> None:
+        self.stop()
 
 
 # ---------------------------------------------------------------------------
