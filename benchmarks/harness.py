@@ -40,7 +40,7 @@ import threading
 import time
 import urllib.error
 import urllib.request
-from collections.abc import Callable, Iterator, Mapping, Sequence
+from collections.abc import Callable, Hashable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from types import TracebackType
@@ -79,6 +79,7 @@ SAMPLE_S = 0.05  # process-tree sampling period
 START, END = "<!-- benchmark:start -->", "<!-- benchmark:end -->"
 
 T = TypeVar("T")
+K = TypeVar("K", bound=Hashable)
 
 
 # ---------------------------------------------------------------------------
@@ -299,26 +300,31 @@ def run_process(
 
 
 @dataclass
-class Best(Generic[T]):
+class Best(Generic[K, T]):
     """The best result of each contender over interleaved rounds, and every result of each."""
 
-    best: dict[str, T] = field(default_factory=dict)
-    runs: dict[str, list[T]] = field(default_factory=dict)
+    best: dict[K, T] = field(default_factory=dict)
+    runs: dict[K, list[T]] = field(default_factory=dict)
 
 
 def interleaved(
-    contenders: Sequence[tuple[str, Callable[[], T]]],
+    contenders: Sequence[tuple[K, Callable[[], T]]],
     rounds: int,
-    wall: Callable[[str, T], float],
-    after_round: Callable[[int, dict[str, T]], None] | None = None,
-) -> Best[T]:
-    """``rounds`` rounds, every contender once in each, the order rotated by one from round to round;
-    the best of each contender is the one with the least ``wall(name, result)``. ``after_round(r, got)``
+    wall: Callable[[K, T], float],
+    after_round: Callable[[int, dict[K, T]], None] | None = None,
+    before_round: Callable[[int], None] | None = None,
+    rotate: int = 1,
+) -> Best[K, T]:
+    """``rounds`` rounds, every contender once in each, the order rotated by ``rotate`` places from
+    round to round; the best of each contender is the one with the least ``wall(name, result)``.
+    ``before_round(r)`` runs first in each round (e.g. ``available_cores``), ``after_round(r, got)``
     sees each round's results (to print progress)."""
-    out: Best[T] = Best()
+    out: Best[K, T] = Best()
     for r in range(rounds):
-        k = r % len(contenders) if contenders else 0
-        got: dict[str, T] = {}
+        if before_round is not None:
+            before_round(r)
+        k = (r * rotate) % len(contenders) if contenders else 0
+        got: dict[K, T] = {}
         for name, run in [*contenders[k:], *contenders[:k]]:
             got[name] = run()
             out.runs.setdefault(name, []).append(got[name])
