@@ -185,7 +185,7 @@ def measure_processes(path: Path, triangles: int, repeat: int) -> dict[str, dict
 def stage_breakdown(path: Path, warmup: Path) -> dict[str, float]:
     """Seconds per stage of one in-process ``pipeline.analyze`` (after a warm-up run on a small file)."""
     import inertia.load.stl as stl
-    import inertia.mass as mass
+    import inertia.mass.geometry as mass_geometry
     import inertia.solid as solid
     from inertia import pipeline
 
@@ -210,7 +210,7 @@ def stage_breakdown(path: Path, warmup: Path) -> dict[str, float]:
         (stl, "read_stl_file", "read STL + float32 weld"),
         (solid, "surface_topology", "edge topology (watertight check)"),
         (solid, "_orient_outward", "outward orientation"),
-        (mass._Geometry, "sums", pass_name),
+        (mass_geometry.Geometry, "sums", pass_name),
     ]
     saved = [(obj, attr, getattr(obj, attr)) for obj, attr, _ in patches]
     try:

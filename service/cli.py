@@ -37,7 +37,7 @@ from .errors import (
     ServiceError,
 )
 from .tolerances import DEFAULT_TOLERANCES
-from .vocabulary import METHODS, MODELS, Model, MotionMethod
+from .vocabulary import METHODS, MODELS, ExportFormat, Geometry, Isotopes, Model, MotionMethod, values
 
 __all__ = ["main", "EXIT_CODES", "exit_code"]
 
@@ -107,7 +107,7 @@ def add_analysis_options(p: argparse.ArgumentParser) -> None:
     )
     p.add_argument("--densities", help="JSON file: part name -> density (kg/m^3) for files of several parts")
     p.add_argument(
-        "--geometry", choices=("brep", "mesh"), help="CAD files: integrate the exact B-rep (default) or a tessellation of it"
+        "--geometry", choices=values(Geometry), help="CAD files: integrate the exact B-rep (default) or a tessellation of it"
     )
     p.add_argument(
         "--deflection",
@@ -124,8 +124,8 @@ def add_analysis_options(p: argparse.ArgumentParser) -> None:
     )
     p.add_argument(
         "--isotopes",
-        choices=("standard", "abundant"),
-        default="standard",
+        choices=values(Isotopes),
+        default=Isotopes.STANDARD.value,
         help="atoms named by element (.xyz): standard atomic weights or the most abundant isotope",
     )
 
@@ -156,11 +156,11 @@ def options_from_args(args: argparse.Namespace) -> Any:
         samples=getattr(args, "samples", None),
         method=getattr(args, "method", MotionMethod.EXACT.value),
         densities=densities,
-        geometry=getattr(args, "geometry", None) or ("mesh" if getattr(args, "deflection", None) else "brep"),
+        geometry=getattr(args, "geometry", None) or (Geometry.MESH if getattr(args, "deflection", None) else Geometry.BREP),
         deflection=getattr(args, "deflection", None),
         export=getattr(args, "export", None),
         frame=getattr(args, "frame", None),
-        isotopes=getattr(args, "isotopes", "standard"),
+        isotopes=getattr(args, "isotopes", Isotopes.STANDARD),
     )
 
 
@@ -194,7 +194,7 @@ def _parser() -> argparse.ArgumentParser:
         help="units of the table: si (kg, m, kg m^2; default), kg-mm (kg mm^2), g-mm (g mm^2) or g-cm (g cm^2); --json stays SI",
     )
     a.add_argument(
-        "--export", choices=("urdf", "sdf", "mjcf"), help="print only the inertial element of a robot description format (SI units)"
+        "--export", choices=values(ExportFormat), help="print only the inertial element of a robot description format (SI units)"
     )
 
     b = sub.add_parser("batch", help="analyse many files, folders or .zip archives into JSONL/CSV/Parquet")

@@ -34,13 +34,30 @@ def jacobi_eigh(
     """
     a = np.array(matrix, dtype=np.float64)
     a = 0.5 * (a + a.T)
+    exponent = _safe_exponent(a)
+    if exponent:
+        a = np.ldexp(a, -exponent)
     v = np.eye(3)
     for _ in range(tolerances.jacobi_max_sweeps):
         if _off_diagonal_negligible(a, tolerances.jacobi_rel):
             break
         for p, q in _PAIRS:
             _rotate(a, v, p, q)
-    return np.diag(a).copy(), v.T.copy()
+    return np.ldexp(np.diag(a), exponent), v.T.copy()
+
+
+# The negligibility test multiplies two diagonal entries: entries beyond 2**±480 would overflow to inf (every
+# off-diagonal then looks negligible and the matrix is returned unrotated) or underflow to 0.  Such a matrix is
+# scaled by a power of two, which is exact, and its eigenvalues scaled back; any other is left untouched.
+_EXPONENT_RANGE = 480
+
+
+def _safe_exponent(a: NDArray[np.float64]) -> int:
+    largest = float(np.max(np.abs(a)))
+    if largest == 0.0 or not math.isfinite(largest):
+        return 0
+    exponent = math.frexp(largest)[1]
+    return exponent if abs(exponent) > _EXPONENT_RANGE else 0
 
 
 def _off_diagonal_negligible(a: NDArray[np.float64], rel: float) -> bool:

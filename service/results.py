@@ -22,6 +22,7 @@ import numpy as np
 from .classification import Classification
 from .mass import InertiaTensor, MassProperties
 from .principal import PrincipalFrame
+from .vocabulary import SourceKind, UnitsFrom
 
 if TYPE_CHECKING:
     from .export import Snippet
@@ -59,9 +60,9 @@ class Source:
 
     filename: str | None = None
     format: str
-    kind: str
+    kind: SourceKind
     units: str
-    units_from: str
+    units_from: UnitsFrom
     vertices: int | None = None
     triangles: int | None = None
     watertight: bool | None = None
@@ -104,8 +105,10 @@ class Source:
     )
 
     def as_dict(self) -> dict[str, Any]:
-        order = self._CAD_ORDER if self.kind == "cad" else self._ORDER
-        return {key: getattr(self, key) for key in order if getattr(self, key) is not None}
+        order = self._CAD_ORDER if self.kind == SourceKind.CAD else self._ORDER
+        out = {key: getattr(self, key) for key in order if getattr(self, key) is not None}
+        out["kind"], out["units_from"] = self.kind.value, self.units_from.value  # plain strings in the JSON
+        return out
 
 
 # the JSON keys of the source section, for the response schema

@@ -12,16 +12,18 @@ Every error status is documented with the envelope and an example.
 
 from __future__ import annotations
 
+import enum
 import json
 import math
 from dataclasses import MISSING, fields
-from typing import Annotated, Any, Literal, get_type_hints
+from typing import TYPE_CHECKING, Annotated, Any, Literal, TypeAlias, get_type_hints
 
 from pydantic import BaseModel, ConfigDict, Field, create_model, model_validator
 
-from ..errors import InvalidParameterError
-from ..options import METHODS, AnalysisOptions
+from ..errors import InvalidParameterError, envelope
+from ..options import DEFAULT_OPTIONS, AnalysisOptions
 from ..results import Diagnostics, Source
+from ..vocabulary import ExportFormat, Geometry, Isotopes, MassUnit, Model, MotionMethod, values
 from .settings import MIN_SAMPLES, max_samples
 
 __all__ = [
@@ -40,8 +42,29 @@ __all__ = [
     "error_responses",
 ]
 
-Method = Literal["exact", "dop853", "rk45", "splitting"]
-assert set(METHODS) == set(Method.__args__)  # type: ignore[attr-defined]
+
+def _choice(members: type[enum.Enum]) -> Any:
+    """A closed set of ``vocabulary`` as ``Literal`` of its strings: the schema lists them inline, and a value
+    outside them is pydantic's ``literal_error`` naming them."""
+    return Literal[values(members)]
+
+
+def _default(name: str) -> Any:
+    """The default of an option, from ``AnalysisOptions`` (where every default lives), as the schema shows it."""
+    value = getattr(DEFAULT_OPTIONS, name)
+    return value.value if isinstance(value, enum.Enum) else value
+
+
+if TYPE_CHECKING:  # the request models hold the strings; AnalysisOptions validates them into the enums
+    Method: TypeAlias = str
+    ModelName: TypeAlias = str
+    GeometryName: TypeAlias = str
+    IsotopesName: TypeAlias = str
+    MassUnitName: TypeAlias = str
+    ExportName: TypeAlias = str
+else:
+    Method, ModelName, GeometryName = _choice(MotionMethod), _choice(Model), _choice(Geometry)
+    IsotopesName, MassUnitName, ExportName = _choice(Isotopes), _choice(MassUnit), _choice(ExportFormat)
 
 # the most trajectory samples one HTTP response carries (INERTIA_MAX_SAMPLES, default 10000: ~2.3 MB of
 # JSON and under a second of compute); longer ones belong to the CLI or the library
@@ -58,8 +81,6 @@ RealVector = Annotated[list[Real], Field(min_length=3, max_length=3)]
 RealTensor = Annotated[list[RealVector], Field(min_length=3, max_length=3)]
 Tensor = Annotated[list[Vector], Field(min_length=3, max_length=3)]
 Quaternion = Annotated[list[float], Field(min_length=4, max_length=4)]
-ExportFormat = Literal["urdf", "sdf", "mjcf"]
-Isotopes = Literal["standard", "abundant"]
 
 
 class _Request(BaseModel):
@@ -124,11 +145,11 @@ class MeshQuery(_Request):
     )
     density: float | None = Field(None, gt=0, le=MAX_MAGNITUDE, description="density [kg/m^3] (default 1000); exclusive with mass")
     mass: float | None = Field(None, gt=0, le=MAX_MAGNITUDE, description="total mass [kg]; the density is then derived")
-    model: Literal["solid", "shell"] = Field(
-        "solid", description="solid (closed surface or volume mesh) or shell (thin surface, needs thickness)"
+    model: ModelName = Field(
+        _default("model"), description="solid (closed surface or volume mesh) or shell (thin surface, needs thickness)"
     )
     thickness: float | None = Field(None, gt=0, le=MAX_MAGNITUDE, description="shell wall thickness [file units]")
-    tolerance: float = Field(1e-6, gt=0, lt=1, description="relative tolerance for equal principal moments")
+    tolerance: float = Field(_default("tolerance"), gt=0, lt=1, description="relative tolerance for equal principal moments")
     reference: str | None = Field(
         None, description="'x,y,z' point [file units]: also report the tensor about it", examples=["0,0,0"]
     )
@@ -137,10 +158,10 @@ class MeshQuery(_Request):
     )
     duration: float | None = Field(None, gt=0, le=MAX_MAGNITUDE, description="with omega: seconds to predict [s]")
     samples: int | None = Field(None, ge=MIN_SAMPLES, le=MAX_SAMPLES, description=f"with omega: {_SAMPLES}")
-    method: Method = Field("exact", description="with omega: exact, dop853, rk45 or splitting")
+    method: Method = Field(_default("method"), description="with omega: exact, dop853, rk45 or splitting")
     densities: str | None = Field(None, description="JSON object: part name -> density [kg/m^3]", examples=['{"bracket": 7850}'])
-    geometry: Literal["brep", "mesh"] = Field(
-        "brep", description="CAD files (STEP, IGES): integrate the exact B-rep (brep) or its tessellation (mesh)"
+    geometry: GeometryName = Field(
+        _default("geometry"), description="CAD files (STEP, IGES): integrate the exact B-rep (brep) or its tessellation (mesh)"
     )
     deflection: float | None = Field(
         None,
@@ -148,13 +169,15 @@ class MeshQuery(_Request):
         lt=1,
         description="with geometry=mesh: chordal deflection relative to the bounding-box diagonal [1] (default 1e-3)",
     )
-    export: ExportFormat | None = Field(None, description="urdf, sdf or mjcf: adds the format's inertial element")
+    export: ExportName | None = Field(None, description="urdf, sdf or mjcf: adds the format's inertial element")
     frame: str | None = Field(
         None,
         description="'w,x,y,z' unit quaternion carrying a named frame's axes into the input frame: adds the frame section",
         examples=["1,0,0,0"],
     )
-    isotopes: Isotopes = Field("standard", description="atoms of an XYZ file: standard atomic weights or the most abundant isotope")
+    isotopes: IsotopesName = Field(
+        _default("isotopes"), description="atoms of an XYZ file: standard atomic weights or the most abundant isotope"
+    )
 
     def as_options(self) -> AnalysisOptions:
         return AnalysisOptions(
@@ -196,7 +219,7 @@ class PointIn(_Request):
 _POINTS_EXAMPLE: dict[str, Any] = {
     "points": [{"mass": 1.0, "position": [0, 0, 0]}, {"mass": 2.0, "position": [1, 0, 0]}, {"mass": 1.0, "position": [0, 1, 0]}],
     "units": "m",
-    "tolerance": 1e-6,
+    "tolerance": _default("tolerance"),
     "reference": [0, 0, 0],
 }
 
@@ -208,20 +231,20 @@ class PointsRequest(_Request):
 
     points: list[PointIn] = Field(min_length=1, description="point masses")
     units: str | None = Field(None, description="length unit of the positions: m, cm, mm, um, in, ft, angstrom (default m)")
-    mass_unit: Literal["kg", "u"] = Field("kg", description="unit of given masses: kg, or u (dalton)")
-    isotopes: Isotopes = Field(
-        "standard", description="masses of points given by element: standard atomic weights or the most abundant isotope"
+    mass_unit: MassUnitName = Field(_default("mass_unit"), description="unit of given masses: kg, or u (dalton)")
+    isotopes: IsotopesName = Field(
+        _default("isotopes"), description="masses of points given by element: standard atomic weights or the most abundant isotope"
     )
-    export: ExportFormat | None = Field(None, description="urdf, sdf or mjcf: adds the format's inertial element")
+    export: ExportName | None = Field(None, description="urdf, sdf or mjcf: adds the format's inertial element")
     frame: Quaternion | None = Field(
         None, description="[w, x, y, z] unit quaternion carrying a named frame's axes into the input frame: adds the frame section"
     )
-    tolerance: float = Field(1e-6, gt=0, lt=1, description="relative tolerance for equal principal moments")
+    tolerance: float = Field(_default("tolerance"), gt=0, lt=1, description="relative tolerance for equal principal moments")
     reference: RealVector | None = Field(None, description="also report the tensor about this point [units]")
     omega: RealVector | None = Field(None, description="initial angular velocity [rad/s]: adds precession")
     duration: float | None = Field(None, gt=0, le=MAX_MAGNITUDE, description="with omega: seconds to predict [s]")
     samples: int | None = Field(None, ge=MIN_SAMPLES, le=MAX_SAMPLES, description=f"with omega: {_SAMPLES}")
-    method: Method = Field("exact", description="with omega: exact, dop853, rk45 or splitting")
+    method: Method = Field(_default("method"), description="with omega: exact, dop853, rk45 or splitting")
 
     def records(self) -> list[dict[str, Any]]:
         return [p.model_dump(exclude_none=True) for p in self.points]
@@ -259,10 +282,10 @@ class PrecessionRequest(_Request):
         None, description="principal moments [kg m^2]; the input frame is then the principal frame"
     )
     omega: RealVector = Field(description="initial angular velocity [rad/s], input frame")
-    tolerance: float = Field(1e-6, gt=0, lt=1, description="relative tolerance for equal principal moments")
+    tolerance: float = Field(_default("tolerance"), gt=0, lt=1, description="relative tolerance for equal principal moments")
     duration: float | None = Field(None, gt=0, le=MAX_MAGNITUDE, description="seconds to predict [s]")
     samples: int | None = Field(None, ge=MIN_SAMPLES, le=MAX_SAMPLES, description=_SAMPLES)
-    method: Method = Field("exact", description="exact, dop853, rk45 or splitting")
+    method: Method = Field(_default("method"), description="exact, dop853, rk45 or splitting")
 
     def arguments(self) -> dict[str, Any]:
         return self.model_dump()
@@ -283,7 +306,10 @@ def _from_dataclass(cls: type, name: str, doc: str) -> type[BaseModel]:
     spec: dict[str, Any] = {}
     for f in fields(cls):
         required = f.default is MISSING and f.default_factory is MISSING
-        spec[f.name] = (hints[f.name], ... if required else None)
+        hint = hints[f.name]
+        if isinstance(hint, type) and issubclass(hint, enum.Enum):  # a closed set: its strings, inline
+            hint = _choice(hint)
+        spec[f.name] = (hint, ... if required else None)
     model: type[BaseModel] = create_model(name, __base__=_Out, __doc__=doc, **spec)
     return model
 
@@ -380,7 +406,7 @@ class ExportPartOut(_Out):
 
 
 class ExportOut(_Out):
-    format: ExportFormat
+    format: ExportName
     text: str = Field(description="the format's inertial element, SI units, 17 significant digits")
     parts: list[ExportPartOut] | None = None
 
@@ -459,7 +485,7 @@ class FormatsOut(BaseModel):
 
 
 def _example(code: str, message: str, **details: Any) -> dict[str, Any]:
-    return {"error": {"code": code, "message": message, "details": details}}
+    return envelope(code, message, details)
 
 
 _ERRORS: dict[int, tuple[str, dict[str, dict[str, Any]]]] = {

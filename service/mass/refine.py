@@ -1,0 +1,262 @@
+"""The multi-pass refinement engine: a body's centre of mass, inertia tensor and principal axes, exactly.
+
+Closed triangle surfaces are integrated exactly with the divergence theorem
+as signed tetrahedra, volume meshes as their tetrahedra, shells as area
+triangles and point sets directly (the integrals are in ``integrals``;
+Mirtich 1996, Eberly 2002, Tonon 2004).
+
+Precision.  Coordinates are first shifted to a local origin taken from the
+body's own coordinates, so a part far from the file's origin loses nothing
+(the difference of two nearby floats is exact, Sterbenz's lemma).  A first
+pass gives the centre of mass and approximate principal axes; the body is
+then re-integrated in that principal frame about its centre of mass, where
+each diagonal entry is a sum of squares of coordinates of its own size, so
+even the smallest moment of a needle keeps its relative precision.  Passes
+repeat (at most ``MAX_PASSES``) until the frame no longer moves.  The tensor
+in the input frame is then R diag(I) R^T.
+
+The engine works in the file's length unit and the geometry's own measure
+(volume, area or point count, times the geometry's weights); what turns that
+into kilograms is the material rule's (``material``).  It also returns the
+honest error bound of the moments and refuses what is not a body.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ..eigen import jacobi_eigh
+from ..errors import InsufficientPrecisionError, ZeroVolumeError
+from ..integrals import Sums, local_origin, point_records
+from ..tolerances import EPS, Tolerances
+from .geometry import Geometry
+
+__all__ = ["FRAME_SETTLED", "MAX_PASSES", "Refined", "refine"]
+
+MAX_PASSES = 4  # one coarse pass plus refinements; the frame settles in 2-3
+FRAME_SETTLED = 1e-7  # off-diagonal / sqrt(diag product) below this: the next pass moves moments < 1e-14
+
+
+def _covariance(s: Sums) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Centre of mass (local) and int (x-c)(x-c)^T dm."""
+    c = s.m1 / s.m0
+    return c, s.m2 - s.m0 * np.outer(c, c)
+
+
+def _inertia_from_covariance(cov: NDArray[np.float64]) -> NDArray[np.float64]:
+    # I_ik = int (x_l^2 delta_ik - x_i x_k) dm   (Landau & Lifshitz eq. 32.2).
+    # The diagonal is summed as C_yy + C_zz, never trace(C) - C_xx: for a
+    # needle along x that difference would cancel all but a few digits.
+    tensor = -cov
+    for i in range(3):
+        j, k = (i + 1) % 3, (i + 2) % 3
+        tensor[i, i] = cov[j, j] + cov[k, k]
+    return tensor
+
+
+@dataclass(frozen=True, slots=True)
+class Refined:
+    """What the passes found, in the file's units and the geometry's measure.
+
+    sums : the final pass's integrals (principal frame, about the centre).
+    com : (3,) centre, input frame.  tensor : (3, 3) about it, input frame.
+    moments, axes : eigenvalues and axes (rows) from the final pass.
+    estimate : relative error bound of the moments.
+    """
+
+    sums: Sums
+    com: NDArray[np.float64]
+    tensor: NDArray[np.float64]
+    moments: NDArray[np.float64]
+    axes: NDArray[np.float64]
+    estimate: float
+    warnings: tuple[str, ...] = ()
+
+
+def refine(geometry: Geometry, tolerances: Tolerances) -> Refined:
+    """Multi-pass integration: a coarse pass, then passes in the principal frame until it settles."""
+    origin = local_origin(geometry.points)
+    s = geometry.sums(origin, None)
+    _check_volume(s, geometry.kind)
+    c, cov = _covariance(s)
+    values, vectors = jacobi_eigh(_inertia_from_covariance(cov), tolerances)
+    rotation = vectors.T  # columns: axes in the input frame
+    com = origin + c
+    previous = values
+    for _ in range(MAX_PASSES - 1):
+        s = geometry.sums(com, rotation)
+        c_body, cov_body = _covariance(s)
+        tensor_body = _inertia_from_covariance(cov_body)
+        values, v_body = jacobi_eigh(tensor_body, tolerances)
+        com = com + rotation @ c_body
+        settled = _offdiagonal_ratio(tensor_body) <= FRAME_SETTLED
+        top = float(np.abs(values).max())
+        step = float(np.max(np.abs(values - previous)) / top) if top > 0 else 0.0
+        rotation = rotation @ v_body.T
+        previous = values
+        if settled:
+            break
+    _check_volume(s, geometry.kind)
+    estimate, errors = _error_estimate(s, values)
+    if not settled:
+        estimate = max(estimate, step)
+    values, warnings = _physical_moments(geometry, values, errors)
+    if geometry.kind == "apex":
+        warnings += _check_resolution(geometry, s, com, rotation, values)
+    tensor = rotation @ np.diag(values) @ rotation.T
+    tensor = 0.5 * (tensor + tensor.T)
+    return Refined(s, com, tensor, values, rotation.T.copy(), estimate, warnings)
+
+
+def _physical_moments(
+    geometry: Geometry, values: NDArray[np.float64], errors: NDArray[np.float64]
+) -> tuple[NDArray[np.float64], tuple[str, ...]]:
+    """No zero or negative moment of a solid, and no negative moment at all, comes back.
+
+    Points on one line have a smallest moment that is zero up to rounding: it is
+    reported as 0 (a linear rotator), with a warning.  A solid or a surface
+    always has three positive moments (I1 + I2 >= I3 too); a stored polyhedron
+    whose integration gives a moment within its rounding of zero, or below,
+    is not a body (its faces cross or its shells are degenerate) and is refused.
+    """
+    low = values <= errors
+    if geometry.kind == "points":
+        # the second pass's rotation leaves a line's points off it by ~eps of their spread: a smallest
+        # moment below 64 eps of the largest (the motion's rounding level) is that, not a size
+        low |= values <= 64 * EPS * float(np.max(values))
+        if not np.any(low):
+            return values, ()
+        if bool(np.all(low)):  # a single point, or all the mass at one place: every moment is zero
+            return np.zeros(3), () if not np.any(values) else (
+                "all principal moments are zero within rounding (the mass is at one point) and are reported as 0",
+            )
+        return np.where(low, 0.0, values), (
+            "the smallest principal moment is zero within rounding (the points lie on a line) and is reported as 0",
+        )
+    order = np.sort(values)
+    slack = float(errors.sum())
+    if np.any(low) or order[0] + order[1] < order[2] - slack:
+        raise InsufficientPrecisionError(
+            "the stored polyhedron integrates to principal moments no body has (zero, negative, or "
+            f"I1 + I2 < I3: {', '.join(f'{x:.6g}' for x in order)} in the file's units): its faces cross "
+            "or its shells are degenerate; repair the mesh or export it nearer the origin in float64",
+            moments=[float(x) for x in order],
+        )
+    return values, ()
+
+
+_RESOLUTION_REFUSE = 1.0
+"""Refuse a surface whose volume or a moment could change by this fraction of itself when every
+stored coordinate moves by its resolution: the file does not determine the body."""
+_RESOLUTION_WARN = 1e-3
+"""Warn (naming the resolution) above this fraction: the stored polyhedron is computed exactly,
+but it may differ that much from the part it was exported from."""
+
+
+def _check_resolution(
+    geometry: Geometry, s: Sums, com: NDArray[np.float64], rotation: NDArray[np.float64], values: NDArray[np.float64]
+) -> tuple[str, ...]:
+    """Refuse a closed surface its stored coordinates cannot represent; warn when they barely do.
+
+    Each stored coordinate x is the exporter's value to within delta = u |x|max
+    (u: the storage's unit roundoff, 2**-24 for float32).  Moving every surface
+    point by up to sqrt(3) delta changes the volume by at most sqrt(3) delta A
+    (A the surface area) and moment k by at most that volume times the largest
+    squared distance of the surface from axis k.  When either change reaches
+    the quantity itself, the numbers describe the rounding, not a part.
+    """
+    x = geometry.points
+    delta = geometry.coordinate_eps * float(np.abs(x).max())
+    y = x - com
+    records = point_records(y)  # one gather of 24 bytes per corner, not numpy's slower 2-D fancy indexing
+    area = 0.0
+    for start in range(0, len(geometry.cells), 1 << 16):
+        tri = records.take(geometry.cells[start : start + (1 << 16)]).view(np.float64).reshape(-1, 3, 3)
+        area += 0.5 * float(np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]), axis=1).sum())
+    weight = 1.0 if geometry.weight is None else float(np.max(geometry.weight))
+    moved = math.sqrt(3.0) * delta * area  # volume the resolution can move
+    volume = abs(s.measure)
+    along = y @ rotation  # principal-frame coordinates (columns of rotation are the axes)
+    sq = along * along
+    reach = np.array([float(np.max(sq.sum(axis=1) - sq[:, k])) for k in range(3)])
+    ratio_v = moved / volume if volume > 0 else math.inf
+    ratio_i = float(np.max(moved * weight * reach / values))
+    ratio = max(ratio_v, ratio_i)
+    if not ratio >= _RESOLUTION_WARN:
+        return ()
+    float32 = geometry.coordinate_eps >= 2.0**-24
+    cause = (
+        f"the file's float32 coordinates, {float(np.abs(x).max()):.3g} units from the origin, are resolved "
+        f"only to {delta:.3g} units"
+        if float32
+        else f"its coordinates are resolved only to {delta:.3g} units (degenerate shells, or a body thinner "
+        "than the rounding of its coordinates)"
+    )
+    if ratio >= _RESOLUTION_REFUSE:
+        raise InsufficientPrecisionError(
+            f"the stored coordinates cannot represent this body: {cause}, which can change its volume or a "
+            f"principal moment by {ratio:.3g} times its own value; "
+            + (
+                "export it in float64 (e.g. OBJ, or ASCII STL with 9 digits) or nearer the origin"
+                if float32
+                else "repair the degenerate shells or export the part nearer the origin"
+            ),
+            resolution=delta,
+            ratio=min(ratio, 1e300),
+        )
+    return (
+        f"{cause}: the stored polyhedron is integrated exactly, but it may differ from the exported part by up "
+        f"to {ratio:.2g} of its volume or a principal moment; export in float64 or nearer the origin to avoid it",
+    )
+
+
+_TINY = float(np.finfo(np.float64).tiny)
+
+
+def _offdiagonal_ratio(t: NDArray[np.float64]) -> float:
+    worst = 0.0
+    for i, j in ((0, 1), (0, 2), (1, 2)):
+        product = abs(float(t[i, i]) * float(t[j, j]))  # Python floats: an overflow is inf, without a warning
+        if math.isfinite(product) and product >= _TINY:
+            scale = math.sqrt(product)
+        else:  # beyond ~1e154 or below ~1e-154 the product leaves float64's range; the root of each does not
+            scale = math.sqrt(abs(float(t[i, i]))) * math.sqrt(abs(float(t[j, j])))
+        if t[i, j] != 0.0:
+            worst = max(worst, abs(t[i, j]) / scale if scale > 0 else math.inf)
+    return worst
+
+
+def _error_estimate(s: Sums, moments: NDArray[np.float64]) -> tuple[float, NDArray[np.float64]]:
+    """Relative rounding-error bound of each principal moment, the worst one, and each one's absolute bound.
+
+    A moment within its absolute bound of zero is left out of the relative
+    estimate (``_physical_moments`` reports it as 0, or refuses the body).
+
+    In the final pass (principal frame, about the centre of mass) the
+    coordinates are exact to their last bit, so the error comes from each
+    element's own arithmetic (a few eps times its determinant's condition,
+    ``element_err``) and from the summation, pairwise within and across
+    blocks, bounded by gamma * sum |terms| with gamma growing as the depth of
+    the two trees (Higham, Accuracy and Stability of Numerical Algorithms, §4.2).
+    """
+    per_block = max(2, math.ceil(s.terms / max(s.blocks, 1)))
+    gamma = (math.log2(per_block) + math.log2(max(s.blocks, 1)) + 4) * EPS
+    diag_err = gamma * np.diag(s.abs_m2) + 8 * EPS * s.element_err
+    errors = np.array([sum(diag_err[j] for j in range(3) if j != k) for k in range(3)], dtype=np.float64)
+    live = moments > errors
+    worst = float(np.max(errors[live] / moments[live])) if np.any(live) else 1.0
+    return max(worst, 4 * EPS), errors
+
+
+def _check_volume(s: Sums, kind: str) -> None:
+    if kind in ("apex", "tet") and abs(s.m0) <= 64 * EPS * s.noise:
+        raise ZeroVolumeError(
+            "the mesh encloses no volume (it is flat or degenerate); send a solid or use model=shell with a thickness",
+            volume=s.m0,
+        )
+    if kind == "tri" and s.m0 <= 0:
+        raise ZeroVolumeError("the surface has zero area; send a mesh with non-degenerate triangles")
