@@ -171,7 +171,7 @@ def options_from_args(args: argparse.Namespace) -> Any:
 
 def _parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="inertia", description="Mass properties and free rotation of rigid bodies.")
-    parser.add_argument("--version", action="version", version=f"%(prog)s {_package_version()}")
+    parser.add_argument("--version", action=_VersionAction, nargs=0, help="show program's version number and exit")
     sub = parser.add_subparsers(dest="command", required=True)
 
     a = sub.add_parser("analyze", help="analyse one mesh or points file (.json/.csv/.xyz)")
@@ -239,6 +239,16 @@ def _package_version() -> str:
     from . import __version__
 
     return str(__version__)
+
+
+class _VersionAction(argparse.Action):
+    """``--version``, reading the distribution's metadata only when asked (importlib.metadata costs ~30 ms)."""
+
+    def __call__(
+        self, parser: argparse.ArgumentParser, namespace: argparse.Namespace, values: Any, option_string: str | None = None
+    ) -> None:
+        print(f"{parser.prog} {_package_version()}")
+        parser.exit()
 
 
 def joined_negative_values(argv: Sequence[str]) -> list[str]:
