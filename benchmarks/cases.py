@@ -6,12 +6,29 @@ The tests import these (``benchmarks.cases``); nothing here imports the tests.
 from __future__ import annotations
 
 import struct
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
-__all__ = ["BOX_FACES", "box", "prism", "icosahedron", "l_bracket", "triangles_stl_bytes", "stl_bytes", "write_stl", "write_obj"]
+__all__ = [
+    "BOX_FACES",
+    "box",
+    "centred_box",
+    "prism",
+    "icosahedron",
+    "l_bracket",
+    "uv_sphere",
+    "torus",
+    "flat_shells",
+    "triangles_stl_bytes",
+    "stl_bytes",
+    "obj_bytes",
+    "write_stl",
+    "write_obj",
+]
 
 BOX_FACES = np.array(
     [
@@ -39,7 +56,13 @@ def box(a: float, b: float, c: float, origin: Any = (0.0, 0.0, 0.0)) -> tuple[np
     return v, BOX_FACES.copy()
 
 
-def prism(n: int, radius: float, height: float) -> tuple[np.ndarray, np.ndarray]:
+def centred_box(a: float, b: float, c: float) -> tuple[np.ndarray, np.ndarray]:
+    """``box`` with its centre at the origin."""
+    return box(a, b, c, origin=-np.array([a, b, c]) / 2)
+
+
+def prism(n: int, radius: float, height: float, centred: bool = False) -> tuple[np.ndarray, np.ndarray]:
+    """Regular n-gon prism (a tessellated cylinder) about z, from z = 0 to ``height`` or centred on the origin."""
     ang = 2 * np.pi * np.arange(n) / n
     ring = np.stack([radius * np.cos(ang), radius * np.sin(ang)], axis=1)
     v = np.vstack([np.c_[ring, np.zeros(n)], np.c_[ring, np.full(n, height)], [[0, 0, 0], [0, 0, height]]])
@@ -47,6 +70,8 @@ def prism(n: int, radius: float, height: float) -> tuple[np.ndarray, np.ndarray]
     for i in range(n):
         j = (i + 1) % n
         faces += [[i, j, n + j], [i, n + j, n + i], [2 * n, j, i], [2 * n + 1, n + i, n + j]]
+    if centred:
+        v = v - np.array([0.0, 0.0, height / 2])
     return v, np.array(faces)
 
 
@@ -86,6 +111,59 @@ def l_bracket(depth: float) -> tuple[np.ndarray, np.ndarray]:
     return v, np.array(faces)
 
 
+def uv_sphere(n_lat: int, n_lon: int, radius: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
+    """Latitude-longitude sphere: 2 n_lon (n_lat - 1) outward triangles, single-vertex poles."""
+    theta = np.pi * np.arange(1, n_lat) / n_lat
+    phi = 2 * np.pi * np.arange(n_lon) / n_lon
+    ring = np.stack(
+        [
+            np.outer(np.sin(theta), np.cos(phi)),
+            np.outer(np.sin(theta), np.sin(phi)),
+            np.repeat(np.cos(theta)[:, None], n_lon, axis=1),
+        ],
+        axis=-1,
+    ).reshape(-1, 3)
+    v = radius * np.vstack([[0.0, 0.0, 1.0], ring, [0.0, 0.0, -1.0]])
+    south = len(v) - 1
+    idx = 1 + np.arange((n_lat - 1) * n_lon).reshape(n_lat - 1, n_lon)
+    nxt = np.roll(idx, -1, axis=1)
+    top = np.stack([np.zeros(n_lon, dtype=np.int64), idx[0], nxt[0]], axis=1)
+    bottom = np.stack([np.full(n_lon, south), nxt[-1], idx[-1]], axis=1)
+    a, b, c, d = idx[:-1], nxt[:-1], idx[1:], nxt[1:]
+    quads = np.concatenate([np.stack([a, c, d], -1).reshape(-1, 3), np.stack([a, d, b], -1).reshape(-1, 3)])
+    return v, np.vstack([top, quads, bottom]).astype(np.int64)
+
+
+def torus(n_major: int, n_minor: int, major: float = 1.0, minor: float = 0.4) -> tuple[np.ndarray, np.ndarray]:
+    """Torus about z, vertices on the exact surface: 2 n_major n_minor outward triangles."""
+    u = 2 * np.pi * np.arange(n_major) / n_major
+    v = 2 * np.pi * np.arange(n_minor) / n_minor
+    uu, vv = np.meshgrid(u, v, indexing="ij")
+    ring = major + minor * np.cos(vv)
+    verts = np.stack([ring * np.cos(uu), ring * np.sin(uu), minor * np.sin(vv)], -1).reshape(-1, 3)
+    i, j = np.meshgrid(np.arange(n_major), np.arange(n_minor), indexing="ij")
+    a = i * n_minor + j
+    b = ((i + 1) % n_major) * n_minor + j
+    c = ((i + 1) % n_major) * n_minor + (j + 1) % n_minor
+    d = i * n_minor + (j + 1) % n_minor
+    faces = np.concatenate([np.stack([a, b, c], -1).reshape(-1, 3), np.stack([a, c, d], -1).reshape(-1, 3)])
+    return verts, faces.astype(np.int64)
+
+
+def flat_shells(offset: float, count: int = 189) -> tuple[np.ndarray, np.ndarray]:
+    """``count`` closed tetrahedral shells whose four corners lie in one plane (zero volume), about ``offset``."""
+    rng = np.random.default_rng(0)
+    vertices: list[np.ndarray] = []
+    faces: list[list[int]] = []
+    for _ in range(count):
+        centre = rng.normal(size=3) * 10 + offset
+        u, v = rng.normal(size=3), rng.normal(size=3)
+        n = len(vertices)
+        vertices += [centre + a * u + b * v for a, b in ((0, 0), (1, 0), (0, 1), (0.3, 0.4))]
+        faces += [[n, n + 1, n + 2], [n, n + 3, n + 1], [n + 1, n + 3, n + 2], [n, n + 2, n + 3]]
+    return np.array(vertices), np.array(faces)
+
+
 def triangles_stl_bytes(triangles: np.ndarray, header: bytes = b"") -> bytes:
     """Binary STL of triangles (n, 3, 3): float32 coordinates, zero normals, ``header`` padded to 80 bytes."""
     tri = np.asarray(triangles, dtype=np.float64)
@@ -99,11 +177,24 @@ def stl_bytes(vertices: np.ndarray, faces: np.ndarray, header: bytes = b"") -> b
     return triangles_stl_bytes(np.asarray(vertices, dtype=np.float64)[np.asarray(faces)], header)
 
 
+def obj_bytes(objects: Sequence[tuple[str | None, ArrayLike, ArrayLike]]) -> bytes:
+    """OBJ text of named (``o name``) or unnamed objects (name, vertices, faces); float64 coordinates
+    written with repr, an exact round trip."""
+    lines: list[str] = []
+    base = 0
+    for name, v, f in objects:
+        if name is not None:
+            lines.append(f"o {name}")
+        vertices = np.asarray(v, dtype=np.float64)
+        lines += ["v " + " ".join(repr(x) for x in p) for p in vertices.tolist()]
+        lines += ["f " + " ".join(str(base + i + 1) for i in t) for t in np.asarray(f).tolist()]
+        base += len(vertices)
+    return ("\n".join(lines) + "\n").encode()
+
+
 def write_stl(path: Path, v: np.ndarray, f: np.ndarray, header: bytes = b"sample mesh") -> None:
     path.write_bytes(stl_bytes(v, f, header.ljust(80, b" ")))
 
 
 def write_obj(path: Path, v: np.ndarray, f: np.ndarray) -> None:
-    lines = [f"v {x!r} {y!r} {z!r}" for x, y, z in v.tolist()]
-    lines += [f"f {a + 1} {b + 1} {c + 1}" for a, b, c in f.tolist()]
-    path.write_text("\n".join(lines) + "\n")
+    path.write_bytes(obj_bytes([(None, v, f)]))

@@ -28,14 +28,14 @@ from collections.abc import Callable, Sequence
 from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import cast
+from typing import TypedDict, cast
 
 import mpmath
 import numpy as np
 from numpy.typing import NDArray
 from scipy.spatial.transform import Rotation
 
-from benchmarks.cases import BOX_FACES
+from benchmarks.cases import BOX_FACES, box, centred_box, flat_shells, prism, stl_bytes, uv_sphere
 from benchmarks.exact import exact_eigenvalues, exact_points, exact_solid, exact_tetrahedra, relative_error
 from inertia.body import MeshBody, PointBody, VolumeBody
 from inertia.classification import RotorClass, classify
@@ -50,9 +50,6 @@ __all__ = [
     "BOUND_EXACT",
     "BOUND_THIN",
     "BOUND_INVARIANT",
-    "box",
-    "uv_sphere",
-    "prism",
     "two_material_boxes",
     "log_uniform_points",
     "MeshCase",
@@ -61,6 +58,7 @@ __all__ = [
     "MotionCase",
     "motion_cases",
     "measure_motion",
+    "MotionRow",
     "tessellation_rows",
     "near_symmetric_flip",
     "point_case",
@@ -91,54 +89,10 @@ HEX_TETS = np.array([[0, 1, 3, 7], [0, 1, 7, 5], [0, 5, 7, 4], [0, 3, 2, 7], [0,
 # -- bodies ------------------------------------------------------------------------------
 
 
-def box(a: float, b: float, c: float, centred: bool = True) -> tuple[Array, NDArray[np.int64]]:
-    """a x b x c box, outward winding; vertex k has bits (x, y, z) = (k&1, k&2, k&4)."""
-    v = np.array([[(k & 1) * a, ((k >> 1) & 1) * b, ((k >> 2) & 1) * c] for k in range(8)], dtype=float)
-    if centred:
-        v -= np.array([a, b, c]) / 2
-    return v, BOX_FACES.copy()
-
-
-def uv_sphere(n_lat: int, n_lon: int, radius: float = 1.0) -> tuple[Array, NDArray[np.int64]]:
-    """Latitude-longitude sphere: 2 n_lon (n_lat - 1) triangles, single-vertex poles."""
-    theta = np.pi * np.arange(1, n_lat) / n_lat
-    phi = 2 * np.pi * np.arange(n_lon) / n_lon
-    ring = np.stack(
-        [
-            np.outer(np.sin(theta), np.cos(phi)),
-            np.outer(np.sin(theta), np.sin(phi)),
-            np.repeat(np.cos(theta)[:, None], n_lon, axis=1),
-        ],
-        axis=-1,
-    ).reshape(-1, 3)
-    v = radius * np.vstack([[0.0, 0.0, 1.0], ring, [0.0, 0.0, -1.0]])
-    south = len(v) - 1
-    idx = 1 + np.arange((n_lat - 1) * n_lon).reshape(n_lat - 1, n_lon)
-    nxt = np.roll(idx, -1, axis=1)
-    top = np.stack([np.zeros(n_lon, dtype=np.int64), idx[0], nxt[0]], axis=1)
-    bottom = np.stack([np.full(n_lon, south), nxt[-1], idx[-1]], axis=1)
-    a, b, c, d = idx[:-1], nxt[:-1], idx[1:], nxt[1:]
-    quads = np.concatenate([np.stack([a, c, d], -1).reshape(-1, 3), np.stack([a, d, b], -1).reshape(-1, 3)])
-    return v, np.vstack([top, quads, bottom]).astype(np.int64)
-
-
 def sphere_with_triangles(n: int) -> tuple[Array, NDArray[np.int64]]:
     """A UV sphere of about ``n`` triangles (n_lon = 2 n_lat)."""
     k = max(3, round(math.sqrt(n / 4)))
     return uv_sphere(k, 2 * k)
-
-
-def prism(n: int, radius: float, height: float) -> tuple[Array, NDArray[np.int64]]:
-    """Regular n-gon prism (a tessellated cylinder), axis z, centred."""
-    ang = 2 * np.pi * np.arange(n) / n
-    ring = np.stack([radius * np.cos(ang), radius * np.sin(ang)], axis=1)
-    h = height / 2
-    v = np.vstack([np.c_[ring, np.full(n, -h)], np.c_[ring, np.full(n, h)], [[0, 0, -h], [0, 0, h]]])
-    faces = []
-    for i in range(n):
-        j = (i + 1) % n
-        faces += [[i, j, n + j], [i, n + j, n + i], [2 * n, j, i], [2 * n + 1, n + i, n + j]]
-    return v, np.array(faces, dtype=np.int64)
 
 
 def placed(v: Array, rotation: Array = GENERIC, offset: float | Array = 0.0) -> Array:
@@ -339,16 +293,18 @@ def _bound_text(thin: bool) -> str:
 
 def geometry_cases(quick: bool) -> list[MeshCase]:
     """The issue's geometry battery (meshes; points and two materials are separate)."""
-    cases = [MeshCase("box 1x2x3, generic rotation", placed(box(1, 2, 3)[0]), BOX_FACES)]
+    cases = [MeshCase("box 1x2x3, generic rotation", placed(centred_box(1, 2, 3)[0]), BOX_FACES)]
     for sizes in (1e3, 1e6, 1e8):
-        v = placed(box(1, 2, 3)[0], offset=sizes * 3.0 * DIRECTION)
+        v = placed(centred_box(1, 2, 3)[0], offset=sizes * 3.0 * DIRECTION)
         cases.append(MeshCase(f"box 1x2x3 rotated, offset {sizes:.0e} sizes", v, BOX_FACES))
     for thin in (1e-3, 1e-6):
-        v = placed(box(1, thin, thin)[0], offset=np.array([0.25, -1.5, 2.0]))
+        v = placed(centred_box(1, thin, thin)[0], offset=np.array([0.25, -1.5, 2.0]))
         cases.append(MeshCase(f"needle 1 x {thin:.0e} x {thin:.0e}, rotated", v, BOX_FACES, thin=True))
-    cases.append(MeshCase("plate 1 x 1 x 1e-6, rotated", placed(box(1, 1, 1e-6)[0]), BOX_FACES, thin=True))
+    cases.append(MeshCase("plate 1 x 1 x 1e-6, rotated", placed(centred_box(1, 1, 1e-6)[0]), BOX_FACES, thin=True))
     for scale in (1e-9, 1e9):
-        cases.append(MeshCase(f"box 1x2x3 m x {scale:.0e}, rotated", placed(box(scale, 2 * scale, 3 * scale)[0]), BOX_FACES))
+        cases.append(
+            MeshCase(f"box 1x2x3 m x {scale:.0e}, rotated", placed(centred_box(scale, 2 * scale, 3 * scale)[0]), BOX_FACES)
+        )
     return cases
 
 
@@ -461,7 +417,7 @@ def near_symmetric_flip(eps: float = 1e-9) -> dict[str, object]:
     Its exact moments are I1 < I2 = I3 up to rounding (a square cross-section):
     prolate symmetric below the flip, spherical at or above gap / I3.
     """
-    v = placed(box(1.0, 1.0, 1.0 + eps)[0])
+    v = placed(centred_box(1.0, 1.0, 1.0 + eps)[0])
     exact = exact_eigenvalues(exact_solid(v, BOX_FACES)[2])
     with mpmath.workdps(50):
         flip = float((exact[2] - exact[0]) / exact[2])
@@ -528,7 +484,7 @@ def tessellation_rows() -> list[dict[str, object]]:
             )
         )
     for n in (16, 32, 64, 128):
-        v, f = prism(n, 1.0, math.sqrt(3.0))
+        v, f = prism(n, 1.0, math.sqrt(3.0), centred=True)
         specs.append(
             (
                 f"{n}-gon cylinder, h = sqrt(3) r (ideal: spherical)",
@@ -538,7 +494,7 @@ def tessellation_rows() -> list[dict[str, object]]:
                 f"(pi/{n})^2 / 3 = {(math.pi / n) ** 2 / 3:.1e}",
             )
         )
-    v, f = prism(32, 1.0, 2.0)
+    v, f = prism(32, 1.0, 2.0, centred=True)
     specs.append(("32-gon cylinder, h = 2 r (ideal: prolate... oblate)", v, f, RotorClass.SYMMETRIC_PROLATE, ""))
     for name, v, f, true, scale in specs:
         v = placed(v)
@@ -732,7 +688,34 @@ def _elliptic_reference(I: list[mpmath.mpf], w: list[mpmath.mpf], t: Array) -> A
     return np.array([[float(x) for x in at(tau0 + rate * mpmath.mpf(float(tt)))] for tt in t])
 
 
-def measure_motion(case: MotionCase, samples: int = 2001, reference_samples: int = 41, run_scipy: bool = True) -> dict[str, object]:
+class ScipyCell(TypedDict, total=False):
+    """scipy DOP853 on one motion case, or why it was skipped."""
+
+    skipped: str
+    energy_drift: float
+    momentum_drift: float
+    omega_error: float
+    horizon: float
+    seconds: float
+
+
+class MotionRow(TypedDict):
+    """One motion case's measurements (``measure_motion``)."""
+
+    case: str
+    note: str
+    regime: str
+    energy_drift: float
+    momentum_drift: float
+    omega_error: float
+    finite: bool
+    service_drift: tuple[float | None, float | None]
+    passed: bool
+    scipy: ScipyCell
+    seconds: float
+
+
+def measure_motion(case: MotionCase, samples: int = 2001, reference_samples: int = 41, run_scipy: bool = True) -> MotionRow:
     """Invariant drift of our exact method (and scipy DOP853) over 1e5 time units; Omega error vs mpmath."""
     from inertia.pipeline import precession
 
@@ -752,7 +735,8 @@ def measure_motion(case: MotionCase, samples: int = 2001, reference_samples: int
     ref = reference_omega(effective, omega_body0, np.asarray(traj.t)[pick])  # type: ignore[arg-type]
     scale = float(np.linalg.norm(omega_body0))
     ours_err = float(np.max(np.linalg.norm(np.asarray(traj.omega_body)[pick] - ref, axis=1)) / scale)
-    out: dict[str, object] = {
+    scipy_cell = _scipy_cell(case, effective, omega_body0, frame, run_scipy)
+    return {
         "case": case.name,
         "note": case.note,
         "regime": result.motion.regime.value,
@@ -762,10 +746,9 @@ def measure_motion(case: MotionCase, samples: int = 2001, reference_samples: int
         "finite": finite,
         "service_drift": (result.motion.diagnostics.energy_drift, result.motion.diagnostics.momentum_drift),
         "passed": finite and e_drift <= BOUND_INVARIANT and m_drift <= BOUND_INVARIANT,
+        "scipy": scipy_cell,
+        "seconds": time.perf_counter() - start,
     }
-    out["scipy"] = _scipy_cell(case, effective, omega_body0, frame, run_scipy)
-    out["seconds"] = time.perf_counter() - start
-    return out
 
 
 def _effective_moments(moments: Array, rotor: RotorClass) -> Array:
@@ -773,7 +756,7 @@ def _effective_moments(moments: Array, rotor: RotorClass) -> Array:
     return ideal_moments(moments, rotor)
 
 
-def _scipy_cell(case: MotionCase, moments: Array, omega_body0: Array, frame: object, run: bool) -> dict[str, object]:
+def _scipy_cell(case: MotionCase, moments: Array, omega_body0: Array, frame: object, run: bool) -> ScipyCell:
     rate = float(np.linalg.norm(omega_body0))
     horizon = HORIZON if rate * HORIZON <= SCIPY_MAX_ANGLE else 1e5 / rate
     if not run:
@@ -844,7 +827,7 @@ def render(
     growth: list[Row],
     flip: dict[str, object],
     tess: list[dict[str, object]],
-    motion: list[dict[str, object]],
+    motion: list[MotionRow],
     quick: bool,
     elapsed: float,
     timings: dict[str, tuple[float, float]],
@@ -973,7 +956,7 @@ def _flip_lines(flip: dict[str, object]) -> list[str]:
     ]
 
 
-def _motion_lines(motion: list[dict[str, object]]) -> list[str]:
+def _motion_lines(motion: list[MotionRow]) -> list[str]:
     lines = [
         "| case | regime | ours (exact): E drift | \\|M\\| drift | Omega err | scipy DOP853 rtol 1e-12: "
         "E drift | \\|M\\| drift | Omega err | bound (ours) | pass |",
@@ -989,8 +972,8 @@ def _motion_lines(motion: list[dict[str, object]]) -> list[str]:
             sc = [_cell(s["energy_drift"]) + horizon, _cell(s["momentum_drift"]), _cell(s["omega_error"])]
         case = str(m["case"]) + (f" ({m['note']})" if m["note"] else "")
         lines.append(
-            f"| {case} | {m['regime']} | {_cell(m['energy_drift'])} | {_cell(m['momentum_drift'])} | "  # type: ignore[arg-type]
-            f"{_cell(m['omega_error'])} | " + " | ".join(sc) + f" | 1e-12 | {'pass' if m['passed'] else '**FAIL**'} |"  # type: ignore[arg-type]
+            f"| {case} | {m['regime']} | {_cell(m['energy_drift'])} | {_cell(m['momentum_drift'])} | "
+            f"{_cell(m['omega_error'])} | " + " | ".join(sc) + f" | 1e-12 | {'pass' if m['passed'] else '**FAIL**'} |"
         )
     lines += [
         "",
@@ -1014,7 +997,7 @@ def _motion_lines(motion: list[dict[str, object]]) -> list[str]:
 # -- honest numbers (issue 12) ---------------------------------------------------------------
 
 
-F32_BOX = np.array([[x, y, z] for x in (0, 1) for y in (0, 1) for z in (0, 1)], float) * [1.0, 0.5, 0.2]
+F32_BOX = box(1.0, 0.5, 0.2)[0]  # faces BOX_FACES
 
 
 def tensor_estimate_row(cases: int = 20) -> dict[str, object]:
@@ -1082,43 +1065,17 @@ def nearly_symmetric_row(cases: int = 20) -> dict[str, object]:
     }
 
 
-def _binary_stl(vertices: Array, faces: NDArray[np.int64]) -> bytes:
-    import struct
-
-    records = vertices[faces].astype(np.float32)
-    return (
-        b"\0" * 80
-        + struct.pack("<I", len(faces))
-        + b"".join(struct.pack("<12fH", 0.0, 0.0, 0.0, *tri.ravel(), 0) for tri in records)
-    )
-
-
 def float32_rows() -> list[dict[str, object]]:
     """A float32 STL of a rotated 1 x 0.5 x 0.2 box at growing offsets; a zero-volume file of 189 flat shells."""
     from inertia import analyze
     from inertia.errors import ServiceError
 
-    faces = np.array(
-        [
-            [0, 1, 3],
-            [0, 3, 2],
-            [4, 6, 7],
-            [4, 7, 5],
-            [0, 4, 5],
-            [0, 5, 1],
-            [2, 3, 7],
-            [2, 7, 6],
-            [0, 2, 6],
-            [0, 6, 4],
-            [1, 5, 7],
-            [1, 7, 3],
-        ]
-    )
+    faces = BOX_FACES
     cells, worst, first_refused = [], 0.0, None
     for exponent in range(9):
         v = F32_BOX @ GENERIC.T + 10.0**exponent * DIRECTION
         try:
-            res = analyze(_binary_stl(v, faces), filename="part.stl")
+            res = analyze(stl_bytes(v, faces), filename="part.stl")
         except ServiceError as exc:
             cells.append(f"1e{exponent}: {exc.code}")
             first_refused = exponent if first_refused is None else first_refused
@@ -1138,17 +1095,9 @@ def float32_rows() -> list[dict[str, object]]:
             "passed": worst <= 1.0 and first_refused is not None and first_refused <= 7,
         }
     ]
-    rng = np.random.default_rng(0)
-    verts: list[Array] = []
-    shell_faces: list[list[int]] = []
-    for _ in range(189):
-        centre = rng.normal(size=3) * 10 + 1e4
-        u, w = rng.normal(size=3), rng.normal(size=3)
-        n = len(verts)
-        verts += [centre + a * u + b * w for a, b in ((0, 0), (1, 0), (0, 1), (0.3, 0.4))]
-        shell_faces += [[n, n + 1, n + 2], [n, n + 3, n + 1], [n + 1, n + 3, n + 2], [n, n + 2, n + 3]]
+    verts, shell_faces = flat_shells(1e4)
     try:
-        res = analyze(_binary_stl(np.array(verts), np.array(shell_faces)), filename="shells.stl")
+        res = analyze(stl_bytes(verts, shell_faces), filename="shells.stl")
         outcome, ok = f"answered: mass {res.props.mass:.3g} kg", False
     except ServiceError as exc:
         outcome, ok = f"refused: {exc.code}", exc.code in ("insufficient_precision", "zero_volume")

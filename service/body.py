@@ -61,6 +61,7 @@ class MeshBody:
         _check_finite("vertex coordinates", v)
         if f.min() < 0 or f.max() >= len(v):
             raise InvalidParameterError("a face refers to a vertex that does not exist; the file is corrupt")
+        _check_extent(v)
         object.__setattr__(self, "vertices", v)
         object.__setattr__(self, "faces", f)
 
@@ -127,6 +128,7 @@ class VolumeBody:
         for nodes in [t, *(b.nodes for b in self.cells)]:
             if len(nodes) and (nodes.min() < 0 or nodes.max() >= len(p)):
                 raise InvalidParameterError("a cell refers to a point that does not exist; the file is corrupt")
+        _check_extent(p)
         object.__setattr__(self, "points", p)
         object.__setattr__(self, "tets", t)
         if self.cell_density is not None:
@@ -186,6 +188,22 @@ def _check_span(masses: NDArray[np.float64], positions: NDArray[np.float64], len
             f"the points span only {span:.3g} m, so their moments (~ mass x span^2) would underflow float64; "
             "give the positions in a smaller length unit (units) or scale them up",
             field="position",
+        )
+
+
+# A solid's integrals are taken in the file's units and grow as size^5 (the second moments); a part so small
+# that size^5 falls below float64's smallest normal number over eps loses its moments to underflow.
+_MIN_EXTENT = _MIN_MOMENT_SCALE ** (1 / 5)
+
+
+def _check_extent(coordinates: NDArray[np.float64]) -> None:
+    """Refuse a mesh so small, in its own units, that its moments underflow float64."""
+    extent = float(np.max(coordinates.max(axis=0) - coordinates.min(axis=0)))
+    if 0.0 < extent < _MIN_EXTENT:
+        raise InvalidParameterError(
+            f"the part is only {extent:.3g} file units across, so its moments (~ size^5) would underflow float64; "
+            "export it in a smaller length unit (scaled up) and pass that unit (units)",
+            field="coordinates",
         )
 
 

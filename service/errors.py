@@ -4,13 +4,19 @@ Every failure the service can explain is a :class:`ServiceError`.  The HTTP
 layer (``service.api.errors``) maps classes to status codes and the CLI maps
 them to exit codes; nothing else needs to know about transports.  Errors that
 only a transport raises (authentication, request size, the compute pool's time
-limit) live with it, in ``service.api.transport``.
+limit and queue) live with it, in ``service.api.transport``.
+
+:func:`envelope` is the one spelling of the contract's error envelope: the API's
+error responses, the NDJSON and batch rows of a failed file and the command
+line's ``--json`` errors are all made by it.
 """
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from typing import Any
 
+# the error classes (``envelope`` is imported by name)
 __all__ = [
     "ServiceError",
     "LoadError",
@@ -27,8 +33,12 @@ __all__ = [
     "MotionError",
     "InputTooLargeError",
     "InvalidInertiaError",
-    "ServerBusyError",
 ]
+
+
+def envelope(code: str, message: str, details: Mapping[str, Any] | None = None) -> dict[str, Any]:
+    """The error envelope of the API contract: ``{"error": {"code", "message", "details"}}``."""
+    return {"error": {"code": code, "message": message, "details": {} if details is None else details}}
 
 
 class ServiceError(Exception):
@@ -47,7 +57,7 @@ class ServiceError(Exception):
 
     def as_dict(self) -> dict[str, Any]:
         """The error envelope of the API contract."""
-        return {"error": {"code": self.code, "message": self.message, "details": self.details}}
+        return envelope(self.code, self.message, self.details)
 
 
 class LoadError(ServiceError):
@@ -122,9 +132,3 @@ class InvalidInertiaError(ServiceError):
     """The body's inertia is one a simulator would refuse to load (robotics export)."""
 
     code = "invalid_inertia"
-
-
-class ServerBusyError(ServiceError):
-    """Every compute process is busy and the queue of waiting jobs is full; retry later."""
-
-    code = "server_busy"

@@ -36,10 +36,11 @@ from numpy.typing import NDArray
 from .arrays import freeze_fields
 from .errors import InvalidInertiaError, InvalidParameterError
 from .tolerances import EPS
+from .vocabulary import ExportFormat, values
 
 __all__ = ["EXPORT_FORMATS", "MJ_MINVAL", "PLANAR_MARGIN", "Inertial", "Snippet", "inertial_snippet"]
 
-EXPORT_FORMATS = ("urdf", "sdf", "mjcf")
+EXPORT_FORMATS = values(ExportFormat)
 
 # mjMINVAL of MuJoCo's mjmodel.h: moving bodies need mass and principal moments above it [kg, kg m^2]
 MJ_MINVAL = 1e-15

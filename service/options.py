@@ -13,9 +13,9 @@ from dataclasses import dataclass
 from .conventions import length_scale
 from .errors import InvalidParameterError
 from .tolerances import DEFAULT_TOLERANCES
-from .vocabulary import METHODS, MODELS, Model, MotionMethod
+from .vocabulary import METHODS, MODELS, ExportFormat, Geometry, Isotopes, MassUnit, Model, MotionMethod, values
 
-__all__ = ["AnalysisOptions", "METHODS"]
+__all__ = ["AnalysisOptions", "METHODS", "DEFAULT_OPTIONS"]
 
 
 def _vector(name: str, value: Sequence[float] | None) -> tuple[float, float, float] | None:
@@ -42,28 +42,31 @@ class AnalysisOptions:
     """Options of one analysis, as in the API's query parameters.
 
     Lengths (reference, thickness) are in ``units``; density kg/m^3; mass kg;
-    omega rad/s in the input frame; duration s.
+    omega rad/s in the input frame; duration s.  The closed sets (``vocabulary``)
+    may be given as their strings: ``method`` becomes a ``MotionMethod`` and
+    ``model`` a ``Model`` once validated.  The defaults here are the API's and the
+    command line's (``DEFAULT_OPTIONS``); ``tolerance`` is ``Tolerances.moment_rel``.
     """
 
     format: str | None = None
     units: str | None = None
     density: float | None = None
     mass: float | None = None
-    model: str = Model.SOLID
+    model: Model | str = Model.SOLID
     thickness: float | None = None
     tolerance: float = DEFAULT_TOLERANCES.moment_rel
     reference: tuple[float, float, float] | None = None
     omega: tuple[float, float, float] | None = None
     duration: float | None = None
     samples: int | None = None
-    method: str = MotionMethod.EXACT.value
+    method: MotionMethod | str = MotionMethod.EXACT
     densities: Mapping[str, float] | None = None
-    geometry: str = "brep"
+    geometry: str = Geometry.BREP
     deflection: float | None = None
     export: str | None = None
     frame: tuple[float, float, float, float] | None = None
-    isotopes: str = "standard"
-    mass_unit: str = "kg"
+    isotopes: str = Isotopes.STANDARD
+    mass_unit: str = MassUnit.KG
 
     def __post_init__(self) -> None:
         if self.units is not None:
@@ -74,6 +77,7 @@ class AnalysisOptions:
             raise InvalidParameterError("give either density or mass, not both", parameter="density")
         if self.model not in MODELS:
             raise InvalidParameterError(f"model must be 'solid' or 'shell', got {self.model!r}", parameter="model")
+        object.__setattr__(self, "model", Model(self.model))
         if not (isinstance(self.tolerance, (int, float)) and math.isfinite(self.tolerance) and 0 < self.tolerance < 1):
             raise InvalidParameterError("tolerance must be a number between 0 and 1 (relative)", parameter="tolerance")
         object.__setattr__(self, "reference", _vector("reference", self.reference))
@@ -84,8 +88,10 @@ class AnalysisOptions:
             raise InvalidParameterError("duration and samples go together; give both for a trajectory", parameter="samples")
         if self.duration is not None and self.omega is None:
             raise InvalidParameterError("duration and samples need omega", parameter="omega")
-        if self.method not in METHODS:
+        method = self.method.value if isinstance(self.method, MotionMethod) else self.method
+        if method not in METHODS:
             raise InvalidParameterError(f"method must be one of {', '.join(METHODS)}", parameter="method")
+        object.__setattr__(self, "method", MotionMethod(method))
         if self.densities is not None:
             for name, rho in self.densities.items():
                 _positive(f"densities[{name!r}]", rho)
@@ -95,25 +101,23 @@ class AnalysisOptions:
 
 def _check_v11(options: AnalysisOptions) -> None:
     """The options of API 1.1: export, frame, isotopes, mass_unit."""
-    from .export import EXPORT_FORMATS
-    from .frames import frame_rotation
-
-    if options.export is not None and options.export not in EXPORT_FORMATS:
-        raise InvalidParameterError(
-            f"export must be one of {', '.join(EXPORT_FORMATS)}, got {options.export!r}", parameter="export"
-        )
+    formats = values(ExportFormat)
+    if options.export is not None and options.export not in formats:
+        raise InvalidParameterError(f"export must be one of {', '.join(formats)}, got {options.export!r}", parameter="export")
     if options.frame is not None:
+        from .frames import frame_rotation
+
         q, _ = frame_rotation(options.frame)
         object.__setattr__(options, "frame", tuple(float(v) for v in q))
-    if options.isotopes not in ("standard", "abundant"):
+    if options.isotopes not in values(Isotopes):
         raise InvalidParameterError(f"isotopes must be 'standard' or 'abundant', got {options.isotopes!r}", parameter="isotopes")
-    if options.mass_unit not in ("kg", "u"):
+    if options.mass_unit not in values(MassUnit):
         raise InvalidParameterError(f"mass_unit must be 'kg' or 'u', got {options.mass_unit!r}", parameter="mass_unit")
 
 
 def _check_geometry(geometry: str, deflection: float | None) -> None:
     """CAD files: ``geometry`` brep or mesh; ``deflection`` (mesh only) relative to the bounding-box diagonal."""
-    if geometry not in ("brep", "mesh"):
+    if geometry not in values(Geometry):
         raise InvalidParameterError("geometry must be 'brep' or 'mesh'", parameter="geometry")
     if deflection is None:
         return
@@ -124,3 +128,7 @@ def _check_geometry(geometry: str, deflection: float | None) -> None:
         )
     if geometry != "mesh":
         raise InvalidParameterError("deflection applies to geometry=mesh", parameter="deflection")
+
+
+# the defaults of every analysis option, for the request schemas and the command line
+DEFAULT_OPTIONS = AnalysisOptions()

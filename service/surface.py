@@ -13,8 +13,9 @@ import numpy as np
 from numpy.typing import NDArray
 
 from .body import MeshBody, Part
+from .integrals import gather_corners, point_records
 
-__all__ = ["triangle_area", "part_surface_area", "SURFACE_AREA_KEY"]
+__all__ = ["triangle_area", "twice_areas", "part_surface_area", "SURFACE_AREA_KEY"]
 
 SURFACE_AREA_KEY = "surface_area"
 AREA_BLOCK = 1 << 16  # triangles per block: ~10 MB of temporaries, not ~150 bytes per triangle at once
@@ -29,14 +30,47 @@ def triangle_area(vertices: NDArray[np.float64], faces: NDArray[np.int64]) -> fl
     origin = v[f[0, 0]]
     # each triangle's |n| in blocks (temporaries bounded), then one pairwise sum over all of them
     norms = np.empty(len(f))
-    # each row gathered whole as one 24-byte record: ~3x faster than v[block[:, k]] on large meshes
-    records = np.ascontiguousarray(v).view(np.dtype((np.void, 3 * v.itemsize))).reshape(-1)
+    records = point_records(v)
     for start in range(0, len(f), AREA_BLOCK):
-        corners = records.take(f[start : start + AREA_BLOCK]).view(np.float64).reshape(-1, 3, 3)
-        a, b, c = (corners[:, k] - origin for k in range(3))
-        cross = np.cross(b - a, c - a)
-        norms[start : start + AREA_BLOCK] = np.sqrt(np.einsum("ij,ij->i", cross, cross))
+        twice_areas(records, f[start : start + AREA_BLOCK], origin, out=norms[start : start + AREA_BLOCK], einsum_order=True)
     return float(0.5 * np.sum(norms))
+
+
+def twice_areas(
+    records: NDArray[np.void],
+    faces: NDArray[np.int64],
+    origin: NDArray[np.float64] | None = None,
+    out: NDArray[np.float64] | None = None,
+    einsum_order: bool = False,
+) -> NDArray[np.float64]:
+    """|(b - a) x (c - a)| of each triangle, corners gathered as records (``integrals.point_records``).
+
+    With ``origin``, each corner is shifted by it first.  Struct of arrays:
+    each corner is gathered once as a 24-byte record and every coordinate is
+    a contiguous row, and the arithmetic is that of ``np.cross`` and
+    ``np.linalg.norm`` on rows (each product rounded, then the difference;
+    squares summed x + y, then z), so the values are the same to the bit,
+    about three times faster.  ``einsum_order`` sums the squares x + z, then
+    y, as ``np.einsum("ij,ij->i")`` does (the order ``triangle_area`` has
+    always had).
+    """
+    corners = gather_corners(records, faces)
+    if origin is not None:
+        for corner in corners:
+            for k in range(3):
+                corner[k] -= origin[k]
+    a, b, c = corners
+    u = [b[k] - a[k] for k in range(3)]
+    w = [c[k] - a[k] for k in range(3)]
+    cross = [u[1] * w[2], u[2] * w[0], u[0] * w[1]]
+    cross[0] -= u[2] * w[1]
+    cross[1] -= u[0] * w[2]
+    cross[2] -= u[1] * w[0]
+    first, second = (2, 1) if einsum_order else (1, 2)
+    total = cross[0] * cross[0]
+    total += cross[first] * cross[first]
+    total += cross[second] * cross[second]
+    return np.sqrt(total, out=out)
 
 
 def part_surface_area(part: Part) -> float | None:

@@ -31,6 +31,7 @@ __all__ = ["weld", "row_ids", "SurfaceTopology", "surface_topology", "orient_con
 _MIX = (np.uint64(0x9E3779B97F4A7C15), np.uint64(0xBF58476D1CE4E5B9), np.uint64(0x94D049BB133111EB))
 MIN_HASH_BITS = 16  # below this many hash bits beside the index, collisions would dominate: argsort instead
 SCATTER_CHUNK = 1 << 20  # rows per block when scattering ids back: bounds the temporaries to ~16 MB
+BLOCK = 1 << 15  # elements per block of an element-wise chain: its temporaries (256 KB) stay in the cache
 
 
 def weld(vertices: NDArray[np.float64], faces: NDArray[np.int64]) -> tuple[NDArray[np.float64], NDArray[np.int64]]:
@@ -63,6 +64,8 @@ def row_ids(
     exact comparison gathers each row once, as one record of its k integers
     (one cache line), not each column separately (k misses per row), and the
     groups are numbered through flags indexed by row, not a second sort.
+    Element-wise chains (hash, packing, comparisons) run in blocks of
+    ``BLOCK`` rows so their temporaries stay in the cache.
     """
     table = _row_table(rows)
     columns = [table[:, j] for j in range(table.shape[1])]
@@ -71,12 +74,12 @@ def row_ids(
     same = _equal_neighbours(table, order)
     collided = same_hash & ~same
     if np.any(collided):
-        order = _resolve_collisions(table, order, same_hash)
-        same = _equal_neighbours(table, order)
+        order = _resolve_collisions(table, order, same_hash, same)
+    del same_hash, collided
     new = np.empty(n, dtype=bool)
     new[0] = True
     np.logical_not(same, out=new[1:])
-    del same, same_hash, collided
+    del same
     # runs keep index order, so the first row of each run is its group's smallest row
     firsts = order[np.flatnonzero(new)]  # hash-order group -> its first row
     is_head = np.zeros(n, dtype=bool)
@@ -104,17 +107,27 @@ def _row_table(rows: NDArray[np.unsignedinteger] | Sequence[NDArray[np.unsignedi
 
 
 def _row_hash(columns: Sequence[NDArray[np.unsignedinteger]]) -> NDArray[np.uint64]:
-    """A 64-bit hash of each row, well mixed in its high bits (multiply-xorshift)."""
+    """A 64-bit hash of each row, well mixed in its high bits (multiply-xorshift), in blocks."""
+    n = len(columns[0])
+    h = np.empty(n, dtype=np.uint64)
+    tmp = np.empty(min(n, BLOCK), dtype=np.uint64)
     with np.errstate(over="ignore"):
-        h = columns[0].astype(np.uint64)
-        h *= _MIX[0]
-        for col in columns[1:]:
-            h ^= h >> np.uint64(31)
-            h += col
-            h *= _MIX[1]
-        h ^= h >> np.uint64(29)
-        h *= _MIX[2]
-        h ^= h >> np.uint64(32)
+        for start in range(0, n, BLOCK):
+            stop = min(n, start + BLOCK)
+            hb, t = h[start:stop], tmp[: stop - start]
+            hb[...] = columns[0][start:stop]
+            hb *= _MIX[0]
+            for col in columns[1:]:
+                np.right_shift(hb, np.uint64(31), out=t)
+                hb ^= t
+                t[...] = col[start:stop]
+                hb += t
+                hb *= _MIX[1]
+            np.right_shift(hb, np.uint64(29), out=t)
+            hb ^= t
+            hb *= _MIX[2]
+            np.right_shift(hb, np.uint64(32), out=t)
+            hb ^= t
     return h
 
 
@@ -129,23 +142,35 @@ def _hash_order(h: NDArray[np.uint64]) -> tuple[NDArray[np.int64], NDArray[np.bo
         order = np.argsort(h, kind="stable")
         hs = h[order]
         return order, hs[1:] == hs[:-1]
-    h >>= np.uint64(index_bits)
-    return _packed_sort(h, index_bits)
+    return _packed_sort(h, index_bits, shift=True)
 
 
-def _packed_sort(key: NDArray[np.uint64], index_bits: int) -> tuple[NDArray[np.int64], NDArray[np.bool_]]:
+def _packed_sort(key: NDArray[np.uint64], index_bits: int, shift: bool = False) -> tuple[NDArray[np.int64], NDArray[np.bool_]]:
     """Indices sorting ``key`` (< 2**(64 - index_bits)) stably, and equal-neighbour flags.
 
-    Consumes ``key``: it is shifted and sorted in place.
+    With ``shift``, ``key`` is any uint64 and only its top ``64 - index_bits``
+    bits are compared.  Consumes ``key``: it is packed and sorted in place.
     """
-    key <<= np.uint64(index_bits)
-    key |= np.arange(len(key), dtype=np.uint64)
+    n = len(key)
+    low = np.uint64((1 << index_bits) - 1)
+    bits = np.uint64(index_bits)
+    for start in range(0, n, BLOCK):
+        part = key[start : start + BLOCK]
+        if shift:
+            part &= ~low
+        else:
+            part <<= bits
+        part |= np.arange(start, start + len(part), dtype=np.uint64)
     key.sort()
-    diff = key[1:] ^ key[:-1]
-    diff >>= np.uint64(index_bits)
-    same = diff == 0
-    del diff
-    key &= np.uint64((1 << index_bits) - 1)
+    same = np.empty(max(n - 1, 0), dtype=bool)
+    tmp = np.empty(min(n, BLOCK), dtype=np.uint64)
+    for start in range(0, n - 1, BLOCK):
+        stop = min(n - 1, start + BLOCK)
+        t = tmp[: stop - start]
+        np.bitwise_xor(key[start + 1 : stop + 1], key[start:stop], out=t)
+        np.less_equal(t, low, out=same[start:stop])  # equal above the index bits
+    for start in range(0, n, BLOCK):
+        key[start : start + BLOCK] &= low
     return key.view(np.int64), same
 
 
@@ -153,23 +178,31 @@ def _equal_neighbours(table: NDArray[np.unsignedinteger], order: NDArray[np.int6
     """Rows ``order[i]`` and ``order[i + 1]`` of ``table`` (n, k) equal in every column.
 
     Each row is gathered once, as one opaque record of k integers (one
-    memory access per row; the columns then compare in the gathered copy).
+    memory access per row; the columns then compare in the gathered copy),
+    in blocks.
     """
-    k = table.shape[1]
+    n, k = table.shape
     records = table.view(np.dtype((np.void, table.dtype.itemsize * k))).reshape(-1)
-    gathered = records.take(order).view(table.dtype).reshape(-1, k)
-    same: NDArray[np.bool_] = gathered[1:, 0] == gathered[:-1, 0]
-    for j in range(1, k):
-        same &= gathered[1:, j] == gathered[:-1, j]
+    same = np.empty(max(n - 1, 0), dtype=bool)
+    if n < 2:
+        return same
+    eq = np.empty(min(n, BLOCK), dtype=bool)
+    for start in range(0, n - 1, BLOCK):
+        stop = min(n - 1, start + BLOCK)
+        gathered = records.take(order[start : stop + 1]).view(table.dtype).reshape(-1, k)
+        out, e = same[start:stop], eq[: stop - start]
+        np.equal(gathered[1:, 0], gathered[:-1, 0], out=out)
+        for j in range(1, k):
+            np.equal(gathered[1:, j], gathered[:-1, j], out=e)
+            out &= e
     return same
 
 
 def _resolve_collisions(
-    table: NDArray[np.unsignedinteger], order: NDArray[np.int64], same_hash: NDArray[np.bool_]
+    table: NDArray[np.unsignedinteger], order: NDArray[np.int64], same_hash: NDArray[np.bool_], same: NDArray[np.bool_]
 ) -> NDArray[np.int64]:
-    """Re-sort the hash runs that hold distinct rows by (run, columns, index)."""
+    """Re-sort the hash runs that hold distinct rows by (run, columns, index); ``same`` is updated for the new order."""
     run = np.cumsum(np.r_[True, ~same_hash])
-    same = _equal_neighbours(table, order)
     bad_runs = np.zeros(int(run[-1]) + 1, dtype=bool)
     bad_runs[run[1:][same_hash & ~same]] = True
     pos = np.flatnonzero(bad_runs[run])
@@ -177,6 +210,11 @@ def _resolve_collisions(
     keys = [table[sub, j] for j in reversed(range(table.shape[1]))] + [run[pos]]
     out = order.copy()
     out[pos] = sub[np.lexsort(keys)]  # lexsort is stable: index order kept among equal rows
+    # only neighbours inside the re-sorted runs changed; a run's edges border another hash, never equal
+    inner = pos[:-1][np.diff(pos) == 1]
+    inner = inner[same_hash[inner]]
+    a, b = table[out[inner]], table[out[inner + 1]]
+    same[inner] = np.all(a == b, axis=1)
     return out
 
 
@@ -243,19 +281,27 @@ def surface_topology(faces: NDArray[np.int64], n_vertices: int) -> SurfaceTopolo
 def _edge_keys(faces: NDArray[np.int64], n_vertices: int) -> tuple[NDArray[np.uint64], NDArray[np.bool_]]:
     """Undirected key lo * n + hi of each half-edge (face-major) and whether it runs lo -> hi.
 
-    Built one corner column at a time into the output, so the only full-size
-    arrays are the keys and the direction flags.
+    Built in blocks of faces, one corner column at a time, straight into the
+    output, so the only full-size arrays are the keys and the direction flags.
     """
     n = len(faces)
     key = np.empty((n, 3), dtype=np.uint64)
     forward = np.empty((n, 3), dtype=bool)
-    for k in range(3):
-        u, v = faces[:, k], faces[:, (k + 1) % 3]
-        np.less(u, v, out=forward[:, k])
-        lo = np.minimum(u, v).view(np.uint64)
-        lo *= np.uint64(n_vertices)
-        lo += np.maximum(u, v).view(np.uint64)
-        key[:, k] = lo
+    step = max(1, BLOCK // 3)
+    lo = np.empty(min(n, step), dtype=np.int64)
+    hi = np.empty(min(n, step), dtype=np.int64)
+    for start in range(0, n, step):
+        block = faces[start : start + step]
+        m = len(block)
+        for k in range(3):
+            u, v = block[:, k], block[:, (k + 1) % 3]
+            np.less(u, v, out=forward[start : start + m, k])
+            np.minimum(u, v, out=lo[:m])
+            np.maximum(u, v, out=hi[:m])
+            lk = lo[:m].view(np.uint64)
+            lk *= np.uint64(n_vertices)
+            lk += hi[:m].view(np.uint64)
+            key[start : start + m, k] = lk
     return key.reshape(-1), forward.reshape(-1)
 
 
@@ -279,7 +325,8 @@ def _edge_order(key: NDArray[np.uint64], key_bits: int) -> tuple[NDArray[np.int6
     low_bits = key_bits - spill
     bucket = (key >> np.uint64(low_bits)).astype(np.uint16)
     by_bucket = np.argsort(bucket, kind="stable")  # radix sort for 16-bit keys
-    bounds = np.searchsorted(bucket[by_bucket], np.arange((1 << spill) + 1))
+    bounds = np.zeros((1 << spill) + 1, dtype=np.int64)
+    np.cumsum(np.bincount(bucket, minlength=1 << spill), out=bounds[1:])
     del bucket
     order = np.empty(m, dtype=np.int64)
     starts = []

@@ -35,6 +35,7 @@ LAYERS: list[tuple[str, list[str]]] = [
             "cells",
             "elements",
             "vocabulary",
+            "sections",
         ],
     ),
     ("body", ["body"]),

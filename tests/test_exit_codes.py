@@ -28,7 +28,7 @@ from inertia.cli import EXIT_INTERNAL, exit_code
         (E.ZeroVolumeError("x"), 4),
         (E.InsufficientPrecisionError("x"), 4),
         (E.InvalidInertiaError("x"), 4),
-        (E.ServerBusyError("x"), EXIT_INTERNAL),
+        (transport.ServerBusyError("x"), EXIT_INTERNAL),
     ],
 )
 def test_exit_code_by_class(error: E.ServiceError, status: int) -> None:
@@ -42,7 +42,7 @@ def test_every_core_error_has_an_exit_code() -> None:
 
 
 def test_transport_errors_live_in_the_api_package() -> None:
-    for name in ("PayloadTooLargeError", "ComputeTimeoutError", "UnauthorizedError"):
+    for name in ("PayloadTooLargeError", "ComputeTimeoutError", "ServerBusyError", "UnauthorizedError"):
         assert not hasattr(E, name)
         assert issubclass(getattr(transport, name), E.ServiceError)
     assert issubclass(transport.PayloadTooLargeError, E.InputTooLargeError)

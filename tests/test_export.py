@@ -106,8 +106,8 @@ def _assert_same_body(compiled: tuple[float, np.ndarray, np.ndarray], doc: dict[
     mass, com, tensor = compiled
     ours = np.array(doc["inertia_tensor"])
     assert mass == pytest.approx(doc["mass"], rel=REL)
-    np.testing.assert_allclose(com, doc["center_of_mass"], rtol=0, atol=REL * np.linalg.norm(doc["center_of_mass"]))  # type: ignore[call-overload]
-    np.testing.assert_allclose(tensor, ours, rtol=0, atol=REL * np.abs(ours).max())
+    np.testing.assert_allclose(com, doc["center_of_mass"], rtol=0, atol=float(REL * np.linalg.norm(doc["center_of_mass"])))
+    np.testing.assert_allclose(tensor, ours, rtol=0, atol=float(REL * np.abs(ours).max()))
 
 
 def _mjcf_model(snippets: list[str]) -> Any:

@@ -10,12 +10,17 @@ diagonal of the rotated matrix (43 % off for a box 1e40 m across).
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import numpy as np
+import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from benchmarks.cases import box, write_obj
+from inertia import analyze
 from inertia.eigen import jacobi_eigh
+from inertia.errors import InvalidParameterError
 
 _ROTATION_ANGLES = st.tuples(*(st.floats(-math.pi, math.pi) for _ in range(3)))
 _MOMENTS = st.tuples(*(st.floats(0.01, 100.0) for _ in range(3)))
@@ -54,3 +59,33 @@ def test_rotated_tensor_of_1e200_is_diagonalised() -> None:
     # each eigenvector is (up to sign) a column of the rotation
     alignment = np.abs(vectors[order] @ rotation)
     assert np.allclose(alignment, np.eye(3), atol=1e-14)
+
+
+def _rotated_box_file(tmp_path: Path, size: float) -> tuple[Path, np.ndarray, tuple[float, float, float]]:
+    sides = (size, 2.0 * size, 3.0 * size)
+    vertices, faces = box(*sides)
+    rotation = _rotation((0.3, 0.5, 0.7))
+    path = tmp_path / "box.obj"
+    write_obj(path, (vertices - vertices.mean(axis=0)) @ rotation.T, faces)
+    return path, rotation, sides
+
+
+@pytest.mark.parametrize("size", [1e-50, 1e-20, 1e20, 1e40, 1e58])
+def test_rotated_box_at_extreme_sizes_matches_the_closed_form(tmp_path: Path, size: float) -> None:
+    """Principal moments M (b^2 + c^2) / 12 ... and the box's own axes, with no overflow warning (an error here)."""
+    path, rotation, (a, b, c) = _rotated_box_file(tmp_path, size)
+    result = analyze(str(path)).as_dict()
+    mass = result["mass"]
+    assert mass == pytest.approx(1000.0 * a * b * c, rel=1e-14)
+    expected = sorted(mass / 12.0 * x for x in (b * b + c * c, a * a + c * c, a * a + b * b))
+    assert np.allclose(result["principal"]["moments"], expected, rtol=1e-14, atol=0)
+    alignment = np.abs(np.asarray(result["principal"]["axes"]) @ rotation).max(axis=1)
+    assert np.allclose(alignment, 1.0, rtol=0, atol=1e-14)
+
+
+@pytest.mark.parametrize("size", [1e-60, 1e-75, 1e-110])
+def test_mesh_whose_moments_underflow_is_refused_with_its_size(tmp_path: Path, size: float) -> None:
+    path, _, _ = _rotated_box_file(tmp_path, size)
+    with pytest.raises(InvalidParameterError, match="underflow float64") as caught:
+        analyze(str(path))
+    assert f"{3.5 * size:.2g}"[:3] in str(caught.value)  # the part's size, in the message

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 from pathlib import Path
+from typing import Any
 
 import meshio
 import numpy as np
@@ -22,8 +23,8 @@ def box_mesh() -> trimesh.Trimesh:
     return trimesh.Trimesh(*box(1.0, 2.0, 3.0), process=False)
 
 
-def export(obj: trimesh.Trimesh | trimesh.Scene, fmt: str, **kw: object) -> bytes:
-    data = obj.export(file_type=fmt, **kw)  # type: ignore[arg-type]
+def export(obj: trimesh.Trimesh | trimesh.Scene, fmt: str, **kw: Any) -> bytes:
+    data = obj.export(file_type=fmt, **kw)
     if isinstance(data, dict):  # gltf with embedded buffers
         data = data["model.gltf"]
     return data.encode() if isinstance(data, str) else data

@@ -195,3 +195,22 @@ def test_torus_moments_within_estimate_of_exact_polyhedron() -> None:
     ours = np.sort(props.principal_moments)
     worst = max(relative_error(float(m), e) for m, e in zip(ours, exact))
     assert worst <= props.relative_error_estimate
+
+
+def test_twice_areas_equal_numpy_cross_and_norm_to_the_bit() -> None:
+    """The struct-of-arrays area kernel rounds exactly as ``np.cross`` + ``np.linalg.norm`` on rows."""
+    from inertia.surface import twice_areas
+
+    rng = np.random.default_rng(11)
+    points = rng.normal(size=(500, 3)) * rng.choice([1e-8, 1.0, 3e5], size=(500, 1)) + 1e3
+    faces = rng.integers(0, len(points), size=(4000, 3))
+    origin = points[faces[0, 0]]
+    tri = points[faces] - origin
+    expected = np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]), axis=1)
+    np.testing.assert_array_equal(twice_areas(integrals.point_records(points), faces, origin), expected)
+    cross = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+    einsum = np.sqrt(np.einsum("ij,ij->i", cross, cross))  # sums x + z, then y
+    np.testing.assert_array_equal(twice_areas(integrals.point_records(points), faces, origin, einsum_order=True), einsum)
+    unshifted = points[faces]
+    expected = np.linalg.norm(np.cross(unshifted[:, 1] - unshifted[:, 0], unshifted[:, 2] - unshifted[:, 0]), axis=1)
+    np.testing.assert_array_equal(twice_areas(integrals.point_records(points), faces), expected)

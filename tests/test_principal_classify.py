@@ -70,7 +70,8 @@ def test_symmetry_axis_is_the_unique_axis() -> None:
     rot = Rotation.from_euler("xyz", [0.4, -0.3, 1.2]).as_matrix()
     cls = classify(frame_of([1.0, 3.0, 3.0], rot))
     unique = rot[:, 0]
-    assert abs(np.dot(cls.symmetry_axis, unique)) == pytest.approx(1.0, abs=1e-12)  # type: ignore[arg-type]
+    assert cls.symmetry_axis is not None
+    assert abs(np.dot(cls.symmetry_axis, unique)) == pytest.approx(1.0, abs=1e-12)
 
 
 def test_ray_kappa_from_rotational_constants() -> None:

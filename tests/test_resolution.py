@@ -15,7 +15,6 @@
 from __future__ import annotations
 
 import json
-import struct
 import subprocess
 import sys
 import warnings
@@ -28,6 +27,7 @@ import pytest
 from fastapi.testclient import TestClient
 from scipy.spatial.transform import Rotation
 
+from benchmarks.cases import box, flat_shells, obj_bytes, stl_bytes
 from benchmarks.exact import exact_moments, relative_error
 from inertia import analyze, analyze_points
 from inertia.errors import DegenerateBodyError, InsufficientPrecisionError
@@ -36,56 +36,14 @@ from tests.support.paths import ROOT
 
 # a 1 x 0.5 x 0.2 box, turned so that no coordinate lies on a float32 grid line
 ROT = Rotation.from_euler("zyx", [0.3, 0.5, -0.7]).as_matrix()
-CORNERS = np.array([[x, y, z] for x in (0, 1) for y in (0, 1) for z in (0, 1)], float) * [1.0, 0.5, 0.2]
-FACES = np.array(
-    [
-        [0, 1, 3],
-        [0, 3, 2],
-        [4, 6, 7],
-        [4, 7, 5],
-        [0, 4, 5],
-        [0, 5, 1],
-        [2, 3, 7],
-        [2, 7, 6],
-        [0, 2, 6],
-        [0, 6, 4],
-        [1, 5, 7],
-        [1, 7, 3],
-    ]
-)
-
-
-def binary_stl(vertices: np.ndarray, faces: np.ndarray) -> bytes:
-    """A binary STL written here with struct: 80-byte header, count, 50-byte records of float32."""
-    records = vertices[faces].astype(np.float32)
-    body = b"".join(struct.pack("<12fH", 0.0, 0.0, 0.0, *tri.ravel(), 0) for tri in records)
-    return b"\0" * 80 + struct.pack("<I", len(faces)) + body
-
-
-def flat_shells(offset: float, count: int = 189) -> tuple[np.ndarray, np.ndarray]:
-    """``count`` closed tetrahedral shells whose four corners lie in one plane: zero volume."""
-    rng = np.random.default_rng(0)
-    vertices, faces = [], []  # type: ignore[var-annotated]
-    for _ in range(count):
-        centre = rng.normal(size=3) * 10 + offset
-        u, v = rng.normal(size=3), rng.normal(size=3)
-        n = len(vertices)
-        vertices += [centre + a * u + b * v for a, b in ((0, 0), (1, 0), (0, 1), (0.3, 0.4))]
-        faces += [[n, n + 1, n + 2], [n, n + 3, n + 1], [n + 1, n + 3, n + 2], [n, n + 2, n + 3]]
-    return np.array(vertices), np.array(faces)
-
-
-def obj_text(vertices: np.ndarray, faces: np.ndarray) -> bytes:
-    lines = [f"v {float(x)!r} {float(y)!r} {float(z)!r}" for x, y, z in vertices]
-    lines += [f"f {a + 1} {b + 1} {c + 1}" for a, b, c in faces]
-    return ("\n".join(lines) + "\n").encode()
+CORNERS, FACES = box(1.0, 0.5, 0.2)
 
 
 @pytest.mark.parametrize("exponent", range(9))
 def test_float32_part_at_growing_offsets_is_exact_or_refused(exponent: float) -> None:
     offset = 10.0**exponent * np.array([1.0, 0.7, 0.4])
     vertices = CORNERS @ ROT.T + offset
-    data = binary_stl(vertices, FACES)
+    data = stl_bytes(vertices, FACES)
     stored = vertices.astype(np.float32).astype(np.float64)
     resolution = 2.0**-24 * np.abs(stored).max()
     try:
@@ -114,7 +72,7 @@ def test_the_part_collapses_within_the_range() -> None:
     for exponent in range(9):
         vertices = CORNERS @ ROT.T + 10.0**exponent * np.array([1.0, 0.7, 0.4])
         try:
-            analyze(binary_stl(vertices, FACES), filename="part.stl")
+            analyze(stl_bytes(vertices, FACES), filename="part.stl")
         except DegenerateBodyError:  # insufficient_precision, or zero_volume once every triangle collapses
             refused.append(exponent)
     assert refused and refused == list(range(refused[0], refused[-1] + 1)) and refused[0] <= 7
@@ -123,13 +81,13 @@ def test_the_part_collapses_within_the_range() -> None:
 def test_zero_volume_float32_shells_are_refused_not_flipped_into_a_body() -> None:
     vertices, faces = flat_shells(1e4)
     with pytest.raises(InsufficientPrecisionError, match="float32"):
-        analyze(binary_stl(vertices, faces), filename="shells.stl")
+        analyze(stl_bytes(vertices, faces), filename="shells.stl")
 
 
 def test_zero_volume_float64_shells_are_refused_not_flipped_into_a_body() -> None:
     vertices, faces = flat_shells(1e6)
     with pytest.raises(InsufficientPrecisionError, match="degenerate shells"):
-        analyze(obj_text(vertices, faces), filename="shells.obj")
+        analyze(obj_bytes([(None, vertices, faces)]), filename="shells.obj")
 
 
 COLLINEAR = [
@@ -184,7 +142,7 @@ def test_http_collinear_points_with_omega(client: TestClient) -> None:
 
 def test_http_float32_collapse_is_a_422_naming_the_cause(client: TestClient) -> None:
     vertices = CORNERS @ ROT.T + 1e7 * np.array([1.0, 0.7, 0.4])
-    res = client.post("/v1/analyze/mesh", files={"file": ("part.stl", binary_stl(vertices, FACES))})
+    res = client.post("/v1/analyze/mesh", files={"file": ("part.stl", stl_bytes(vertices, FACES))})
     assert res.status_code == 422
     err = res.json()["error"]
     assert err["code"] == "insufficient_precision" and "float32" in err["message"]
@@ -203,7 +161,7 @@ def test_cli_json_never_prints_infinity(tmp_path: Path) -> None:
     assert "Infinity" not in out.stdout and "NaN" not in out.stdout
     assert json.loads(out.stdout)["precession"]["regime"] == "rotator"
     stl = tmp_path / "far.stl"
-    stl.write_bytes(binary_stl(CORNERS @ ROT.T + 1e7 * np.array([1.0, 0.7, 0.4]), FACES))
+    stl.write_bytes(stl_bytes(CORNERS @ ROT.T + 1e7 * np.array([1.0, 0.7, 0.4]), FACES))
     out = subprocess.run([sys.executable, "-m", "inertia", "analyze", str(stl), "--json"], capture_output=True, text=True, cwd=ROOT)
     assert out.returncode == 4
     assert json.loads(out.stderr)["error"]["code"] == "insufficient_precision"

@@ -38,7 +38,7 @@ def _configure_logging() -> None:
 
 
 def create_app(settings: Settings | None = None) -> FastAPI:
-    settings = settings or Settings()  # type: ignore[call-arg]  # fields come from INERTIA_* variables
+    settings = settings or Settings()
     _configure_logging()
     pool = ComputePool(settings.compute_processes, settings.timeout_s, settings.max_waiting)
     workspace = Workspace()

@@ -44,9 +44,9 @@ from contextlib import contextmanager
 from multiprocessing.connection import Connection
 from typing import Any
 
-from ..errors import ServerBusyError, ServiceError, UnreadableFileError
+from ..errors import ServiceError, UnreadableFileError
 from .jobs import Job, MeshJob, run_job
-from .transport import ComputeTimeoutError
+from .transport import ComputeTimeoutError, ServerBusyError
 
 __all__ = ["ComputePool", "WorkerCrashError", "memory_limit", "MEMORY_FLOOR_BYTES", "MEMORY_FACTOR", "COMPRESSED_MEMORY_FACTOR"]
 

@@ -22,11 +22,11 @@ from ..errors import (
     InvalidMeshError,
     InvalidParameterError,
     LoadError,
-    ServerBusyError,
     ServiceError,
     UnsupportedFormatError,
+    envelope,
 )
-from .transport import ComputeTimeoutError, PayloadTooLargeError, UnauthorizedError
+from .transport import ComputeTimeoutError, PayloadTooLargeError, ServerBusyError, UnauthorizedError
 
 __all__ = ["STATUS", "error_response", "install_error_handlers", "status_of", "internal_error_response"]
 
@@ -70,21 +70,8 @@ def error_response(exc: ServiceError) -> JSONResponse:
 def internal_error_response() -> JSONResponse:
     """The envelope of an unexpected failure; the connection is closed cleanly after it (``Connection: close``),
     so a keep-alive client's next request goes on a new connection instead of into a reset one."""
-    return JSONResponse(
-        {
-            "error": {
-                "code": "internal_error",
-                "message": "the server failed unexpectedly; the error was logged, please report it with the input that caused it",
-                "details": {},
-            }
-        },
-        status_code=500,
-        headers={"Connection": "close"},
-    )
-
-
-def _envelope(status: int, code: str, message: str, **details: Any) -> JSONResponse:
-    return JSONResponse({"error": {"code": code, "message": message, "details": details}}, status_code=status)
+    message = "the server failed unexpectedly; the error was logged, please report it with the input that caused it"
+    return JSONResponse(envelope("internal_error", message), status_code=500, headers={"Connection": "close"})
 
 
 def _where(loc: tuple[Any, ...]) -> str:
@@ -128,12 +115,10 @@ async def _http_error(request: Request, exc: Exception) -> JSONResponse:
     assert isinstance(exc, HTTPException)
     detail = str(exc.detail).rstrip(".")
     if exc.status_code == 400:  # FastAPI could not parse the body (bad JSON or multipart)
-        return _envelope(422, "invalid_parameter", f"{detail}; send well-formed JSON or multipart data")
+        return JSONResponse(envelope("invalid_parameter", f"{detail}; send well-formed JSON or multipart data"), status_code=422)
     code = _HTTP_CODES.get(exc.status_code, "http_error")
     message = f"{detail}: {request.method} {request.url.path}; see /docs for the endpoints"
-    return JSONResponse(
-        {"error": {"code": code, "message": message, "details": {}}}, status_code=exc.status_code, headers=exc.headers
-    )
+    return JSONResponse(envelope(code, message), status_code=exc.status_code, headers=exc.headers)
 
 
 async def _unexpected_error(request: Request, exc: Exception) -> JSONResponse:

@@ -19,7 +19,7 @@ from typing import Any
 
 from starlette.concurrency import run_in_threadpool
 
-from ..errors import ServiceError, UnreadableFileError
+from ..errors import ServiceError, UnreadableFileError, envelope
 from ..pipeline import AnalysisOptions
 from .compute import ComputePool, memory_limit
 from .jobs import MeshJob
@@ -34,31 +34,23 @@ def _line(doc: dict[str, Any]) -> bytes:
     return json.dumps(doc, allow_nan=False, separators=(",", ":")).encode() + b"\n"
 
 
-def _error_line(filename: str | None, exc: ServiceError) -> bytes:
-    return _line({"source": {"filename": filename}, **exc.as_dict()})
+def _error_line(filename: str | None, error: dict[str, Any]) -> bytes:
+    """The line of a file that failed: its name and the envelope (as batch rows write it)."""
+    return _line({"source": {"filename": filename}, **error})
 
 
 async def _one(pool: ComputePool, item: Item, options: AnalysisOptions, folder: str, memory_cap: int) -> bytes:
     if item.error is not None:
-        return _error_line(item.filename, item.error)
+        return _error_line(item.filename, item.error.as_dict())
     assert item.path is not None
     job = MeshJob(item.path, item.filename, options, folder, memory_limit(item.size, item.filename, memory_cap))
     try:
         return _line(await pool.run(job))
     except ServiceError as exc:
-        return _error_line(item.filename, exc)
+        return _error_line(item.filename, exc.as_dict())
     except Exception as exc:
         log.error("unexpected error on batch file %r", item.filename, exc_info=exc)
-        return _line(
-            {
-                "source": {"filename": item.filename},
-                "error": {
-                    "code": "internal_error",
-                    "message": "the server failed on this file; the error was logged",
-                    "details": {},
-                },
-            }
-        )
+        return _error_line(item.filename, envelope("internal_error", "the server failed on this file; the error was logged"))
 
 
 def _next(items: Iterator[Item]) -> tuple[Item | None, bool]:

@@ -90,10 +90,7 @@ async def formats() -> FormatsOut:
     cad = [f for f in CAD_FORMATS if f not in missing]
     kinds = [(f, "surface") for f in surface] + [(f, "volume") for f in volume] + [(f, "points") for f in points]
     kinds += [(f, "cad") for f in cad]
-    table = [
-        FormatOut(format=f, kind=k, parts=f in SCENE_FORMATS)  # type: ignore[arg-type]
-        for f, k in kinds
-    ]
+    table = [FormatOut(format=f, kind=k, parts=f in SCENE_FORMATS) for f, k in kinds]
     return FormatsOut(
         formats=table,
         surface=surface,

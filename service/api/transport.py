@@ -8,7 +8,7 @@ from __future__ import annotations
 
 from ..errors import InputTooLargeError, ServiceError
 
-__all__ = ["PayloadTooLargeError", "ComputeTimeoutError", "UnauthorizedError"]
+__all__ = ["PayloadTooLargeError", "ComputeTimeoutError", "ServerBusyError", "UnauthorizedError"]
 
 
 class PayloadTooLargeError(InputTooLargeError):
@@ -21,6 +21,12 @@ class ComputeTimeoutError(ServiceError):
     """The computation did not finish within the server's time limit."""
 
     code = "timeout"
+
+
+class ServerBusyError(ServiceError):
+    """Every compute process is busy and the queue of waiting jobs is full; retry later."""
+
+    code = "server_busy"
 
 
 class UnauthorizedError(ServiceError):

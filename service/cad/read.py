@@ -10,6 +10,7 @@ from ..body import BrepBody, Part
 from ..conventions import LENGTH_UNITS
 from ..errors import InvalidParameterError, UnsupportedFormatError
 from ..surface import SURFACE_AREA_KEY
+from ..vocabulary import UnitsFrom
 
 __all__ = ["CAD_FORMATS", "GEOMETRIES", "DEFAULT_DEFLECTION", "read_cad_parts"]
 
@@ -27,7 +28,7 @@ def _binding() -> None:
         )
 
 
-def read_cad_parts(data: bytes, fmt: str, units: str | None) -> tuple[list[Part], str, str, tuple[str, ...]]:
+def read_cad_parts(data: bytes, fmt: str, units: str | None) -> tuple[list[Part], str, UnitsFrom, tuple[str, ...]]:
     """The solids of a CAD file as ``BrepBody`` parts, the unit applied, where it came from, warnings."""
     try:
         _binding()
@@ -43,14 +44,14 @@ def read_cad_parts(data: bytes, fmt: str, units: str | None) -> tuple[list[Part]
             raise InvalidParameterError(
                 f"the file's length unit ({declared or 'several units'}) cannot be overridden; omit units", parameter="units"
             )
-        scale, unit, units_from = occ.MODEL_UNIT * LENGTH_UNITS[units] / file_scale, units, "request"
+        scale, unit, units_from = occ.MODEL_UNIT * LENGTH_UNITS[units] / file_scale, units, UnitsFrom.REQUEST
     elif file_scale is None:
-        scale, unit, units_from = occ.MODEL_UNIT, "m", "file"
+        scale, unit, units_from = occ.MODEL_UNIT, "m", UnitsFrom.FILE
         warnings.append(
             f"the file's length unit ({declared or 'several units'}) was converted to metres; reference points are read in metres"
         )
     else:
         assert declared is not None
-        scale, unit, units_from = occ.MODEL_UNIT, declared, "file"
+        scale, unit, units_from = occ.MODEL_UNIT, declared, UnitsFrom.FILE
     parts = [Part(s.name, BrepBody(s, scale, s.name), {SURFACE_AREA_KEY: occ.surface_area(s) * scale**2}) for s in solids]
     return parts, unit, units_from, tuple(warnings)

@@ -12,6 +12,7 @@ from numpy.typing import NDArray
 from ..body import Body, BrepBody, MeshBody, Part, PointBody, VolumeBody
 from ..conventions import length_scale
 from ..errors import EmptyGeometryError, UnreadableFileError
+from ..vocabulary import SourceKind, UnitsFrom
 from .guard import check_upload
 from .sniff import CAD_FORMATS, FORMATS, POINT_FORMATS, SCENE_FORMATS, SURFACE_FORMATS, VOLUME_FORMATS, sniff_format
 from .upload import pick_model_file, unpack_zip
@@ -25,17 +26,17 @@ __all__ = ["Loaded", "load_body", "load_points", "FORMATS", "SURFACE_FORMATS", "
 class Loaded:
     """What was read: one or more parts and where they came from.
 
-    kind : "mesh" (surface), "volume" (volume cells), "points" or "cad" (B-rep solids).
-    units : the length unit used; units_from : "request", "file" or "default".
+    kind : mesh (surface), volume (volume cells), points or cad (B-rep solids).
+    units : the length unit used; units_from : request, file or default.
     warnings : what the loader assumed (besides each body's own).
     """
 
     parts: tuple[Part, ...]
     filename: str | None
     format: str
-    kind: str
+    kind: SourceKind
     units: str
-    units_from: str
+    units_from: UnitsFrom
     warnings: tuple[str, ...] = ()
 
     @property
@@ -115,7 +116,7 @@ def _load_path(path: str, filename: str, format: str | None, units: str | None, 
     scale = 1.0 if units is None else length_scale(units)
     name = _stem(filename)
     parts = (Part(name, MeshBody(vertices, faces, scale, name, welded=True, coordinate_eps=stl_eps(vertices))),)
-    return Loaded(parts, filename, "stl", "mesh", units or "m", "request" if units else "default")
+    return Loaded(parts, filename, "stl", SourceKind.MESH, units or "m", UnitsFrom.REQUEST if units else UnitsFrom.DEFAULT)
 
 
 def _load_bytes(
@@ -135,7 +136,7 @@ def _load_bytes(
         from ..cad.read import read_cad_parts
 
         cad_parts, unit, units_from, warnings = read_cad_parts(data, fmt, units)
-        return Loaded(tuple(cad_parts), filename, fmt, "cad", unit, units_from, warnings)
+        return Loaded(tuple(cad_parts), filename, fmt, SourceKind.CAD, unit, units_from, warnings)
     xyz_default = fmt == "xyz" and units is None
     if xyz_default:
         units = XYZ_UNIT
@@ -150,18 +151,18 @@ def _load_bytes(
         parts = [
             Part(_stem(filename), MeshBody(vertices, faces, scale, _stem(filename), welded=True, coordinate_eps=stl_eps(vertices)))
         ]
-        kind = "mesh"
+        kind = SourceKind.MESH
     elif fmt in POINT_FORMATS:
         from .points import read_points
 
         body, molecule = read_points(data, fmt, scale, isotopes=isotopes)
         parts = [Part(_stem(filename), body, {"molecule": True} if molecule else {})]
-        kind = "points"
+        kind = SourceKind.POINTS
     elif fmt in VOLUME_FORMATS:
         from .volume import read_volume_parts
 
         parts = read_volume_parts(data, fmt, scale, filename=filename, companions=companions)
-        kind = "volume"
+        kind = SourceKind.VOLUME
     else:
         from .meshes import read_surface_parts
 
@@ -170,17 +171,17 @@ def _load_bytes(
             first = parts[0]
             assert isinstance(first.body, MeshBody)
             parts[0] = Part(first.name, replace(first.body, warnings=(*first.body.warnings, *notes)), first.extras)
-        kind = "mesh"
+        kind = SourceKind.MESH
 
     if xyz_default:
-        unit, units_from = XYZ_UNIT, "default"
+        unit, units_from = XYZ_UNIT, UnitsFrom.DEFAULT
     elif requested:
-        unit, units_from = requested[0], "request"
+        unit, units_from = requested[0], UnitsFrom.REQUEST
     elif declared:
-        unit, units_from = declared, "file"
+        unit, units_from = declared, UnitsFrom.FILE
         parts = [_rescaled(p, length_scale(declared)) for p in parts]
     else:
-        unit, units_from = "m", "default"
+        unit, units_from = "m", UnitsFrom.DEFAULT
     return Loaded(tuple(parts), filename, fmt, kind, unit, units_from)
 
 
@@ -193,7 +194,8 @@ def load_points(
     unit = units or "m"
     body = points_from_records(records, length_scale(unit), isotopes=isotopes, mass_unit=mass_unit)
     extras: dict[str, object] = {"molecule": True} if names_elements(records) else {}
-    return Loaded((Part("points", body, extras),), None, "points", "points", unit, "request" if units else "default")
+    units_from = UnitsFrom.REQUEST if units else UnitsFrom.DEFAULT
+    return Loaded((Part("points", body, extras),), None, "points", SourceKind.POINTS, unit, units_from)
 
 
 def _rescaled(part: Part, scale: float) -> Part:

@@ -214,10 +214,17 @@ def _check_resolution(
     )
 
 
+_TINY = float(np.finfo(np.float64).tiny)
+
+
 def _offdiagonal_ratio(t: NDArray[np.float64]) -> float:
     worst = 0.0
     for i, j in ((0, 1), (0, 2), (1, 2)):
-        scale = math.sqrt(abs(t[i, i] * t[j, j]))
+        product = abs(float(t[i, i]) * float(t[j, j]))  # Python floats: an overflow is inf, without a warning
+        if math.isfinite(product) and product >= _TINY:
+            scale = math.sqrt(product)
+        else:  # beyond ~1e154 or below ~1e-154 the product leaves float64's range; the root of each does not
+            scale = math.sqrt(abs(float(t[i, i]))) * math.sqrt(abs(float(t[j, j])))
         if t[i, j] != 0.0:
             worst = max(worst, abs(t[i, j]) / scale if scale > 0 else math.inf)
     return worst

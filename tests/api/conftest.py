@@ -53,5 +53,5 @@ def server(live_server: Callable[..., LiveServer]) -> LiveServer:
 @pytest.fixture(scope="session")
 def client() -> Iterator[TestClient]:
     """In-process client of an app with default settings (two compute processes)."""
-    with TestClient(create_app(Settings(compute_processes=2))) as c:  # type: ignore[call-arg]  # fields come from INERTIA_* variables
+    with TestClient(create_app(Settings(compute_processes=2))) as c:
         yield c

@@ -9,7 +9,7 @@ from __future__ import annotations
 import logging
 import warnings
 from collections.abc import Callable
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
 import pytest
@@ -115,11 +115,13 @@ def assert_envelope(response: Any, code: str, status: int) -> dict[str, Any]:
     assert body["error"]["code"] == code
     assert isinstance(body["error"]["message"], str) and len(body["error"]["message"]) > 10
     assert isinstance(body["error"]["details"], dict)
-    return body["error"]  # type: ignore[no-any-return]
+    return cast("dict[str, Any]", body["error"])
 
 
 @pytest.mark.parametrize(("cls", "code", "status", "request_"), CASES, ids=[f"{c[1]}-{i}" for i, c in enumerate(CASES)])
-def test_bad_request_gets_its_code_and_status(client: TestClient, cls, code: str, status: int, request_: Any) -> None:  # type: ignore[no-untyped-def]
+def test_bad_request_gets_its_code_and_status(
+    client: TestClient, cls: type[E.ServiceError], code: str, status: int, request_: Any
+) -> None:
     assert cls.code == code and STATUS[next(k for k in type.mro(cls) if k in STATUS)] == status
     assert_envelope(request_(client), code, status)
 
@@ -145,25 +147,27 @@ LIMITED = [
         T.PayloadTooLargeError,
         "payload_too_large",
         413,
-        Settings(max_upload_bytes=1000, compute_processes=1),  # type: ignore[call-arg]  # fields come from INERTIA_* variables
+        Settings(max_upload_bytes=1000, compute_processes=1),
         mesh(box_stl(1, 2, 3) * 10),
     ),
-    (T.UnauthorizedError, "unauthorized", 401, Settings(api_key="s3cret", compute_processes=1), mesh(BOX)),  # type: ignore[call-arg]  # fields come from INERTIA_* variables
+    (T.UnauthorizedError, "unauthorized", 401, Settings(api_key="s3cret", compute_processes=1), mesh(BOX)),
     (
         T.ComputeTimeoutError,
         "timeout",
         503,
-        Settings(timeout_s=0.05, compute_processes=1),  # type: ignore[call-arg]  # fields come from INERTIA_* variables
+        Settings(timeout_s=0.05, compute_processes=1),
         mesh(torus_stl(500, 500)),
     ),
-    (E.ServerBusyError, "server_busy", 503, Settings(max_waiting=0, compute_processes=1), busy),  # type: ignore[call-arg]  # fields come from INERTIA_* variables
+    (T.ServerBusyError, "server_busy", 503, Settings(max_waiting=0, compute_processes=1), busy),
 ]
 
 
 @pytest.mark.parametrize(("cls", "code", "status", "settings", "request_"), LIMITED, ids=[c[1] for c in LIMITED])
-def test_limits_get_their_code_and_status(cls, code: str, status: int, settings: dict[str, str], request_: Any) -> None:  # type: ignore[no-untyped-def]
+def test_limits_get_their_code_and_status(
+    cls: type[E.ServiceError], code: str, status: int, settings: Settings, request_: Any
+) -> None:
     assert cls.code == code
-    with TestClient(create_app(settings)) as c:  # type: ignore[arg-type]
+    with TestClient(create_app(settings)) as c:
         assert_envelope(request_(c), code, status)
 
 
@@ -180,7 +184,7 @@ def test_unknown_path_and_method_use_the_envelope(client: TestClient) -> None:
 
 
 def test_unexpected_exception_is_500_envelope_with_logged_traceback(caplog: LogCaptureFixture) -> None:
-    app = create_app(Settings(compute_processes=1))  # type: ignore[call-arg]  # fields come from INERTIA_* variables
+    app = create_app(Settings(compute_processes=1))
 
     @app.get("/boom")
     async def boom() -> None:

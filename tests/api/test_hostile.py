@@ -42,7 +42,7 @@ def error_of(response: Any, status: int, code: str) -> dict[str, Any]:
     assert response.status_code == status, response.text
     body = response.json()
     assert body["error"]["code"] == code, body
-    return body["error"]  # type: ignore[no-any-return]
+    return cast("dict[str, Any]", body["error"])
 
 
 # --- no file opened on the client's say-so ------------------------------------------------------------
@@ -152,7 +152,7 @@ def test_zip_bomb_member_is_an_error_line_and_the_batch_goes_on(client: Any) -> 
         z.writestr("a.stl", BOX)
         z.writestr("bomb.stl", b"\0" * (200 * MIB))
         z.writestr("c.stl", BOX)
-    with TestClient(create_app(Settings(compute_processes=1, max_upload_bytes=64 * MIB))) as c:  # type: ignore[call-arg]  # fields come from INERTIA_* variables
+    with TestClient(create_app(Settings(compute_processes=1, max_upload_bytes=64 * MIB))) as c:
         lines = [json.loads(x) for x in c.post("/v1/batch", files={"files": ("z.zip", out.getvalue())}).text.splitlines()]
     assert [line.get("error", {}).get("code") for line in lines] == [None, "payload_too_large", None]
 
@@ -162,7 +162,7 @@ def test_zip_bomb_member_is_an_error_line_and_the_batch_goes_on(client: Any) -> 
 
 def test_job_past_its_memory_allowance_is_413_and_the_worker_serves_on() -> None:
     # a cap below what a 500 x 500 torus needs (>100 MiB of arrays): the job fails in its process only
-    settings = Settings(compute_processes=1, max_job_memory_bytes=24 * MIB)  # type: ignore[call-arg]  # fields come from INERTIA_* variables
+    settings = Settings(compute_processes=1, max_job_memory_bytes=24 * MIB)
     with TestClient(create_app(settings)) as c:
         error = error_of(post_mesh(c, "torus.stl", torus_stl(500, 500)), 413, "payload_too_large")
         assert "memory" in error["message"]
@@ -171,10 +171,11 @@ def test_job_past_its_memory_allowance_is_413_and_the_worker_serves_on() -> None
 
 
 def test_queue_beyond_its_bound_is_503_with_retry_after() -> None:
-    settings = Settings(compute_processes=1, max_waiting=0, timeout_s=60)  # type: ignore[call-arg]  # fields come from INERTIA_* variables
+    settings = Settings(compute_processes=1, max_waiting=0, timeout_s=60)
     slow = torus_stl(400, 400)
-    with TestClient(create_app(settings)) as c:
-        pool = c.app.state.pool  # type: ignore[attr-defined]
+    app = create_app(settings)
+    with TestClient(app) as c:
+        pool = app.state.pool
         results: list[Any] = []
         runner = threading.Thread(target=lambda: results.append(post_mesh(c, "torus.stl", slow)))
         runner.start()
@@ -221,7 +222,7 @@ def buggy_server() -> Iterator[str]:
     """A uvicorn server in this process with one route that fails like a bug."""
     import uvicorn
 
-    app = create_app(Settings(compute_processes=1))  # type: ignore[call-arg]  # fields come from INERTIA_* variables
+    app = create_app(Settings(compute_processes=1))
 
     @app.get("/v1/boom")
     async def boom() -> None:

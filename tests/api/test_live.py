@@ -133,7 +133,7 @@ def test_healthz_answers_within_a_second_during_a_long_analysis(server: Any) -> 
 
     worker = threading.Thread(target=analyse)
     worker.start()
-    latencies = []  # type: ignore[var-annotated]
+    latencies: list[float] = []
     time.sleep(0.5)  # let the upload reach the server
     while worker.is_alive() and len(latencies) < 20:
         start = time.monotonic()

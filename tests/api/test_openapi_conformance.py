@@ -46,7 +46,7 @@ def _client(settings: Settings) -> Iterator[Any]:
 
 @pytest.fixture(scope="module")
 def client() -> Iterator[Any]:
-    yield from _client(Settings(compute_processes=1))  # type: ignore[call-arg]  # fields come from INERTIA_* variables
+    yield from _client(Settings(compute_processes=1))
 
 
 @pytest.fixture(scope="module")
@@ -331,7 +331,7 @@ def test_an_internal_error_validates_against_the_schema(monkeypatch: pytest.Monk
         raise RuntimeError("a bug")
 
     monkeypatch.setattr(routes, "_small_or_pooled", broken)
-    for c in _client(Settings(compute_processes=1)):  # type: ignore[call-arg]  # fields come from INERTIA_* variables
+    for c in _client(Settings(compute_processes=1)):
         response = prec({"principal_moments": [1, 2, 3], "omega": [0, 0, 1]})(c)
         assert response.status_code == 500
         assert check(c.get("/openapi.json").json(), "post", "/v1/precession", response)["error"]["code"] == "internal_error"
@@ -365,7 +365,7 @@ def test_every_error_status_is_documented_with_the_envelope_and_valid_examples(s
 
 
 def test_the_api_key_scheme_is_documented_where_a_key_is_required() -> None:
-    for c in _client(Settings(compute_processes=1, api_key="s3cret")):  # type: ignore[call-arg]  # fields come from INERTIA_* variables
+    for c in _client(Settings(compute_processes=1, api_key="s3cret")):
         spec = c.get("/openapi.json").json()
     schemes = spec["components"]["securitySchemes"]
     described = [{k: s[k] for k in ("type", "in", "name")} for s in schemes.values()]

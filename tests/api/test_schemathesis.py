@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import os
 import warnings
+from typing import TYPE_CHECKING
 
 import schemathesis
 from hypothesis import HealthCheck, settings
@@ -19,9 +20,12 @@ from schemathesis import checks
 
 from inertia.api import Settings, create_app
 
+if TYPE_CHECKING:
+    from schemathesis.specs.openapi.schemas import OpenApiCase
+
 with warnings.catch_warnings():
     warnings.filterwarnings("ignore", message="Using `httpx` with `starlette.testclient`")
-    app = create_app(Settings(compute_processes=2, timeout_s=20))  # type: ignore[call-arg]  # fields come from INERTIA_* variables
+    app = create_app(Settings(compute_processes=2, timeout_s=20))
 
 CHECKS = [
     checks.not_a_server_error,
@@ -41,5 +45,5 @@ EXAMPLES = int(os.environ.get("INERTIA_SCHEMATHESIS_EXAMPLES", "25"))
 
 @schema.parametrize()
 @settings(max_examples=EXAMPLES, deadline=None, suppress_health_check=list(HealthCheck))
-def test_api_conforms_to_its_schema(case: schemathesis.Case) -> None:  # type: ignore[type-arg]
+def test_api_conforms_to_its_schema(case: OpenApiCase) -> None:
     case.call_and_validate(checks=CHECKS)

@@ -44,8 +44,10 @@ def make_library(root: Path) -> dict[str, str | None]:
     folders = ["", "a/", "b/c/", "objs/"]
     for i in range(N_FILES - len(BROKEN)):
         folder = folders[i % len(folders)]
-        size = tuple(float(x) for x in rng.uniform(0.01, 2.0, 3))
-        tri = box(size, float(rng.uniform(0, np.pi)), tuple(float(x) for x in rng.uniform(-50, 50, 3)))  # type: ignore[arg-type]
+        sx, sy, sz = (float(x) for x in rng.uniform(0.01, 2.0, 3))
+        angle = float(rng.uniform(0, np.pi))
+        ox, oy, oz = (float(x) for x in rng.uniform(-50, 50, 3))
+        tri = box((sx, sy, sz), angle, (ox, oy, oz))
         name = f"{folder}part_{i:02d}." + ("obj" if folder == "objs/" else "stl")
         path = root / name
         path.parent.mkdir(parents=True, exist_ok=True)

@@ -164,16 +164,17 @@ def test_groups_are_sized_by_bytes_largest_files_first() -> None:
 
 
 def test_rendered_rows_are_the_sinks_own_lines(library: Library, tmp_path: Path) -> None:
+    from inertia.batch.rows import ErrorRow
     from inertia.batch.sinks import open_sink, render
-    from inertia.batch.tasks import render_sources
+    from inertia.batch.tasks import analyze_rows, render_sources
 
     sources = list_sources([str(library[0])])[:6]
     for fmt in ("jsonl", "csv", "parquet"):
         if fmt == "parquet":
             pytest.importorskip("pyarrow")
-        rows = analyze_sources(sources, AnalysisOptions())
+        rows = analyze_rows(sources, AnalysisOptions())
         rendered = render_sources(sources, AnalysisOptions(), fmt)
-        assert [e for _, e in rendered] == ["error" in r for r in rows]
+        assert [e for _, e in rendered] == [isinstance(r, ErrorRow) for r in rows]
         a, b = tmp_path / f"a.{fmt}", tmp_path / f"b.{fmt}"
         sink_a, sink_b = open_sink(str(a), False), open_sink(str(b), False)
         for row, (text, _) in zip(rows, rendered, strict=True):
@@ -202,14 +203,38 @@ def test_a_task_whose_worker_died_is_split_into_single_files() -> None:
     assert "more memory" in row["error"]["message"]
 
 
-class _Collect:
-    fmt = "jsonl"
+class _Rows:
+    """A sink and progress bar that keep the JSON Lines rows written to them."""
 
     def __init__(self) -> None:
         self.rows: list[dict[str, Any]] = []
 
-    def write(self, rendered: list[tuple[str, bool]]) -> None:
-        self.rows.extend(json.loads(text) for text, _ in rendered)
+    def write(self, row: dict[str, Any]) -> None:
+        self.rows.append(row)
+
+    def write_rendered(self, rendered: str) -> None:
+        self.rows.append(json.loads(rendered))
+
+    def update(self, n: int) -> None:
+        pass
+
+    def flush(self) -> None:
+        pass
+
+    def close(self) -> None:
+        pass
+
+
+class _Collect(runner._Output):
+    """The run's real output, its rows kept in ``rows``."""
+
+    def __init__(self) -> None:
+        self._kept = _Rows()
+        super().__init__(self._kept, self._kept, "jsonl")
+
+    @property
+    def rows(self) -> list[dict[str, Any]]:
+        return self._kept.rows
 
 
 def test_head_start_analyses_small_files_until_the_cluster_is_ready(library: Library) -> None:
@@ -219,7 +244,7 @@ def test_head_start_analyses_small_files_until_the_cluster_is_ready(library: Lib
     pending = [sources[0], big, unsized, *sources[1:]]
     answers = iter([False] * 5 + [True])
     out = _Collect()
-    rest = runner._head_start(pending, lambda: next(answers), AnalysisOptions(), out)  # type: ignore[arg-type]
+    rest = runner._head_start(pending, lambda: next(answers), AnalysisOptions(), out)
     # five inputs looked at: three analysed here, the large and the unsized one left for the workers
     assert [r["source"]["filename"] for r in out.rows] == [s.name for s in (sources[0], *sources[1:3])]
     assert rest == [big, unsized, *sources[3:]]
@@ -231,7 +256,7 @@ def test_head_start_hands_everything_over_when_no_file_is_small_enough(library: 
     monkeypatch.setattr(runner, "HEAD_START_BYTES", -1)
     sources = list_sources([str(library[0])])
     out = _Collect()
-    assert runner._head_start(sources, lambda: False, AnalysisOptions(), out) == sources  # type: ignore[arg-type]
+    assert runner._head_start(sources, lambda: False, AnalysisOptions(), out) == sources
     assert out.rows == []
 
 
@@ -258,7 +283,7 @@ def test_an_interrupted_head_start_still_closes_the_cluster_it_started(library: 
     monkeypatch.setattr(runner, "render_sources", interrupted)
     before = sys.getswitchinterval()
     with pytest.raises(KeyboardInterrupt):
-        runner._run_local(list_sources([str(library[0])]), 2, AnalysisOptions(), _Collect())  # type: ignore[arg-type]
+        runner._run_local(list_sources([str(library[0])]), 2, AnalysisOptions(), _Collect())
     assert cluster.closed
     assert sys.getswitchinterval() == before  # the head start's shorter interval does not outlive it
 

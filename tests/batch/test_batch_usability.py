@@ -15,6 +15,7 @@ import subprocess
 import sys
 import time
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
@@ -23,8 +24,8 @@ ROOT = Path(__file__).resolve().parents[2]
 BOX = ROOT / "sample_meshes" / "box.stl"
 
 
-def inertia(*args: str, **kwargs: object) -> subprocess.CompletedProcess[str]:
-    run: subprocess.CompletedProcess[str] = subprocess.run(  # type: ignore[call-overload]
+def inertia(*args: str, **kwargs: Any) -> subprocess.CompletedProcess[str]:
+    run: subprocess.CompletedProcess[str] = subprocess.run(
         [sys.executable, "-m", "inertia", "batch", *args], capture_output=True, text=True, timeout=300, **kwargs
     )
     return run

@@ -10,11 +10,15 @@ from fractions import Fraction
 from pathlib import Path
 from typing import Any, cast
 
-import mpmath
 import numpy as np
 import pytest
 from fastapi.testclient import TestClient
+from numpy.typing import ArrayLike
 
+from benchmarks.cases import BOX_FACES as BOX_FACES  # re-exported for the contract tests
+from benchmarks.cases import box
+from benchmarks.cases import obj_bytes as obj_bytes
+from benchmarks.exact import Tensor, exact_eigenvalues, exact_solid
 from tests.support.motion import euler_reference
 
 with warnings.catch_warnings():
@@ -78,39 +82,9 @@ def strip_elapsed(obj: Any) -> Any:
     return obj
 
 
-BOX_FACES = np.array(
-    [
-        [0, 1, 3],
-        [0, 3, 2],
-        [4, 6, 7],
-        [4, 7, 5],
-        [0, 4, 5],
-        [0, 5, 1],
-        [2, 3, 7],
-        [2, 7, 6],
-        [0, 2, 6],
-        [0, 6, 4],
-        [1, 5, 7],
-        [1, 7, 3],
-    ]
-)
-
-
 def box_corners(a: float, b: float, c: float) -> np.ndarray:
-    """Corners of [0,a]x[0,b]x[0,c], indexed so that BOX_FACES wind outward."""
-    return np.array([[x, y, z] for x in (0, a) for y in (0, b) for z in (0, c)], dtype=np.float64)
-
-
-def obj_bytes(objects: list[tuple[str | None, np.ndarray, np.ndarray]]) -> bytes:
-    """OBJ text, float64 coordinates written with repr (exact round trip)."""
-    lines, base = [], 0
-    for name, v, f in objects:
-        if name is not None:
-            lines.append(f"o {name}")
-        lines += ["v " + " ".join(repr(float(x)) for x in p) for p in v]
-        lines += ["f " + " ".join(str(base + int(i) + 1) for i in t) for t in f]
-        base += len(v)
-    return ("\n".join(lines) + "\n").encode()
+    """Corners of [0,a]x[0,b]x[0,c] (``benchmarks.cases.box``), indexed so that BOX_FACES wind outward."""
+    return box(a, b, c)[0]
 
 
 def read_stl_triangles(data: bytes) -> np.ndarray:
@@ -134,48 +108,29 @@ def read_obj_triangles(data: bytes) -> np.ndarray:
     return cast("np.ndarray", np.asarray(verts)[np.asarray(tris)])
 
 
-def exact_mass_properties(triangles: np.ndarray, density: float = RHO) -> Any:
-    """Exact rational mass, centre of mass and inertia tensor (about the COM) of the closed
-    polyhedron with these triangles (divergence theorem, tetrahedra from the origin:
-    ∫x dV = V s/4, ∫x xᵀ dV = V/20 (Σ v vᵀ + s sᵀ))."""
-    F = Fraction
-    V = F(0)
-    S1 = [F(0)] * 3
-    S2 = [[F(0)] * 3 for _ in range(3)]
-    for tri in triangles:
-        a, b, c = ([F(float(x)) for x in p] for p in tri)
-        det = a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0]) + a[2] * (b[0] * c[1] - b[1] * c[0])
-        vol = det / 6
-        s = [a[i] + b[i] + c[i] for i in range(3)]
-        V += vol
-        for i in range(3):
-            S1[i] += vol * s[i] / 4
-            for j in range(3):
-                S2[i][j] += vol / 20 * (a[i] * a[j] + b[i] * b[j] + c[i] * c[j] + s[i] * s[j])
-    if V < 0:  # inverted winding: the same solid
-        V, S1, S2 = -V, [-x for x in S1], [[-x for x in r] for r in S2]
-    rho = F(density)
-    com = [x / V for x in S1]
-    C = [[rho * (S2[i][j] - V * com[i] * com[j]) for j in range(3)] for i in range(3)]
-    tr = C[0][0] + C[1][1] + C[2][2]
-    inertia = [[(tr if i == j else 0) - C[i][j] for j in range(3)] for i in range(3)]
-    return rho * V, com, inertia, V
+def exact_mass_properties(triangles: np.ndarray, density: float = RHO) -> tuple[Fraction, list[Fraction], Tensor, Fraction]:
+    """Exact rational mass, centre of mass, inertia tensor (about the COM) and volume of the closed
+    polyhedron with these triangles (``benchmarks.exact.exact_solid``); an inverted winding is the same solid."""
+    tri = np.asarray(triangles, dtype=np.float64)
+    volume, com, tensor = exact_solid(tri.reshape(-1, 3), np.arange(3 * len(tri)).reshape(-1, 3))
+    if volume < 0:
+        volume, tensor = -volume, [[-x for x in row] for row in tensor]
+    rho = Fraction(density)
+    return rho * volume, com, [[rho * x for x in row] for row in tensor], volume
 
 
-def exact_moments(inertia: list[list[Fraction]]) -> list[float]:
-    with mpmath.workdps(50):
-        m = mpmath.matrix([[mpmath.mpf(x.numerator) / x.denominator for x in row] for row in inertia])
-        ev, _ = mpmath.eigsy(m)
-        return sorted(float(ev[i]) for i in range(3))
+def exact_moments(inertia: Tensor) -> list[float]:
+    """Ascending principal moments of an exact tensor (50-digit eigenvalues), as floats."""
+    return [float(x) for x in exact_eigenvalues(inertia)]
 
 
-def exact_of(filename: str, data: bytes | None = None) -> Any:
+def exact_of(filename: str, data: bytes | None = None) -> tuple[Fraction, list[Fraction], Tensor, Fraction]:
     data = data if data is not None else (SAMPLES / filename).read_bytes()
     tris = read_stl_triangles(data) if filename.endswith(".stl") else read_obj_triangles(data)
     return exact_mass_properties(tris)
 
 
-def parallel_axis(I_com: np.ndarray, mass: float, d: np.ndarray) -> np.ndarray:
+def parallel_axis(I_com: np.ndarray, mass: float, d: ArrayLike) -> np.ndarray:
     d = np.asarray(d, float)
     return cast("np.ndarray", I_com + mass * (d @ d * np.eye(3) - np.outer(d, d)))
 
@@ -346,7 +301,7 @@ def check_invariants(pre: dict[str, Any], I_input: np.ndarray, omega0: Any) -> N
     w = np.asarray(omega0, float)
     M = I_input @ w
     scale = np.linalg.norm(M) + 1e-300
-    np.testing.assert_allclose(pre["angular_momentum"], M, rtol=0, atol=1e-13 * scale)  # type: ignore[call-overload]
+    np.testing.assert_allclose(pre["angular_momentum"], M, rtol=0, atol=float(1e-13 * scale))
     assert pre["angular_momentum_magnitude"] == pytest.approx(np.linalg.norm(M), rel=1e-13, abs=1e-300)
     assert pre["kinetic_energy"] == pytest.approx(0.5 * w @ I_input @ w, rel=1e-13, abs=1e-300)
 
@@ -382,25 +337,25 @@ def check_trajectory(
     np.testing.assert_allclose(np.linalg.norm(Q, axis=1), 1, atol=1e-12)
     np.testing.assert_allclose(quat_matrix(Q[0]), np.eye(3), atol=1e-14)
     A = np.asarray(axes, float)
-    np.testing.assert_allclose(W[0], pre["omega_body"], rtol=0, atol=1e-13 * np.linalg.norm(omega0))  # type: ignore[call-overload]
-    np.testing.assert_allclose(w[0], omega0, rtol=0, atol=1e-13 * np.linalg.norm(omega0))  # type: ignore[call-overload]
+    np.testing.assert_allclose(W[0], pre["omega_body"], rtol=0, atol=float(1e-13 * np.linalg.norm(omega0)))
+    np.testing.assert_allclose(w[0], omega0, rtol=0, atol=float(1e-13 * np.linalg.norm(omega0)))
     M0 = I_input @ np.asarray(omega0, float)
-    wscale = np.linalg.norm(omega0)
+    wscale = float(np.linalg.norm(omega0))
     for k in range(samples):
         R = quat_matrix(Q[k])
         # omega(t) in the fixed input frame is the rotated body omega
-        np.testing.assert_allclose(w[k], R @ A.T @ W[k], rtol=0, atol=max(tol, 1e-12) * wscale)  # type: ignore[call-overload]
+        np.testing.assert_allclose(w[k], R @ A.T @ W[k], rtol=0, atol=max(tol, 1e-12) * wscale)
         # M stays constant in the fixed frame: I(t) = R I0 Rᵀ
         np.testing.assert_allclose(
             R @ I_input @ R.T @ w[k],
             M0,
-            rtol=0,  # type: ignore[call-overload]
-            atol=max(tol, 1e-12) * np.linalg.norm(M0) + 1e-300,
+            rtol=0,
+            atol=float(max(tol, 1e-12) * np.linalg.norm(M0) + 1e-300),
         )
     if moments[0] > 0:
         Wr, wr, Rr = reference_motion(moments, A, omega0, t)
-        np.testing.assert_allclose(W, Wr, rtol=0, atol=tol * wscale)  # type: ignore[call-overload]
-        np.testing.assert_allclose(w, wr, rtol=0, atol=tol * wscale)  # type: ignore[call-overload]
+        np.testing.assert_allclose(W, Wr, rtol=0, atol=tol * wscale)
+        np.testing.assert_allclose(w, wr, rtol=0, atol=tol * wscale)
         for k in range(samples):
             np.testing.assert_allclose(quat_matrix(Q[k]), Rr[k], rtol=0, atol=tol)
     d = pre["diagnostics"]

@@ -16,7 +16,7 @@ from fastapi.testclient import TestClient
 from tests.contract.helpers import ROOT, SAMPLES, analyze, strip_elapsed
 
 
-def run_cli(*args: str, cwd: Path = SAMPLES) -> subprocess.CompletedProcess:  # type: ignore[type-arg]
+def run_cli(*args: str, cwd: Path = SAMPLES) -> subprocess.CompletedProcess[str]:
     env = {k: v for k, v in os.environ.items() if not k.startswith("INERTIA_")}
     return subprocess.run([sys.executable, "-m", "inertia", *args], cwd=cwd, env=env, capture_output=True, text=True, timeout=60)
 
@@ -37,7 +37,7 @@ def test_cli_json_equals_the_http_response(client: TestClient) -> None:
     p = run_cli(*args)
     assert p.returncode == 0, p.stderr
     cli = json.loads(p.stdout)
-    http = analyze(client, "box.stl", **opts)  # type: ignore[arg-type]
+    http = analyze(client, "box.stl", None, **opts)
     assert strip_elapsed(cli) == strip_elapsed(http)
 
 

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import warnings
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -71,8 +72,13 @@ def off_ascii(v: np.ndarray, f: np.ndarray) -> bytes:
 @pytest.mark.parametrize("fmt", ["ply", "off", "obj", "stl"])
 def test_surface_formats_give_the_same_box(client: TestClient, fmt: str) -> None:
     v = box_corners(1, 2, 3) + np.array([1, -1, 2])
-    writer = {"ply": ply_ascii, "off": off_ascii, "obj": lambda a, b: obj_bytes([(None, a, b)]), "stl": stl_bytes}[fmt]
-    res = analyze(client, f"box.{fmt}", writer(v, BOX_FACES))  # type: ignore[no-untyped-call]
+    writers: dict[str, Callable[[np.ndarray, np.ndarray], bytes]] = {
+        "ply": ply_ascii,
+        "off": off_ascii,
+        "obj": lambda a, b: obj_bytes([(None, a, b)]),
+        "stl": stl_bytes,
+    }
+    res = analyze(client, f"box.{fmt}", writers[fmt](v, BOX_FACES))
     assert res["source"]["format"] == fmt
     assert res["mass"] == pytest.approx(6000, rel=1e-14)
     np.testing.assert_allclose(res["center_of_mass"], [1.5, 0, 3.5], rtol=0, atol=1e-14 * 4)
@@ -139,7 +145,8 @@ def kuhn_tetrahedra(origin: Any, size: Any) -> tuple[np.ndarray, np.ndarray]:
     from itertools import permutations
 
     o = np.asarray(origin, float)
-    pts, cells = [], []  # type: ignore[var-annotated]
+    pts: list[np.ndarray] = []
+    cells: list[list[int]] = []
     for perm in permutations(range(3)):
         p = [o.copy()]
         for axis in perm:

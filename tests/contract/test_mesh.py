@@ -92,7 +92,7 @@ def test_box_tensor_in_input_frame_and_reference_by_parallel_axis_theorem(client
     np.testing.assert_allclose(ref["point"], [0, 0, 0], atol=0)
     np.testing.assert_allclose(
         ref["tensor"],
-        parallel_axis(I_com, 6000, [0.5, 1, 1.5]),  # type: ignore[arg-type]
+        parallel_axis(I_com, 6000, [0.5, 1, 1.5]),
         rtol=0,
         atol=1e-12 * 26000,
     )
@@ -161,11 +161,13 @@ def test_far_from_origin_binary_stl_uses_its_float32_coordinates(client: TestCli
 
 
 @pytest.mark.parametrize("dims", [(1.0, 1e-6, 1e-6), (1.0, 1.0, 1e-6)], ids=["needle", "plate"])
-def test_needle_and_plate_of_aspect_1e6_at_an_angle_keep_the_smallest_moment(client: TestClient, dims: Any) -> None:
+def test_needle_and_plate_of_aspect_1e6_at_an_angle_keep_the_smallest_moment(
+    client: TestClient, dims: tuple[float, float, float]
+) -> None:
     """Accuracy: estimate <= 1e-9 for the smallest moment of needles and plates of aspect
     ratio up to 1e6, at any orientation."""
     R = rotation([0.2, 0.9, -0.4], 0.83)
-    v, f = rotated_box(*dims, R, [0.25, 0.5, -0.75])  # type: ignore[call-arg]
+    v, f = rotated_box(*dims, R, [0.25, 0.5, -0.75])
     data = obj_bytes([(None, v, f)])
     res = analyze(client, "thin.obj", data)
     _, _, inertia, _ = exact_mass_properties(v[f])

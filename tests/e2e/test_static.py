@@ -21,7 +21,7 @@ ASSET = re.compile(r"""(?:src|href)=["']([^"'#]+)["']""")
 
 @pytest.fixture(scope="module")
 def client() -> Iterator[TestClient]:
-    with TestClient(create_app(Settings(compute_processes=1))) as c:  # type: ignore[call-arg]  # fields come from INERTIA_* variables
+    with TestClient(create_app(Settings(compute_processes=1))) as c:
         yield c
 
 

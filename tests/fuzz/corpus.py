@@ -65,7 +65,9 @@ def _trimesh_seeds() -> list[tuple[str, bytes]]:
         if isinstance(data, dict):  # gltf with embed_buffers gives {name: bytes}
             data = data["model.gltf"]
         out.append((f"tet.{ext}", data if isinstance(data, bytes) else data.encode()))
-    out.append(("tet_ascii.stl", mesh.export(file_type="stl_ascii").encode()))  # type: ignore[union-attr]
+    ascii_stl = mesh.export(file_type="stl_ascii")
+    assert isinstance(ascii_stl, str), type(ascii_stl)  # trimesh writes text formats as str
+    out.append(("tet_ascii.stl", ascii_stl.encode()))
     return out
 
 

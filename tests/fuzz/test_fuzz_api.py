@@ -32,6 +32,7 @@ from hypothesis import strategies as st
 
 from inertia.api import Settings, create_app
 from inertia.api.compute import MEMORY_FLOOR_BYTES
+from tests.support.server import LiveServer
 
 from . import hostile as H
 from .corpus import mutate, seeds
@@ -81,21 +82,26 @@ def _descendants(pid: int) -> list[int]:
     return found
 
 
-@pytest.fixture(scope="module")
-def fuzz_server(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Any]:
-    from tests.api.conftest import LiveServer
+class FuzzServer(LiveServer):
+    """The fuzzing server, with ``tmp`` its own TMPDIR: where the test looks for leftover files."""
 
+    def __init__(self, env: dict[str, str], tmp: Path) -> None:
+        self.tmp = tmp
+        super().__init__({**env, "TMPDIR": str(tmp)})
+
+
+@pytest.fixture(scope="module")
+def fuzz_server(tmp_path_factory: pytest.TempPathFactory) -> Iterator[FuzzServer]:
     tmp = tmp_path_factory.mktemp("fuzz-tmp")
     (Path(__file__).resolve().parents[2] / ".pytest_cache").mkdir(exist_ok=True)
-    server = LiveServer(
+    server = FuzzServer(
         {
             "INERTIA_TIMEOUT_S": str(TIMEOUT_S),
             "INERTIA_COMPUTE_PROCESSES": "2",
             "INERTIA_MAX_UPLOAD_BYTES": str(MAX_UPLOAD),
-            "TMPDIR": str(tmp),
-        }
+        },
+        tmp,
     )
-    server.tmp = tmp  # type: ignore[attr-defined]  # where the test looks for leftover files
     try:
         yield server
     finally:
@@ -121,7 +127,7 @@ def _check_reply(response: httpx.Response, counts: Counter[str], name: str) -> s
 
 
 @pytest.mark.timeout(FUZZ_SECONDS + 600)
-def test_mutated_files_of_every_format_never_break_the_server(fuzz_server: Any) -> None:
+def test_mutated_files_of_every_format_never_break_the_server(fuzz_server: FuzzServer) -> None:
     corpus = seeds()
     problems: list[str] = []
     counts: Counter[str] = Counter()
@@ -220,7 +226,7 @@ def app_client() -> Iterator[TestClient]:
         create_app(
             Settings(
                 compute_processes=1,
-                timeout_s=TIMEOUT_S,  # type: ignore[call-arg]  # fields come from INERTIA_* variables
+                timeout_s=TIMEOUT_S,
                 max_upload_bytes=MAX_UPLOAD,
             )
         )

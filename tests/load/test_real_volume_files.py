@@ -11,6 +11,7 @@ import pytest
 from inertia import load_body
 from inertia.body import VolumeBody
 from inertia.mass import mass_properties
+from tests.support.bodies import meshed, volume
 
 QUADRATIC = Path(__file__).resolve().parents[1] / "data" / "real" / "quadratic"
 REFERENCE = json.loads((QUADRATIC / "gmsh_reference.json").read_text())
@@ -19,7 +20,7 @@ REFERENCE = json.loads((QUADRATIC / "gmsh_reference.json").read_text())
 @pytest.mark.parametrize("name", sorted(REFERENCE))
 def test_gmsh_quadratic_meshes_match_gmsh_own_integration(name: str) -> None:
     ref = REFERENCE[name]
-    props = mass_properties(load_body(QUADRATIC / name).body, density=1.0)  # type: ignore[arg-type]
+    props = mass_properties(meshed(load_body(QUADRATIC / name).body), density=1.0)
     tensor = np.array(ref["inertia_unit_density"])
     assert props.mass == pytest.approx(ref["volume"], rel=1e-12)
     np.testing.assert_allclose(props.center_of_mass, ref["center"], rtol=0, atol=1e-12)
@@ -41,9 +42,9 @@ def test_gmsh_meshes_agree_with_vtk_shape_functions(name: str) -> None:
     volref = pytest.importorskip("tests.load.volref")
     from inertia.body import CellBlock
 
-    body = load_body(QUADRATIC / name).body
-    block = body.cells[0]  # type: ignore[union-attr]
+    body = volume(load_body(QUADRATIC / name).body)
+    block = body.cells[0]
     some = block.nodes[:: max(1, len(block.nodes) // 20)]  # about 20 cells: the reference is slow
-    m0 = sum(volref.reference_integrals(block.type, body.points[c])[0] for c in some)  # type: ignore[union-attr]
-    subset = VolumeBody(body.points, np.empty((0, 4), np.int64), cells=(CellBlock(block.type, some),))  # type: ignore[union-attr]
+    m0 = sum(volref.reference_integrals(block.type, body.points[c])[0] for c in some)
+    subset = VolumeBody(body.points, np.empty((0, 4), np.int64), cells=(CellBlock(block.type, some),))
     assert mass_properties(subset, density=1.0).mass == pytest.approx(m0, rel=1e-13)

@@ -24,6 +24,7 @@ from inertia.errors import EmptyGeometryError, LoadError, UnreadableFileError, U
 from inertia.load.volume import VTK_CELL_TYPES
 from inertia.mass import assembly_properties, mass_properties
 from inertia.pipeline import AnalysisOptions, analyze
+from tests.support.bodies import meshed
 
 vtk = pytest.importorskip("vtk")
 volref = pytest.importorskip("tests.load.volref")  # needs vtk
@@ -99,8 +100,8 @@ def vtk_volume(ug: float) -> float:
 def volume_of(data: bytes, filename: str) -> float:
     loaded = load_body(data, filename=filename)
     if loaded.is_assembly:
-        return assembly_properties([(p.body, 1.0) for p in loaded.parts]).mass  # type: ignore[misc]
-    return mass_properties(loaded.body, density=1.0).mass  # type: ignore[arg-type]
+        return assembly_properties([(meshed(p.body), 1.0) for p in loaded.parts]).mass
+    return mass_properties(meshed(loaded.body), density=1.0).mass
 
 
 def warped_hexes() -> tuple[np.ndarray, list[tuple[int, list[int]]]]:
@@ -152,7 +153,7 @@ def test_voxels_are_read_in_vtks_node_order(tmp_path: Path, ext: str) -> None:
     pts = np.array([(0, 0, 0), (2, 0, 0), (0, 3, 0), (2, 3, 0), (0, 0, 5), (2, 0, 5), (0, 3, 5), (2, 3, 5)], float)
     ug = grid([(11, list(range(8)))], pts)
     data = write_vtu(ug, tmp_path / f"v.{ext}") if ext == "vtu" else write_legacy(ug, tmp_path / f"v.{ext}")
-    props = mass_properties(load_body(data, filename=f"v.{ext}").body, density=1.0)  # type: ignore[arg-type]
+    props = mass_properties(meshed(load_body(data, filename=f"v.{ext}").body), density=1.0)
     assert props.mass == pytest.approx(30.0, rel=1e-15) == vtk_volume(ug)
     # a box 2 x 3 x 5: I_xx = m (b^2 + c^2) / 12
     np.testing.assert_allclose(
@@ -170,7 +171,7 @@ def test_quadratic_cells_in_vtk_files(tmp_path: Path, name: str, ext: str) -> No
         nodes[9:13] = 0.5 * (nodes[[0, 1, 2, 3]] + nodes[4])
     ug = grid([(volref.VTK_TYPE_IDS[name], list(range(len(nodes))))], nodes, density=[2500.0])
     data = write_vtu(ug, tmp_path / f"q.{ext}") if ext == "vtu" else write_legacy(ug, tmp_path / f"q.{ext}")
-    props = mass_properties(load_body(data, filename=f"q.{ext}").body)  # type: ignore[arg-type]
+    props = mass_properties(meshed(load_body(data, filename=f"q.{ext}").body))
     m0 = volref.reference_integrals(name, points_as_vtk_reads_them(tmp_path / f"q.{ext}"))[0]
     assert props.mass == pytest.approx(2500.0 * m0, rel=1e-13)  # the cell's own density
 
@@ -200,7 +201,7 @@ def test_legacy_cell_lists_longer_than_the_type_use_vtks_first_ids(tmp_path: Pat
     reader.SetFileName(str(path))
     reader.Update()
     loaded = load_body(data, filename="long.vtk")
-    props = mass_properties(loaded.body, density=1.0)  # type: ignore[arg-type]
+    props = mass_properties(meshed(loaded.body), density=1.0)
     assert props.mass == pytest.approx(vtk_volume(reader.GetOutput()), rel=1e-14) == 8.0
     assert any("first 8" in w for w in props.warnings)
 
@@ -343,13 +344,13 @@ def test_tetgen_ele_with_its_node_file_as_pairs_and_as_a_zip() -> None:
     expected = 1 / 6 + 1 / 3  # the corner tetrahedron; the second has |det [e1 e2 e3]| = 2
     pairs = load_body([("cube/mesh.ele", ele), ("cube/mesh.node", node)])
     assert pairs.format == "ele" and pairs.filename == "mesh.ele"
-    assert assembly_properties([(p.body, 1.0) for p in pairs.parts]).mass == pytest.approx(expected, rel=1e-15)  # type: ignore[misc]
+    assert assembly_properties([(meshed(p.body), 1.0) for p in pairs.parts]).mass == pytest.approx(expected, rel=1e-15)
     buf = io.BytesIO()
     with zipfile.ZipFile(buf, "w") as zf:
         zf.writestr("mesh.node", node)
         zf.writestr("mesh.ele", ele)
     zipped = load_body(buf.getvalue(), filename="mesh.zip")
-    assert assembly_properties([(p.body, 1.0) for p in zipped.parts]).mass == pytest.approx(expected, rel=1e-15)  # type: ignore[misc]
+    assert assembly_properties([(meshed(p.body), 1.0) for p in zipped.parts]).mass == pytest.approx(expected, rel=1e-15)
 
 
 def test_tetgen_ele_alone_asks_for_its_node_file() -> None:
@@ -371,7 +372,7 @@ def test_meshio_reorders_gmsh_quadratic_cells_to_vtk_order(tmp_path: Path) -> No
     nodes = volref.parametric_nodes("tetra10") + np.random.default_rng(2).uniform(-0.04, 0.04, (10, 3))
     path = tmp_path / "t.msh"
     meshio.write(path, meshio.Mesh(nodes, [("tetra10", np.arange(10)[None, :])]), file_format="gmsh", binary=False)
-    props = mass_properties(load_body(path).body, density=1.0)  # type: ignore[arg-type]
+    props = mass_properties(meshed(load_body(path).body), density=1.0)
     assert props.mass == pytest.approx(volref.reference_integrals("tetra10", nodes)[0], rel=1e-13)
 
 
@@ -431,4 +432,4 @@ def test_alternating_cell_types_make_one_part_per_type(tmp_path: Path) -> None:
     loaded = load_body(data, filename="mixed.vtu")
     assert [p.name for p in loaded.parts] == ["tetra_0", "hexahedron_1"]
     expected = sum(rho * (1.0 if ctype == 12 else 1 / 6) for (ctype, _), rho in zip(cells, density))
-    assert assembly_properties([(p.body, None) for p in loaded.parts]).mass == pytest.approx(expected, rel=1e-14)  # type: ignore[misc]
+    assert assembly_properties([(meshed(p.body), None) for p in loaded.parts]).mass == pytest.approx(expected, rel=1e-14)

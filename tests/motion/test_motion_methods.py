@@ -20,13 +20,14 @@ from inertia.motion.elliptic import (
 )
 from inertia.motion.integrators import SPLITTING_ORDER, integrate_splitting
 from inertia.motion.invariants import RigidProblem
+from inertia.motion.result import FreeMotion
 from inertia.tolerances import Tolerances
-from tests.support.motion import body, euler_reference
+from tests.support.motion import body, euler_reference, trajectory
 
 MOMENTS, OMEGA = (1.0, 2.0, 3.0), (0.3, 0.2, 1.0)
 
 
-def _exact(moments: Any, omega: Any, duration: float, samples: int, **kw: Any) -> Any:
+def _exact(moments: Any, omega: Any, duration: float, samples: int, **kw: Any) -> FreeMotion:
     frame, cls = body(moments, **kw)
     return predict_motion(frame, cls, omega, duration=duration, samples=samples)
 
@@ -40,10 +41,10 @@ def test_numerical_methods_agree_with_exact(method: str, tol: float, moments: An
     numeric = predict_motion(frame, cls, omega, duration=20.0, samples=41, method=method)
     exact = _exact(moments, omega, 20.0, 41)
     assert numeric.method is MotionMethod(method) and numeric.regime is exact.regime
-    assert np.max(np.abs(numeric.trajectory.omega_body - exact.trajectory.omega_body)) <= tol  # type: ignore[union-attr]
+    assert np.max(np.abs(trajectory(numeric).omega_body - trajectory(exact).omega_body)) <= tol
     dq = np.minimum(
-        np.abs(numeric.trajectory.quaternion - exact.trajectory.quaternion).max(1),  # type: ignore[union-attr]
-        np.abs(numeric.trajectory.quaternion + exact.trajectory.quaternion).max(1),  # type: ignore[union-attr]
+        np.abs(trajectory(numeric).quaternion - trajectory(exact).quaternion).max(1),
+        np.abs(trajectory(numeric).quaternion + trajectory(exact).quaternion).max(1),
     )
     assert np.max(dq) <= tol
 
@@ -51,14 +52,15 @@ def test_numerical_methods_agree_with_exact(method: str, tol: float, moments: An
 def test_splitting_keeps_momentum_exactly_and_energy_without_drift() -> None:
     frame, cls = body(MOMENTS)
     motion = predict_motion(frame, cls, OMEGA, duration=100.0, samples=11, method="splitting")
-    assert motion.diagnostics.momentum_drift <= 1e-12  # type: ignore[operator]  # rounding only, over ~4e5 sub-rotations
-    assert motion.diagnostics.energy_drift <= 1e-6  # type: ignore[operator]  # O((h Omega)^2), bounded, not growing
+    assert motion.diagnostics.momentum_drift is not None and motion.diagnostics.energy_drift is not None
+    assert motion.diagnostics.momentum_drift <= 1e-12  # rounding only, over ~4e5 sub-rotations
+    assert motion.diagnostics.energy_drift <= 1e-6  # O((h Omega)^2), bounded, not growing
 
 
 def test_splitting_converges_at_its_declared_order() -> None:
     problem = RigidProblem(np.array(MOMENTS), np.array(OMEGA), np.eye(3), np.array([1.0, 0, 0, 0]))
     t = np.array([0.0, 5.0])
-    exact = _exact(MOMENTS, OMEGA, 5.0, 2).trajectory.omega_body[-1]
+    exact = trajectory(_exact(MOMENTS, OMEGA, 5.0, 2)).omega_body[-1]
     steps = np.array([0.04, 0.02, 0.01, 0.005])
     errors = [np.linalg.norm(integrate_splitting(problem, t, h, 10**6)[0][-1] - exact) for h in steps]
     order = np.polyfit(np.log(steps), np.log(errors), 1)[0]
@@ -69,7 +71,7 @@ def test_integrator_tolerance_is_taken_from_tolerances() -> None:
     frame, cls = body(MOMENTS)
     loose = predict_motion(frame, cls, OMEGA, duration=20.0, samples=5, method="rk45", tolerances=Tolerances(integrator_rtol=1e-4))
     exact = _exact(MOMENTS, OMEGA, 20.0, 5)
-    error = np.max(np.abs(loose.trajectory.omega_body - exact.trajectory.omega_body))  # type: ignore[union-attr]
+    error = np.max(np.abs(trajectory(loose).omega_body - trajectory(exact).omega_body))
     assert 1e-7 < error < 1e-2
 
 
@@ -119,16 +121,17 @@ omega_st = st.tuples(st.floats(-5.0, 5.0), st.floats(-5.0, 5.0), st.floats(-5.0,
 def test_exact_path_keeps_energy_and_momentum(moments: Any, omega: Any, duration: float) -> None:
     motion = _exact(moments, omega, duration, 257)
     assert motion.regime is Regime.ASYMMETRIC
+    assert motion.diagnostics.momentum_drift is not None and motion.diagnostics.energy_drift is not None
     assert motion.diagnostics.energy_drift <= 1e-12
     assert motion.diagnostics.momentum_drift <= 1e-12
-    assert np.all(np.isfinite(motion.trajectory.quaternion))
+    assert np.all(np.isfinite(trajectory(motion).quaternion))
 
 
 @settings(max_examples=15, deadline=None)
 @given(moments_st, omega_st)
 def test_exact_path_agrees_with_dop853(moments: Any, omega: Any) -> None:
-    rate = np.linalg.norm(omega)
+    rate = float(np.linalg.norm(omega))
     duration = 10.0 / rate  # ~10 radians: beyond, DOP853's own error grows near separatrices
-    motion = _exact(moments, omega, duration, 21)  # type: ignore[arg-type]
-    w_ref, _r_ref = euler_reference(moments, omega, motion.trajectory.t)
-    assert np.max(np.abs(motion.trajectory.omega_body - w_ref)) <= 1e-8 * rate
+    motion = _exact(moments, omega, duration, 21)
+    w_ref, _r_ref = euler_reference(moments, omega, trajectory(motion).t)
+    assert np.max(np.abs(trajectory(motion).omega_body - w_ref)) <= 1e-8 * rate

@@ -15,6 +15,7 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 from inertia.classification import Classification, classify
+from inertia.motion.result import FreeMotion, Trajectory
 from inertia.principal import PrincipalFrame
 
 
@@ -25,6 +26,12 @@ def body(moments: Any, rotation: Any = None, tolerance: float = 1e-6) -> tuple[P
     frame = PrincipalFrame.from_eigen(np.asarray(moments, dtype=float), axes, tolerance)
     assert np.allclose(frame.axes, axes, rtol=0, atol=1e-15), "choose test axes that already obey the sign rule"
     return frame, classify(frame)
+
+
+def trajectory(motion: FreeMotion) -> Trajectory:
+    """The sampled trajectory of a motion asked for with samples (a test fails here if it is missing)."""
+    assert motion.trajectory is not None, "the motion was asked for with samples"
+    return motion.trajectory
 
 
 def euler_reference(moments: Any, omega_body: Any, t: Any, rtol: float = 1e-12) -> Any:

@@ -1,0 +1,413 @@
+"""The benchmarks' one small harness: timing, rounds, memory, the machine, and the report.
+
+Every benchmark under ``benchmarks/`` measures with these and writes its document through them,
+so that each one states the same things the same way:
+
+- ``timed(call)``: wall and CPU seconds of an in-process call (``time.perf_counter`` and
+  ``time.process_time``), and this process's peak resident set after it;
+- ``best_of(call, repeat, budget_s)``: the least disturbed of several runs (timeit's rule: the
+  minimum wall time), stopping early once ``budget_s`` is spent;
+- ``run_process(args)``: a whole process from launch to exit: its wall time, the CPU time and
+  peak resident set of it and every process it starts (sampled from ``/proc`` every
+  ``SAMPLE_S``; the peak is the kernel's own high-water mark, ``VmHWM``, so no peak is missed
+  between samples), its exit status and output;
+- ``interleaved(contenders, rounds)``: rounds in which every contender runs once, their order
+  rotated from round to round, and the best run of each kept: robust to a machine that is
+  busy with other work for part of the time;
+- ``available_cores()`` and ``machine()``: what the run had to work with;
+- ``Report``: a markdown document with a title, a header line that names the command that
+  regenerates it and the machine, and ``write`` (the whole file, or only the section between
+  ``START`` and ``END`` markers of a document that has prose around it).
+
+Nothing here imports the service or the tests.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import math
+import os
+import platform
+import resource
+import shlex
+import subprocess
+import sys
+import threading
+import time
+from collections.abc import Callable, Iterator, Mapping, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Generic, TypeVar
+
+__all__ = [
+    "ROOT",
+    "SAMPLE_S",
+    "START",
+    "END",
+    "Timing",
+    "timed",
+    "best_of",
+    "ProcStat",
+    "TreeLog",
+    "sampled",
+    "ProcessRun",
+    "run_process",
+    "Best",
+    "interleaved",
+    "peak_rss_bytes",
+    "available_cores",
+    "load_average",
+    "cpu_model",
+    "machine",
+    "command_line",
+    "Report",
+    "write_section",
+]
+
+ROOT = Path(__file__).resolve().parents[1]
+SAMPLE_S = 0.05  # process-tree sampling period
+START, END = "<!-- benchmark:start -->", "<!-- benchmark:end -->"
+
+T = TypeVar("T")
+
+
+# ---------------------------------------------------------------------------
+# in-process calls
+
+
+@dataclass(frozen=True)
+class Timing:
+    """Wall and CPU seconds of one call, and this process's peak resident set after it [bytes]."""
+
+    wall_s: float
+    cpu_s: float
+    peak_rss_bytes: int
+
+
+def peak_rss_bytes() -> int:
+    """This process's peak resident set so far (``ru_maxrss``, KiB on Linux)."""
+    return int(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss) * 1024
+
+
+def timed(call: Callable[[], T]) -> tuple[T, Timing]:
+    """``call()`` and its wall time, CPU time (this process, all threads) and the peak RSS after it."""
+    wall0, cpu0 = time.perf_counter(), time.process_time()
+    out = call()
+    wall, cpu = time.perf_counter() - wall0, time.process_time() - cpu0
+    return out, Timing(wall, cpu, peak_rss_bytes())
+
+
+def best_of(call: Callable[[], T], repeat: int = 1, budget_s: float = math.inf) -> tuple[T, Timing]:
+    """The result and timing of the fastest of ``repeat`` runs of ``call`` (at least one; no new
+    run starts once the runs so far took ``budget_s`` together)."""
+    best: tuple[T, Timing] | None = None
+    spent = 0.0
+    for _ in range(max(1, repeat)):
+        out, t = timed(call)
+        if best is None or t.wall_s < best[1].wall_s:
+            best = (out, t)
+        spent += t.wall_s
+        if spent > budget_s:
+            break
+    assert best is not None
+    return best
+
+
+# ---------------------------------------------------------------------------
+# whole processes and their trees
+
+
+@dataclass(frozen=True)
+class ProcStat:
+    """CPU seconds, peak resident set [bytes] and command line of one live process (``/proc``)."""
+
+    cpu_s: float
+    peak_rss_bytes: int
+    command: str
+
+
+def _children() -> dict[int, list[int]]:
+    kids: dict[int, list[int]] = {}
+    for entry in os.listdir("/proc"):
+        if entry.isdigit():
+            try:
+                with open(f"/proc/{entry}/stat") as fh:
+                    ppid = int(fh.read().rsplit(")", 1)[1].split()[1])
+            except (OSError, IndexError, ValueError):
+                continue
+            kids.setdefault(ppid, []).append(int(entry))
+    return kids
+
+
+def _tree(roots: Sequence[int]) -> list[int]:
+    kids = _children()
+    out, todo = [], list(roots)
+    while todo:
+        pid = todo.pop()
+        out.append(pid)
+        todo.extend(kids.get(pid, []))
+    return out
+
+
+def _proc(pid: int) -> ProcStat | None:
+    try:
+        with open(f"/proc/{pid}/stat") as fh:
+            fields = fh.read().rsplit(")", 1)[1].split()
+        cpu = (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
+        hwm = 0
+        with open(f"/proc/{pid}/status") as fh:
+            for line in fh:
+                if line.startswith("VmHWM:"):
+                    hwm = int(line.split()[1]) * 1024
+        with open(f"/proc/{pid}/cmdline", "rb") as fh:
+            cmd = fh.read().replace(b"\0", b" ").decode(errors="replace")
+        return ProcStat(cpu, hwm, cmd)
+    except (OSError, IndexError, ValueError):
+        return None
+
+
+@dataclass
+class TreeLog:
+    """The last CPU time, peak RSS and command line seen of each process of sampled trees."""
+
+    seen: dict[int, ProcStat] = field(default_factory=dict)
+    start_cpu: dict[int, float] = field(default_factory=dict)
+
+    def sample(self, roots: Sequence[int]) -> None:
+        for pid in _tree(roots):
+            got = _proc(pid)
+            if got is not None:
+                self.seen[pid] = got
+                self.start_cpu.setdefault(pid, got.cpu_s)
+
+    def cpu(self, pids: Sequence[int] | None = None) -> float:
+        """CPU seconds the processes used while sampled (all of them by default)."""
+        keys = list(self.seen) if pids is None else [p for p in pids if p in self.seen]
+        return sum(self.seen[p].cpu_s - self.start_cpu[p] for p in keys)
+
+    def peak(self, pids: Sequence[int] | None = None) -> int:
+        """The largest peak RSS among the processes [bytes] (0 if none was seen)."""
+        keys = list(self.seen) if pids is None else [p for p in pids if p in self.seen]
+        return max((self.seen[p].peak_rss_bytes for p in keys), default=0)
+
+
+@contextlib.contextmanager
+def sampled(roots: Sequence[int], log: TreeLog, every_s: float = SAMPLE_S) -> Iterator[None]:
+    """Sample the process trees under ``roots`` into ``log`` every ``every_s`` while the block runs."""
+    stop = threading.Event()
+
+    def loop() -> None:
+        while not stop.is_set():
+            log.sample(roots)
+            stop.wait(every_s)
+
+    thread = threading.Thread(target=loop, daemon=True)
+    thread.start()
+    try:
+        yield
+    finally:
+        stop.set()
+        thread.join()
+
+
+@dataclass(frozen=True)
+class ProcessRun:
+    """One whole process, launch to exit: wall time, the CPU and peak RSS of its tree, its output.
+
+    ``tree`` holds what was last seen of each process (the command's own is ``pid``; with
+    ``extra_roots`` their trees too), ``cpu_s`` is the CPU time of them all while it ran.
+    """
+
+    args: tuple[str, ...]
+    pid: int
+    returncode: int
+    wall_s: float
+    cpu_s: float
+    stdout: str
+    stderr: str
+    tree: TreeLog
+
+    @property
+    def own_cpu_s(self) -> float:
+        """CPU seconds of the command's own process."""
+        return self.tree.cpu([self.pid])
+
+    @property
+    def peak_rss_bytes(self) -> int:
+        """The largest peak RSS of any process of the tree [bytes]."""
+        return self.tree.peak()
+
+
+def run_process(
+    args: Sequence[str],
+    *,
+    cwd: Path = ROOT,
+    env: Mapping[str, str] | None = None,
+    extra_roots: Sequence[int] = (),
+    check: bool = True,
+    timeout_s: float | None = None,
+) -> ProcessRun:
+    """Run ``args`` to its end, sampling its process tree (and ``extra_roots``' trees, whose CPU counts
+    from now): a non-zero exit raises ``RuntimeError`` with the end of its stderr when ``check``."""
+    log = TreeLog()
+    if extra_roots:
+        log.sample(extra_roots)
+    t0 = time.perf_counter()
+    proc = subprocess.Popen(
+        list(args), cwd=cwd, env=None if env is None else dict(env), stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True
+    )
+    with sampled([proc.pid, *extra_roots], log):
+        try:
+            out, err = proc.communicate(timeout=timeout_s)
+        except subprocess.TimeoutExpired:
+            proc.kill()
+            out, err = proc.communicate()
+            raise RuntimeError(f"`{command_line(args)}` ran past {timeout_s} s:\n{err[-3000:]}") from None
+    wall = time.perf_counter() - t0
+    if check and proc.returncode != 0:
+        raise RuntimeError(f"`{command_line(args)}` failed (exit {proc.returncode}):\n{err[-3000:]}")
+    return ProcessRun(tuple(args), proc.pid, proc.returncode, wall, log.cpu(), out, err, log)
+
+
+# ---------------------------------------------------------------------------
+# rounds
+
+
+@dataclass
+class Best(Generic[T]):
+    """The best result of each contender over interleaved rounds, and every result of each."""
+
+    best: dict[str, T] = field(default_factory=dict)
+    runs: dict[str, list[T]] = field(default_factory=dict)
+
+
+def interleaved(
+    contenders: Sequence[tuple[str, Callable[[], T]]],
+    rounds: int,
+    wall: Callable[[str, T], float],
+    after_round: Callable[[int, dict[str, T]], None] | None = None,
+) -> Best[T]:
+    """``rounds`` rounds, every contender once in each, the order rotated by one from round to round;
+    the best of each contender is the one with the least ``wall(name, result)``. ``after_round(r, got)``
+    sees each round's results (to print progress)."""
+    out: Best[T] = Best()
+    for r in range(rounds):
+        k = r % len(contenders) if contenders else 0
+        got: dict[str, T] = {}
+        for name, run in [*contenders[k:], *contenders[:k]]:
+            got[name] = run()
+            out.runs.setdefault(name, []).append(got[name])
+            if name not in out.best or wall(name, got[name]) < wall(name, out.best[name]):
+                out.best[name] = got[name]
+        if after_round is not None:
+            after_round(r, got)
+    return out
+
+
+# ---------------------------------------------------------------------------
+# the machine
+
+_SPIN = "import time\nt = time.perf_counter()\nwhile time.perf_counter() - t < {s}: pass\nprint(time.process_time())"
+
+
+def available_cores(processes: int = 2, seconds: float = 1.0) -> float:
+    """CPU seconds per second that ``processes`` busy processes of this session get right now.
+
+    2.0 on an idle 2-core machine.  With the kernel's autogroup scheduling, a
+    busy session elsewhere cuts it towards 1.0, whatever the number of our
+    processes: parallel speed-ups are then capped.
+    """
+    procs = [
+        subprocess.Popen([sys.executable, "-c", _SPIN.format(s=seconds)], stdout=subprocess.PIPE, text=True)
+        for _ in range(processes)
+    ]
+    cpu = sum(float(p.communicate()[0]) for p in procs)
+    return cpu / seconds
+
+
+def load_average() -> float:
+    """The 1-minute load average (0 where the system has none)."""
+    try:
+        return os.getloadavg()[0]
+    except OSError:
+        return 0.0
+
+
+def cpu_model() -> str:
+    """The CPU's model name (``/proc/cpuinfo``), else what ``platform`` knows."""
+    with contextlib.suppress(OSError), open("/proc/cpuinfo") as fh:
+        for line in fh:
+            if line.startswith("model name"):
+                return line.split(":", 1)[1].strip()
+    return platform.processor() or platform.machine()
+
+
+def machine(packages: Sequence[str] = ()) -> dict[str, str]:
+    """CPU model, cores (all, and usable by this process), Python, load average, and the versions of ``packages``."""
+    import importlib.metadata as md
+
+    versions = {}
+    for pkg in packages:
+        try:
+            versions[pkg] = md.version(pkg)
+        except md.PackageNotFoundError:
+            versions[pkg] = "not installed"
+    usable = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1
+    return {
+        "cpu": cpu_model(),
+        "cores": str(os.cpu_count()),
+        "usable": str(usable),
+        "python": platform.python_version(),
+        "load": f"{load_average():.2f}",
+        **versions,
+    }
+
+
+def command_line(args: Sequence[str]) -> str:
+    """``args`` as one shell-quoted line."""
+    return shlex.join(list(args))
+
+
+# ---------------------------------------------------------------------------
+# the report
+
+
+@dataclass
+class Report:
+    """A markdown document: ``# title``, then the lines added, with ``regenerate`` (the command
+    that writes it, run from the repository root) stated where the benchmark puts it."""
+
+    title: str
+    regenerate: str
+    lines: list[str] = field(default_factory=list)
+
+    def add(self, *lines: str) -> None:
+        self.lines.extend(lines)
+
+    def regenerate_line(self, needs: str = "") -> str:
+        """``Regenerate: `command` (from the repository root[; needs ...]).``"""
+        return f"Regenerate: `{self.regenerate}` (from the repository root{'; ' + needs if needs else ''})."
+
+    def text(self) -> str:
+        body = "\n".join(self.lines).rstrip("\n")
+        return f"# {self.title}\n\n{body}\n" if self.title else f"{body}\n"
+
+    def write(self, path: Path, section: bool = False) -> None:
+        """Write the document to ``path``; with ``section``, only between the markers (see ``write_section``)."""
+        if section:
+            write_section(path, self.text())
+        else:
+            path.parent.mkdir(parents=True, exist_ok=True)
+            path.write_text(self.text(), encoding="utf-8")
+
+
+def write_section(path: Path, text: str) -> None:
+    """Replace the benchmark section of ``path`` (between ``START`` and ``END``), or append it to the file."""
+    section = f"{START}\n{text.rstrip()}\n{END}"
+    old = path.read_text(encoding="utf-8") if path.exists() else ""
+    if START in old and END in old:
+        new = old[: old.index(START)] + section + old[old.index(END) + len(END) :]
+    else:
+        new = old + ("\n" if old else "") + section + "\n"
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text(new, encoding="utf-8")
