@@ -41,7 +41,7 @@ LAYERS: list[tuple[str, list[str]]] = [
     ("body", ["body"]),
     ("geometry", ["topology", "seams", "solid", "surface"]),
     ("load", ["load", "cad.read", "cad.occ"]),
-    ("mass geometry", ["mass.properties", "mass.geometry"]),
+    ("mass geometry", ["mass.properties", "mass.points", "mass.geometry"]),
     ("refinement", ["mass.refine"]),
     ("mass", ["mass", "mass.material", "cad"]),
     ("principal", ["principal"]),

@@ -10,7 +10,7 @@ import subprocess
 import sys
 import zipfile
 from pathlib import Path
-from typing import Any, cast
+from typing import Any
 
 import pytest
 
@@ -211,7 +211,7 @@ class _Rows:
         self.rows: list[dict[str, Any]] = []
 
     def write(self, row: Row) -> None:
-        self.rows.append(cast("dict[str, Any]", row))
+        self.rows.append(row.as_dict())
 
     def write_rendered(self, rendered: str) -> None:
         self.rows.append(json.loads(rendered))
