@@ -8,7 +8,8 @@
 
 from __future__ import annotations
 
-from typing import Any
+import math
+from typing import Any, cast
 
 import mpmath as mp
 import numpy as np
@@ -65,6 +66,24 @@ def ll_period(moments: Any, omega_body: Any) -> float:
         rate = mp.sqrt((I3 - I2) * (M2 - E2 * I1) / (I1 * I2 * I3))
         k2 = (I2 - I1) * (E2 * I3 - M2) / ((I3 - I2) * (M2 - E2 * I1))
         return float(4 * mp.ellipk(k2) / rate)
+
+
+def hat(w: Any) -> np.ndarray:
+    """The cross-product matrix [w]x: hat(w) @ v = w x v."""
+    return np.array([[0, -w[2], w[1]], [w[2], 0, -w[0]], [-w[1], w[0], 0]], dtype=float)
+
+
+def rotation(axis: Any, angle: float) -> np.ndarray:
+    """The rotation by ``angle`` about ``axis`` (Rodrigues' formula)."""
+    u = np.asarray(axis, float)
+    u = u / np.linalg.norm(u)
+    K = hat(u)
+    return cast("np.ndarray", np.eye(3) + math.sin(angle) * K + (1 - math.cos(angle)) * K @ K)
+
+
+def unit_quaternion_matrix(q: Any) -> np.ndarray:
+    """The rotation matrix of one quaternion [w, x, y, z], normalised first."""
+    return cast("np.ndarray", quaternion_matrix(np.asarray(q, float) / np.linalg.norm(q)))
 
 
 def quaternion_matrix(q: Any) -> Any:
