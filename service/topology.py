@@ -233,7 +233,7 @@ class SurfaceTopology:
     open_edges: int
     unbalanced_edges: int
     nonmanifold_edges: int
-    edge_faces: NDArray[np.int64]  # (k, 2) pairs of faces sharing a manifold edge
+    edge_faces: NDArray[np.signedinteger]  # (k, 2) pairs of faces sharing a manifold edge (int32 when that holds twice the faces)
     edge_same_direction: NDArray[np.bool_]  # (k,) the pair traverses the edge the same way
 
     @property
@@ -270,7 +270,8 @@ def surface_topology(faces: NDArray[np.int64], n_vertices: int) -> SurfaceTopolo
     first = starts[pair]
     del starts, pair
     # the two faces of each manifold edge, smaller index first; built in blocks to bound memory
-    edge_faces = np.empty((len(first), 2), dtype=np.int64)
+    pair_index = np.int32 if 2 * (m // 3) < 2**31 else np.int64  # half the memory of every later pass over the pairs
+    edge_faces = np.empty((len(first), 2), dtype=pair_index)
     for start in range(0, len(first), BLOCK):
         at = first[start : start + BLOCK]
         face_a = order[at]
@@ -338,26 +339,39 @@ def _edge_order(key: NDArray[np.uint64], key_bits: int) -> tuple[NDArray[np.int6
     bucket = (key >> np.uint64(low_bits)).astype(np.uint16)
     by_bucket = np.argsort(bucket, kind="stable")  # radix sort for 16-bit keys
     bounds = np.zeros((1 << spill) + 1, dtype=np.int64)
-    np.cumsum(np.bincount(bucket, minlength=1 << spill), out=bounds[1:])
+    if spill <= 4:  # a few buckets: counted in place (bincount would widen every id to intp first)
+        np.cumsum([np.count_nonzero(bucket == b) for b in range(1 << spill)], out=bounds[1:])
+    else:
+        np.cumsum(np.bincount(bucket, minlength=1 << spill), out=bounds[1:])
     del bucket
+    low = np.uint64((1 << low_bits) - 1)
+    index_mask = np.uint64((1 << index_bits) - 1)
     order = np.empty(m, dtype=np.int64)
     starts = []
     for b0, b1 in itertools.pairwise(bounds):
         if b1 == b0:
             continue
         sub = by_bucket[b0:b1]
-        part = key[sub] & np.uint64((1 << low_bits) - 1)
-        part <<= np.uint64(index_bits)
-        part |= sub.view(np.uint64)
+        part = np.empty(b1 - b0, dtype=np.uint64)
+        for start in range(0, len(part), BLOCK):  # the low key bits and the index, packed in blocks
+            block = part[start : start + BLOCK]
+            block[...] = key[sub[start : start + BLOCK]]
+            block &= low
+            block <<= np.uint64(index_bits)
+            block |= sub[start : start + BLOCK].view(np.uint64)
         part.sort()
-        diff = (part[1:] ^ part[:-1]) >> np.uint64(index_bits)
-        starts.append(b0 + np.flatnonzero(np.r_[True, diff != 0]))
-        part &= np.uint64((1 << index_bits) - 1)
+        same = np.empty(len(part) - 1, dtype=bool)
+        for start in range(0, len(part) - 1, BLOCK):
+            stop = min(len(part) - 1, start + BLOCK)
+            np.less_equal(part[start + 1 : stop + 1] ^ part[start:stop], index_mask, out=same[start:stop])
+        starts.append(b0 + np.flatnonzero(np.r_[True, ~same]))
+        for start in range(0, len(part), BLOCK):
+            part[start : start + BLOCK] &= index_mask
         order[b0:b1] = part.view(np.int64)
     return order, np.concatenate(starts)
 
 
-def _components(n: int, a: NDArray[np.int64], b: NDArray[np.int64]) -> tuple[int, NDArray[np.int64]]:
+def _components(n: int, a: NDArray[np.signedinteger], b: NDArray[np.signedinteger]) -> tuple[int, NDArray[np.int64]]:
     """Connected components of the undirected graph on n nodes with edges (a, b).
 
     Vectorised union-find: every edge hooks the larger of its two roots onto
@@ -402,7 +416,7 @@ def orient_consistently(faces: NDArray[np.int64], topo: SurfaceTopology) -> tupl
     surface.  Returns the re-wound faces and the number of flipped faces.
     """
     n = len(faces)
-    f1, f2 = topo.edge_faces[:, 0], topo.edge_faces[:, 1]
+    f1, f2 = topo.edge_faces[:, 0].astype(np.int64), topo.edge_faces[:, 1].astype(np.int64)
     flip = topo.edge_same_direction.astype(np.int64) * n
     rows = np.concatenate([f1, f1 + n])
     cols = np.concatenate([f2 + flip, f2 + n - flip])
