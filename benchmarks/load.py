@@ -220,7 +220,8 @@ def _row(p: Phase) -> str:
     return f"| {p.name} | {len(p.latencies)} | {p.rate:.0f} | {p.quantile(0.5):.1f} | {p.quantile(0.99):.1f} | {p.errors} |"
 
 
-async def measure(url: str, sampler: MemorySampler, seconds: float, rounds: int, clients: int, big: bytes) -> dict[str, object]:
+async def measure_pairs(url: str, sampler: MemorySampler, seconds: float, rounds: int, clients: int) -> list[tuple[Phase, Phase]]:
+    """Interleaved rounds of the bare route and 3-point requests, with the server's CPU time of each phase."""
     pid = sampler.pid
     pairs = []
     for k in range(rounds):  # interleaved, order alternating, so drift of the shared machine hits both
@@ -235,6 +236,11 @@ async def measure(url: str, sampler: MemorySampler, seconds: float, rounds: int,
             await _drive(url, got[name], fn, clients, seconds)
             got[name].cpu_s = _cpu_s(pid) - cpu
         pairs.append((got["bare"], got["points"]))
+    return pairs
+
+
+async def measure(url: str, sampler: MemorySampler, seconds: float, rounds: int, clients: int, big: bytes) -> dict[str, object]:
+    pairs = await measure_pairs(url, sampler, seconds, rounds, clients)
     sampler.phase = "small meshes"
     small = Phase("small meshes (box.stl)")
     await _drive(url, small, _box, clients, seconds)
@@ -355,8 +361,27 @@ def main() -> None:
     parser.add_argument("--rounds", type=int, default=3, help="interleaved bare/points rounds")
     parser.add_argument("--clients", type=int, default=8, help="concurrent clients (at most 64)")
     parser.add_argument("--doc", type=Path, default=ROOT / "docs" / "load.md")
+    parser.add_argument(
+        "--small-only", action="store_true", help="only the bare/points rounds, printed; docs/load.md is not written"
+    )
     args = parser.parse_args()
     args.clients = max(1, min(64, args.clients))
+    if args.small_only:
+        with running_server() as (url, proc):
+            sampler = MemorySampler(proc.pid)
+            sampler.start()
+            try:
+                pairs = asyncio.run(measure_pairs(url, sampler, args.seconds, args.rounds, args.clients))
+            finally:
+                sampler.done.set()
+                sampler.join()
+        for b, p in pairs:
+            print(_row(b) + f" {b.cpu_ms_per_request:.2f} |\n" + _row(p) + f" {p.cpu_ms_per_request:.2f} |")
+        print("throughput ratios", [round(p.rate / b.rate, 2) for b, p in pairs])
+        print("CPU ratios", [round(b.cpu_ms_per_request / p.cpu_ms_per_request, 2) for b, p in pairs])
+        print("load average", os.getloadavg())
+        return
+    args.load_before = os.getloadavg()
     big = _torus_stl(707, 707)  # 999,698 triangles
     start = time.monotonic()
     with running_server() as (url, proc):

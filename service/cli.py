@@ -24,8 +24,8 @@ import json
 import os
 import re
 import sys
-from collections.abc import Sequence
-from typing import Any
+from collections.abc import Callable, Sequence
+from typing import TYPE_CHECKING, Any
 
 from .errors import (
     DegenerateBodyError,
@@ -39,7 +39,12 @@ from .errors import (
 from .tolerances import DEFAULT_TOLERANCES
 from .vocabulary import METHODS, MODELS, ExportFormat, Geometry, Isotopes, Model, MotionMethod, values
 
+if TYPE_CHECKING:
+    from .sections import AnalysisDocument, PrecessionSection
+
 __all__ = ["main", "EXIT_CODES", "exit_code"]
+
+TensorRows = Callable[[str, Sequence[Sequence[float]]], list[tuple[str, str]]]
 
 EXIT_INTERNAL = 1
 EXIT_CODES: dict[type[ServiceError], int] = {
@@ -288,23 +293,22 @@ def exit_code(exc: ServiceError) -> int:
 def _analyze(args: argparse.Namespace) -> int:
     from .pipeline import analyze
 
-    result = analyze(args.file, options=options_from_args(args))
-    doc = result.as_dict()
+    document = analyze(args.file, options=options_from_args(args)).document()
     if getattr(args, "export", None) and not args.json:
-        print(export_text(doc))
-        for w in doc.get("warnings", []):
+        print(export_text(document))
+        for w in document.warnings:
             print(f"warning: {w}", file=sys.stderr)
         return 0
     if args.json:
         try:
-            text = json.dumps(doc, indent=2, allow_nan=False)
+            text = json.dumps(document.as_dict(), indent=2, allow_nan=False)
         except ValueError as exc:  # a non-finite number is a bug: say so, never print Infinity or NaN
             raise InvalidParameterError(
                 "the result holds a number that is not finite, which JSON cannot carry; please report the input"
             ) from exc
         print(text)
     else:
-        print(render_table(doc, args.output_units))
+        print(render_table(document, args.output_units))
     return 0
 
 
@@ -403,34 +407,38 @@ def _vec(v: Sequence[float]) -> str:
     return "[" + ", ".join(_fmt(x) for x in v) + "]"
 
 
-def export_text(doc: dict[str, Any]) -> str:
+def export_text(doc: AnalysisDocument) -> str:
     """The export snippet alone; for several parts, each part's after the whole body's, named in a comment."""
-    export = doc["export"]
-    blocks = [export["text"]]
-    for part in export.get("parts", []):
-        blocks.append(f"<!-- part {part['name'].replace('--', '- -')} -->\n{part['text']}")
+    export = doc.export
+    assert export is not None, "the analysis was asked for an export"
+    blocks = [export.text]
+    for part in export.parts or ():
+        blocks.append(f"<!-- part {part.name.replace('--', '- -')} -->\n{part.text}")
     return "\n".join(blocks)
 
 
-def _v11_rows(doc: dict[str, Any], length: Any, tensor_rows: Any) -> list[tuple[str, str]]:
+Rows = list[tuple[str, str]]
+
+
+def _v11_rows(doc: AnalysisDocument, length: Callable[[Sequence[float]], str], tensor_rows: TensorRows) -> Rows:
     """Rows of the API 1.1 sections: rotational constants and the named frame (in the table's units)."""
-    rows: list[tuple[str, str]] = []
-    rc = doc.get("rotational_constants")
+    rows: Rows = []
+    rc = doc.rotational_constants
     if rc is not None:
-        names = "B" if len(rc["MHz"]) == 1 else "A, B, C"
-        rows.append((f"rotational {names}", ", ".join(f"{v:.9g}" for v in rc["MHz"]) + " MHz"))
-        rows.append(("", ", ".join(f"{v:.9g}" for v in rc["cm-1"]) + " cm^-1"))
-    fr = doc.get("frame")
+        names = "B" if len(rc.MHz) == 1 else "A, B, C"
+        rows.append((f"rotational {names}", ", ".join(f"{v:.9g}" for v in rc.MHz) + " MHz"))
+        rows.append(("", ", ".join(f"{v:.9g}" for v in rc.cm_1) + " cm^-1"))
+    fr = doc.frame
     if fr is not None:
-        rows.append(("frame (w,x,y,z)", _vec(fr["quaternion"])))
-        rows.append(("  centre of mass", length(fr["center_of_mass"])))
-        rows += tensor_rows("  inertia tensor", fr["inertia_tensor"])
-        if "reference_inertia" in fr:
-            rows += tensor_rows("  about reference", fr["reference_inertia"])
+        rows.append(("frame (w,x,y,z)", _vec(fr.quaternion)))
+        rows.append(("  centre of mass", length(fr.center_of_mass)))
+        rows += tensor_rows("  inertia tensor", fr.inertia_tensor)
+        if fr.reference_inertia is not None:
+            rows += tensor_rows("  about reference", fr.reference_inertia)
     return rows
 
 
-def render_table(doc: dict[str, Any], output_units: str = "si") -> str:
+def render_table(doc: AnalysisDocument, output_units: str = "si") -> str:
     """A readable summary of an analysis result, in ``OUTPUT_UNITS[output_units]`` (SI by default)."""
     (ln, lu), (mn, mu) = OUTPUT_UNITS[output_units]
     inertia_unit = f"{mn} {ln}^2"
@@ -438,56 +446,49 @@ def render_table(doc: dict[str, Any], output_units: str = "si") -> str:
     def length(v: Sequence[float]) -> str:
         return f"{_vec([x / lu for x in v])} {ln}"
 
-    def tensor_rows(label: str, tensor: Sequence[Sequence[float]]) -> list[tuple[str, str]]:
+    def tensor_rows(label: str, tensor: Sequence[Sequence[float]]) -> Rows:
         scale = mu * lu * lu
         return [(label if i == 0 else "", f"{_vec([x / scale for x in row])} {inertia_unit}") for i, row in enumerate(tensor)]
 
-    src = doc["source"]
-    lines = [f"{src.get('filename', 'points')}  ({src['format']}, {src['kind']}, units {src['units']})"]
-    rows: list[tuple[str, str]] = [("mass", f"{_fmt(doc['mass'] / mu)} {mn}")]
-    if "volume" in doc:
-        rows.append(("volume", f"{_fmt(doc['volume'] / lu**3)} {ln}^3"))
-    if "density" in doc:
-        rows.append(("density", f"{_fmt(doc['density'] / mu * lu**3)} {mn}/{ln}^3"))
-    if "surface_area" in doc:
-        rows.append(("surface area", f"{_fmt(doc['surface_area'] / lu**2)} {ln}^2"))
-    rows.append(("centre of mass", length(doc["center_of_mass"])))
-    rows += tensor_rows("inertia tensor", doc["inertia_tensor"])
-    pr = doc["principal"]
-    rows.append(("principal moments", f"{_vec([x / (mu * lu * lu) for x in pr['moments']])} {inertia_unit}"))
-    for i, axis in enumerate(pr["axes"]):
+    src = doc.source
+    lines = [f"{src.filename if src.filename is not None else 'points'}  ({src.format}, {src.kind}, units {src.units})"]
+    rows: Rows = [("mass", f"{_fmt(doc.mass / mu)} {mn}")]
+    if doc.volume is not None:
+        rows.append(("volume", f"{_fmt(doc.volume / lu**3)} {ln}^3"))
+    if doc.density is not None:
+        rows.append(("density", f"{_fmt(doc.density / mu * lu**3)} {mn}/{ln}^3"))
+    if doc.surface_area is not None:
+        rows.append(("surface area", f"{_fmt(doc.surface_area / lu**2)} {ln}^2"))
+    rows.append(("centre of mass", length(doc.center_of_mass)))
+    rows += tensor_rows("inertia tensor", doc.inertia_tensor)
+    pr = doc.principal
+    rows.append(("principal moments", f"{_vec([x / (mu * lu * lu) for x in pr.moments])} {inertia_unit}"))
+    for i, axis in enumerate(pr.axes):
         rows.append((f"axis {i + 1}", _vec(axis)))
-    if "radii_of_gyration" in pr:
-        rows.append(("radii of gyration", length(pr["radii_of_gyration"])))
-    cls = doc["classification"]
-    kind = cls["kind"] + (f" ({cls['shape']})" if "shape" in cls else "")
-    rows.append(("class", kind))
-    if "asymmetry" in cls:
-        rows.append(("asymmetry kappa", _fmt(cls["asymmetry"])))
-    rows.append(("planar", str(cls["planar"]).lower()))
+    if pr.radii_of_gyration is not None:
+        rows.append(("radii of gyration", length(pr.radii_of_gyration)))
+    cls = doc.classification
+    rows.append(("class", cls.kind + (f" ({cls.shape})" if cls.shape is not None else "")))
+    if cls.asymmetry is not None:
+        rows.append(("asymmetry kappa", _fmt(cls.asymmetry)))
+    rows.append(("planar", str(cls.planar).lower()))
     rows += _v11_rows(doc, length, tensor_rows)
-    if "reference_inertia" in doc:
-        ref = doc["reference_inertia"]
-        rows += tensor_rows(f"tensor about {length(ref['point'])}", ref["tensor"])
-    if "precession" in doc:
-        rows += _motion_rows(doc["precession"], inertia_unit, mu * lu * lu)
-    if "parts" in doc:
-        for part in doc["parts"]:
-            moments = [x / (mu * lu * lu) for x in part["principal"]["moments"]]
-            rows.append((f"part {part['name']}", f"mass {_fmt(part['mass'] / mu)} {mn}, moments {_vec(moments)} {inertia_unit}"))
-    diag = doc["diagnostics"]
-    rows.append(("relative error", f"{diag['relative_error_estimate']:.2g}"))
-    if "tessellation_error" in diag:
-        rows.append(
-            (
-                "tessellation error",
-                f"{diag['tessellation_error']:.2g} vs the exact B-rep (deflection {doc['source'].get('deflection')})",
-            )
-        )
-    rows.append(("elapsed", f"{diag['elapsed_s'] * 1e3:.2f} ms"))
+    if doc.reference_inertia is not None:
+        ref = doc.reference_inertia
+        rows += tensor_rows(f"tensor about {length(ref.point)}", ref.tensor)
+    if doc.precession is not None:
+        rows += _motion_rows(doc.precession, inertia_unit, mu * lu * lu)
+    for part in doc.parts or ():
+        moments = [x / (mu * lu * lu) for x in part.principal.moments]
+        rows.append((f"part {part.name}", f"mass {_fmt(part.mass / mu)} {mn}, moments {_vec(moments)} {inertia_unit}"))
+    diag = doc.diagnostics
+    rows.append(("relative error", f"{diag.relative_error_estimate:.2g}"))
+    if diag.tessellation_error is not None:
+        rows.append(("tessellation error", f"{diag.tessellation_error:.2g} vs the exact B-rep (deflection {src.deflection})"))
+    rows.append(("elapsed", f"{diag.elapsed_s * 1e3:.2f} ms"))
     width = max(len(k) for k, _ in rows)
     lines += [f"  {k:<{width}}  {v}" for k, v in rows]
-    lines += [f"  warning: {w}" for w in doc.get("warnings", [])]
+    lines += [f"  warning: {w}" for w in doc.warnings]
     return "\n".join(lines)
 
 
@@ -504,12 +505,13 @@ _MOTION_UNITS = {
 }
 
 
-def _motion_rows(pc: dict[str, Any], inertia_unit: str, inertia_scale: float) -> list[tuple[str, str]]:
+def _motion_rows(pc: PrecessionSection, inertia_unit: str, inertia_scale: float) -> Rows:
     """|M| in (inertia unit)/s and E in (inertia unit)/s^2 (J in SI); rates, angles and times in SI."""
     scaled = {"momentum": f"{inertia_unit}/s", "energy": "J" if inertia_unit == "kg m^2" else f"{inertia_unit}/s^2"}
-    rows = [("precession", pc.get("regime", ""))]
+    rows = [("precession", pc.regime.value)]
     for key, unit in _MOTION_UNITS.items():
-        if key in pc:
-            value = pc[key] / inertia_scale if unit in scaled else pc[key]
-            rows.append((key.replace("_", " "), f"{_fmt(value)} {scaled.get(unit, unit)}"))
+        value: float | None = getattr(pc, key)
+        if value is not None:
+            shown = value / inertia_scale if unit in scaled else value
+            rows.append((key.replace("_", " "), f"{_fmt(shown)} {scaled.get(unit, unit)}"))
     return rows

@@ -61,9 +61,10 @@ def _safe_exponent(a: NDArray[np.float64]) -> int:
 
 
 def _off_diagonal_negligible(a: NDArray[np.float64], rel: float) -> bool:
+    t = a.tolist()  # Python floats: the same IEEE products and correctly rounded sqrt, without numpy's scalar overhead
     for p, q in _PAIRS:
-        scale = np.sqrt(abs(a[p, p] * a[q, q]))
-        if abs(a[p, q]) > rel * scale and a[p, q] != 0.0:
+        scale = math.sqrt(abs(t[p][p] * t[q][q]))
+        if abs(t[p][q]) > rel * scale and t[p][q] != 0.0:
             return False
     return True
 

@@ -1,11 +1,12 @@
 """The result model: what one analysis computed, and its one serialiser to the API's JSON.
 
 Every section the contract returns (API.md, "The analysis result" and
-"Additions, version 1.1") is a field here, typed; ``as_dict()`` writes the
-sections present and only those (absent means "not asked for", never null).
-The HTTP response models (``api/schemas.py``), the CLI table and the batch
-rows are all built from ``as_dict()``: there is no second description of the
-JSON to drift from this one.
+"Additions, version 1.1") is a field here, typed.  ``document()`` turns a
+result into its typed JSON (``sections.AnalysisDocument``: one frozen
+dataclass per JSON object, absent sections None) and ``as_dict()`` into the
+JSON itself.  The HTTP response models (``api/schemas.py``) are generated from
+those dataclasses, and the CLI table and the batch rows read the document:
+there is no second description of the JSON to drift from this one.
 
 This module imports no stage that computes anything: results serialise
 without knowing the pipeline that made them.
@@ -14,7 +15,7 @@ without knowing the pipeline that made them.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, fields
+from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -22,7 +23,21 @@ import numpy as np
 from .classification import Classification
 from .mass import InertiaTensor, MassProperties
 from .principal import PrincipalFrame
-from .vocabulary import SourceKind, UnitsFrom
+from .sections import (
+    AnalysisDocument,
+    ClassificationSection,
+    Diagnostics,
+    ExportPartSection,
+    ExportSection,
+    FrameSection,
+    PartSection,
+    PrecessionDocument,
+    PrincipalSection,
+    ReferenceInertiaSection,
+    RotationalConstantsSection,
+    Source,
+)
+from .vocabulary import ExportFormat, RotorKind, RotorShape
 
 if TYPE_CHECKING:
     from .export import Snippet
@@ -36,104 +51,14 @@ __all__ = [
     "PartResult",
     "AnalysisResult",
     "PrecessionResult",
+    "analysis_document",
+    "precession_document",
     "analysis_dict",
     "precession_dict",
     "principal_dict",
     "classification_dict",
     "radii_of_gyration",
 ]
-
-
-@dataclass(frozen=True, slots=True, kw_only=True)
-class Source:
-    """The ``source`` section: what was read, how, and how many elements it had.
-
-    filename : the client's file name (absent for in-memory input without one).
-    format : the reader's format name (``stl``, ``step``, ``points``, ...).
-    kind : ``mesh``, ``volume``, ``points`` or ``cad``.
-    units : the length unit applied to the file; units_from : ``request``, ``file`` or ``default``.
-    geometry, solids, deflection : CAD files (``brep`` or ``mesh``; solids read; relative chordal deflection).
-    vertices, triangles, watertight : surfaces (distinct vertices, triangles, closed) and tessellated CAD.
-    points : point masses, or the nodes of a volume mesh; tetrahedra, cells : volume meshes.
-    parts : the number of parts of a scene or assembly (absent for one body).
-    """
-
-    filename: str | None = None
-    format: str
-    kind: SourceKind
-    units: str
-    units_from: UnitsFrom
-    vertices: int | None = None
-    triangles: int | None = None
-    watertight: bool | None = None
-    points: int | None = None
-    tetrahedra: int | None = None
-    cells: int | None = None
-    geometry: str | None = None
-    solids: int | None = None
-    deflection: float | None = None
-    parts: int | None = None
-
-    # the order of the keys in the JSON: the identity, then what the kind of input counts
-    _ORDER = (
-        "filename",
-        "format",
-        "kind",
-        "units",
-        "units_from",
-        "vertices",
-        "triangles",
-        "watertight",
-        "points",
-        "tetrahedra",
-        "cells",
-        "parts",
-    )
-    _CAD_ORDER = (
-        "filename",
-        "format",
-        "kind",
-        "units",
-        "units_from",
-        "geometry",
-        "solids",
-        "watertight",
-        "deflection",
-        "vertices",
-        "triangles",
-        "parts",
-    )
-
-    def as_dict(self) -> dict[str, Any]:
-        order = self._CAD_ORDER if self.kind == SourceKind.CAD else self._ORDER
-        out = {key: getattr(self, key) for key in order if getattr(self, key) is not None}
-        out["kind"], out["units_from"] = self.kind.value, self.units_from.value  # plain strings in the JSON
-        return out
-
-
-# the JSON keys of the source section, for the response schema
-SOURCE_KEYS = tuple(f.name for f in fields(Source))
-
-
-@dataclass(frozen=True, slots=True)
-class Diagnostics:
-    """The ``diagnostics`` section.
-
-    elapsed_s : [s] wall time of the whole analysis.
-    relative_error_estimate : [1] bound on the relative floating-point error of the principal moments.
-    tessellation_error : [1] CAD with geometry=mesh: the largest relative difference of mass and principal
-        moments between the tessellation and the exact B-rep (None otherwise).
-    """
-
-    elapsed_s: float
-    relative_error_estimate: float
-    tessellation_error: float | None = None
-
-    def as_dict(self) -> dict[str, Any]:
-        out: dict[str, Any] = {"elapsed_s": float(self.elapsed_s), "relative_error_estimate": float(self.relative_error_estimate)}
-        if self.tessellation_error is not None:
-            out["tessellation_error"] = float(self.tessellation_error)
-        return out
 
 
 @dataclass(frozen=True, slots=True)
@@ -148,7 +73,7 @@ class PartResult:
     export: Snippet | None = None
 
     def as_dict(self) -> dict[str, Any]:
-        return _part_dict(self)
+        return _part_section(self).as_dict()
 
 
 @dataclass(frozen=True, slots=True)
@@ -177,6 +102,10 @@ class AnalysisResult:
     def tessellation_error(self) -> float | None:
         return self.diagnostics.tessellation_error
 
+    def document(self) -> AnalysisDocument:
+        """The typed JSON of this result."""
+        return analysis_document(self)
+
     def as_dict(self) -> dict[str, Any]:
         return analysis_dict(self)
 
@@ -199,6 +128,10 @@ class PrecessionResult:
     def elapsed_s(self) -> float:
         return self.diagnostics.elapsed_s
 
+    def document(self) -> PrecessionDocument:
+        """The typed JSON of this result."""
+        return precession_document(self)
+
     def as_dict(self) -> dict[str, Any]:
         return precession_dict(self)
 
@@ -215,107 +148,124 @@ def radii_of_gyration(moments: Any, mass: float) -> list[float]:
     return [math.sqrt(max(float(i), 0.0) / mass) for i in moments]
 
 
+def principal_section(frame: PrincipalFrame, mass: float | None = None) -> PrincipalSection:
+    return PrincipalSection(
+        moments=_list(frame.moments),
+        axes=_list(frame.axes),
+        quaternion=_list(frame.quaternion),
+        unique_axes=bool(frame.unique_axes),
+        radii_of_gyration=radii_of_gyration(frame.moments, mass) if mass is not None and mass > 0 else None,
+    )
+
+
 def principal_dict(frame: PrincipalFrame, mass: float | None = None) -> dict[str, Any]:
-    out: dict[str, Any] = {
-        "moments": _list(frame.moments),
-        "axes": _list(frame.axes),
-        "quaternion": _list(frame.quaternion),
-        "unique_axes": bool(frame.unique_axes),
-    }
-    if mass is not None and mass > 0:
-        out["radii_of_gyration"] = radii_of_gyration(frame.moments, mass)
-    return out
+    return principal_section(frame, mass).as_dict()
+
+
+def classification_section(cls: Classification) -> ClassificationSection:
+    return ClassificationSection(
+        kind=RotorKind(cls.kind),
+        shape=None if cls.shape is None else RotorShape(cls.shape),
+        symmetry_axis=None if cls.symmetry_axis is None else _list(cls.symmetry_axis),
+        asymmetry=None if cls.asymmetry is None else float(cls.asymmetry),
+        planar=bool(cls.planar),
+        tolerance=float(cls.tolerance),
+    )
 
 
 def classification_dict(cls: Classification) -> dict[str, Any]:
-    out: dict[str, Any] = {"kind": cls.kind}
-    if cls.shape is not None:
-        out["shape"] = cls.shape
-    if cls.symmetry_axis is not None:
-        out["symmetry_axis"] = _list(cls.symmetry_axis)
-    if cls.asymmetry is not None:
-        out["asymmetry"] = float(cls.asymmetry)
-    out["planar"] = bool(cls.planar)
-    out["tolerance"] = float(cls.tolerance)
-    return out
+    return classification_section(cls).as_dict()
 
 
-def _body_dict(p: MassProperties) -> dict[str, Any]:
+def _body(p: MassProperties) -> dict[str, Any]:
     """mass, volume, density (solids only, API.md), area (shells), centre of mass, tensor."""
-    out: dict[str, Any] = {"mass": p.mass}
-    if p.volume is not None:
-        out["volume"] = p.volume
-        if p.density is not None:
-            out["density"] = p.density
-    if p.area is not None:
-        out["area"] = p.area
-    out["center_of_mass"] = _list(p.center_of_mass)
-    out["inertia_tensor"] = _list(p.inertia.matrix)
-    return out
+    return {
+        "mass": p.mass,
+        "volume": p.volume,
+        "density": p.density if p.volume is not None else None,
+        "area": p.area,
+        "center_of_mass": _list(p.center_of_mass),
+        "inertia_tensor": _list(p.inertia.matrix),
+    }
 
 
-def _part_dict(part: PartResult) -> dict[str, Any]:
+def _part_section(part: PartResult) -> PartSection:
     p = part.props
-    out: dict[str, Any] = {"name": part.name, **_body_dict(p)}
-    if part.surface_area is not None:
-        out["surface_area"] = float(part.surface_area)
-    out["principal"] = principal_dict(part.frame, p.mass)
-    out["classification"] = classification_dict(part.classification)
-    if p.warnings:
-        out["warnings"] = list(p.warnings)
-    return out
+    return PartSection(
+        name=part.name,
+        **_body(p),
+        surface_area=None if part.surface_area is None else float(part.surface_area),
+        principal=principal_section(part.frame, p.mass),
+        classification=classification_section(part.classification),
+        warnings=list(p.warnings) if p.warnings else None,
+    )
+
+
+def analysis_document(result: AnalysisResult) -> AnalysisDocument:
+    """The analysis result of the contract (API.md, "The analysis result"), typed."""
+    p = result.props
+    ref = result.reference
+    parts = result.parts
+    return AnalysisDocument(
+        source=result.source,
+        **_body(p),
+        reference_inertia=None if ref is None else ReferenceInertiaSection(point=_list(ref.point), tensor=_list(ref.matrix)),
+        surface_area=None if result.surface_area is None else float(result.surface_area),
+        principal=principal_section(result.frame, p.mass),
+        classification=classification_section(result.classification),
+        rotational_constants=_rotational_section(result),
+        frame=_frame_section(result),
+        export=_export_section(result),
+        precession=None if result.motion is None else result.motion.section(),
+        parts=None if parts is None else [_part_section(part) for part in parts],
+        warnings=list(result.warnings),
+        diagnostics=result.diagnostics,
+    )
 
 
 def analysis_dict(result: AnalysisResult) -> dict[str, Any]:
     """The analysis result of the contract (API.md, "The analysis result")."""
-    p = result.props
-    out: dict[str, Any] = {"source": result.source.as_dict(), **_body_dict(p)}
-    if result.reference is not None:
-        out["reference_inertia"] = {"point": _list(result.reference.point), "tensor": _list(result.reference.matrix)}
-    if result.surface_area is not None:
-        out["surface_area"] = float(result.surface_area)
-    out["principal"] = principal_dict(result.frame, p.mass)
-    out["classification"] = classification_dict(result.classification)
-    out.update(_v11_dict(result))
-    if result.motion is not None:
-        out["precession"] = result.motion.as_dict()
-    if result.parts is not None:
-        out["parts"] = [_part_dict(part) for part in result.parts]
-        if result.export is not None:
-            out["export"]["parts"] = [
-                {"name": part.name, "text": part.export.text} for part in result.parts if part.export is not None
-            ]
-    out["warnings"] = list(result.warnings)
-    out["diagnostics"] = result.diagnostics.as_dict()
-    return out
+    return analysis_document(result).as_dict()
 
 
-def _v11_dict(result: AnalysisResult) -> dict[str, Any]:
-    """rotational_constants, frame and export (API.md, "Additions, version 1.1")."""
-    out: dict[str, Any] = {}
+def _rotational_section(result: AnalysisResult) -> RotationalConstantsSection | None:
     rc = result.rotational_constants
-    if rc is not None:
-        out["rotational_constants"] = {"MHz": list(rc.mhz), "cm-1": list(rc.wavenumber)}
+    return None if rc is None else RotationalConstantsSection(MHz=list(rc.mhz), cm_1=list(rc.wavenumber))
+
+
+def _frame_section(result: AnalysisResult) -> FrameSection | None:
     nf = result.named_frame
-    if nf is not None:
-        out["frame"] = {
-            "quaternion": _list(nf.quaternion),
-            "center_of_mass": _list(nf.center_of_mass),
-            "inertia_tensor": _list(nf.inertia_tensor),
-        }
-        if nf.reference_inertia is not None:
-            out["frame"]["reference_inertia"] = _list(nf.reference_inertia)
-    if result.export is not None:
-        out["export"] = {"format": result.export.format, "text": result.export.text}
-    return out
+    if nf is None:
+        return None
+    return FrameSection(
+        quaternion=_list(nf.quaternion),
+        center_of_mass=_list(nf.center_of_mass),
+        inertia_tensor=_list(nf.inertia_tensor),
+        reference_inertia=None if nf.reference_inertia is None else _list(nf.reference_inertia),
+    )
+
+
+def _export_section(result: AnalysisResult) -> ExportSection | None:
+    """The robot export (API.md, "Additions, version 1.1"): the whole body's element, and each part's."""
+    if result.export is None:
+        return None
+    parts = None
+    if result.parts is not None:
+        parts = [ExportPartSection(name=part.name, text=part.export.text) for part in result.parts if part.export is not None]
+    return ExportSection(format=ExportFormat(result.export.format), text=result.export.text, parts=parts)
+
+
+def precession_document(result: PrecessionResult) -> PrecessionDocument:
+    """The response of POST /v1/precession, typed."""
+    return PrecessionDocument(
+        principal=principal_section(result.frame),
+        classification=classification_section(result.classification),
+        precession=result.motion.section(),
+        warnings=list(result.warnings),
+        diagnostics=result.diagnostics,
+    )
 
 
 def precession_dict(result: PrecessionResult) -> dict[str, Any]:
     """The response of POST /v1/precession."""
-    return {
-        "principal": principal_dict(result.frame),
-        "classification": classification_dict(result.classification),
-        "precession": result.motion.as_dict(),
-        "warnings": list(result.warnings),
-        "diagnostics": result.diagnostics.as_dict(),
-    }
+    return precession_document(result).as_dict()

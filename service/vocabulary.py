@@ -19,6 +19,9 @@ __all__ = [
     "ExportFormat",
     "SourceKind",
     "UnitsFrom",
+    "Regime",
+    "RotorKind",
+    "RotorShape",
     "MODELS",
     "METHODS",
     "values",
@@ -85,6 +88,33 @@ class UnitsFrom(enum.StrEnum):
     REQUEST = "request"
     FILE = "file"
     DEFAULT = "default"
+
+
+class Regime(enum.Enum):
+    """The API's ``precession.regime``."""
+
+    REST = "rest"
+    PERMANENT_ROTATION = "permanent_rotation"
+    SPHERICAL = "spherical"
+    REGULAR_PRECESSION = "regular_precession"
+    ASYMMETRIC = "asymmetric"
+    ROTATOR = "rotator"
+
+
+class RotorKind(enum.StrEnum):
+    """The API's ``classification.kind``."""
+
+    SPHERICAL_TOP = "spherical_top"
+    SYMMETRIC_TOP = "symmetric_top"
+    ASYMMETRIC_TOP = "asymmetric_top"
+    LINEAR_ROTATOR = "linear_rotator"
+
+
+class RotorShape(enum.StrEnum):
+    """The API's ``classification.shape`` of a symmetric top."""
+
+    PROLATE = "prolate"
+    OBLATE = "oblate"
 
 
 def values(members: type[enum.Enum]) -> tuple[str, ...]:

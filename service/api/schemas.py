@@ -1,12 +1,12 @@
 """Every pydantic model of the HTTP API: requests and responses, both strict.
 
-Requests forbid unknown fields and non-finite numbers. Responses are the
-result model's one serialisation (``inertia.results``, ``as_dict``), each
-section a model that forbids keys it does not name, so a response the
-service sends is one the OpenAPI schema describes (a key added to the result
-model and not here fails every response that carries it, in the tests).
-The ``source`` and ``diagnostics`` models are generated from the result
-model's own dataclasses. Sections appear only when present (absent, never null).
+Requests forbid unknown fields and non-finite numbers; their closed sets and
+defaults come from ``vocabulary`` and ``AnalysisOptions``. Responses are the
+result model's one serialisation (``inertia.results``, ``as_dict``): their
+models are generated from the result model's sections (``inertia.sections``),
+each forbidding keys it does not name, so a response the service sends is one
+the OpenAPI schema describes, and a field added to a section is added to the
+schema with it. Sections appear only when present (absent, never null).
 Every error status is documented with the envelope and an example.
 """
 
@@ -15,14 +15,15 @@ from __future__ import annotations
 import enum
 import json
 import math
+import types
 from dataclasses import MISSING, fields
-from typing import TYPE_CHECKING, Annotated, Any, Literal, TypeAlias, get_type_hints
+from typing import TYPE_CHECKING, Annotated, Any, Literal, TypeAlias, Union, get_args, get_origin, get_type_hints
 
 from pydantic import BaseModel, ConfigDict, Field, create_model, model_validator
 
 from ..errors import InvalidParameterError, envelope
 from ..options import DEFAULT_OPTIONS, AnalysisOptions
-from ..results import Diagnostics, Source
+from ..sections import AnalysisDocument, PrecessionDocument, PrecessionSection, Section, Size
 from ..vocabulary import ExportFormat, Geometry, Isotopes, MassUnit, Model, MotionMethod, values
 from .settings import MIN_SAMPLES, max_samples
 
@@ -299,147 +300,54 @@ class _Out(BaseModel):
     model_config = ConfigDict(extra="forbid")
 
 
-def _from_dataclass(cls: type, name: str, doc: str) -> type[BaseModel]:
-    """A response model with exactly the fields of one of the result model's dataclasses (each optional
-    where the dataclass has a default: the serialiser leaves such a field out when it is None)."""
-    hints = get_type_hints(cls)
-    spec: dict[str, Any] = {}
-    for f in fields(cls):
-        required = f.default is MISSING and f.default_factory is MISSING
-        hint = hints[f.name]
-        if isinstance(hint, type) and issubclass(hint, enum.Enum):  # a closed set: its strings, inline
-            hint = _choice(hint)
-        spec[f.name] = (hint, ... if required else None)
-    model: type[BaseModel] = create_model(name, __base__=_Out, __doc__=doc, **spec)
+# the response models of the result model's sections (``inertia.sections``), generated from their fields:
+# the same names, types, descriptions and optional keys; a model per section, named after it
+_NAMES: dict[type, str] = {PrecessionDocument: "PrecessionResponse"}
+_GENERATED: dict[type, type[BaseModel]] = {}
+
+
+def response_model(section: type[Section]) -> type[BaseModel]:
+    """The pydantic model of a section of the result model: a field per dataclass field (optional where the
+    dataclass defaults it to None, since the serialiser leaves such a key out), keyed as the JSON is."""
+    model = _GENERATED.get(section)
+    if model is None:
+        hints = get_type_hints(section, include_extras=True)
+        spec: dict[str, Any] = {}
+        for f in fields(section):  # type: ignore[arg-type]  # every Section is a dataclass
+            required = f.default is MISSING and f.default_factory is MISSING
+            description, key = f.metadata.get("description") or None, f.metadata.get("key")
+            info = Field(description=description, alias=key) if required else Field(None, description=description, alias=key)
+            spec[f.name] = (_pydantic_type(hints[f.name]), info)
+        name = _NAMES.get(section) or section.__name__.removesuffix("Section").removesuffix("Document") + "Out"
+        summary = (section.__doc__ or "").split("\n\n")[0].strip().replace("``", "") or None
+        model = _GENERATED[section] = create_model(name, __base__=_Out, __doc__=summary, **spec)
     return model
 
 
-SourceOut = _from_dataclass(Source, "SourceOut", "What was read, how, and how many elements it had (inertia.results.Source).")
-DiagnosticsOut = _from_dataclass(
-    Diagnostics,
-    "DiagnosticsOut",
-    "Elapsed time [s] and the relative error estimate of the principal moments [1] (inertia.results.Diagnostics).",
-)
+def _pydantic_type(hint: Any) -> Any:
+    """A section field's type for pydantic: arrays of a ``Size`` get that length, closed sets their strings,
+    nested sections their generated models."""
+    origin = get_origin(hint)
+    if origin is Annotated:
+        base, *extras = get_args(hint)
+        sizes = [m.n for m in extras if isinstance(m, Size)]
+        inner = _pydantic_type(base)
+        return Annotated[inner, Field(min_length=sizes[0], max_length=sizes[0])] if sizes else inner
+    if origin is Union or origin is types.UnionType:
+        return Union[tuple(_pydantic_type(a) for a in get_args(hint))]  # noqa: UP007  (built at run time)
+    if origin is list:
+        (item,) = get_args(hint)
+        return list[_pydantic_type(item)]  # type: ignore[misc]
+    if isinstance(hint, type) and issubclass(hint, enum.Enum):
+        return _choice(hint)
+    if isinstance(hint, type) and issubclass(hint, Section):
+        return response_model(hint)
+    return hint
 
 
-class ReferenceInertiaOut(_Out):
-    point: Vector = Field(description="reference point [m], input frame")
-    tensor: Tensor = Field(description="inertia about the point [kg m^2]")
-
-
-class PrincipalOut(_Out):
-    moments: Vector = Field(description="ascending principal moments [kg m^2]")
-    axes: Tensor = Field(description="rows: unit principal axes in the input frame")
-    quaternion: Quaternion = Field(description="[w, x, y, z]: principal frame -> input frame")
-    unique_axes: bool
-    radii_of_gyration: Vector | None = Field(None, description="k_i = sqrt(I_i / m) [m]")
-
-
-class ClassificationOut(_Out):
-    kind: Literal["spherical_top", "symmetric_top", "asymmetric_top", "linear_rotator"]
-    shape: Literal["prolate", "oblate"] | None = None
-    symmetry_axis: Vector | None = None
-    asymmetry: float | None = Field(None, description="Ray's kappa")
-    planar: bool
-    tolerance: float
-
-
-class TrajectoryOut(_Out):
-    t: list[float] = Field(description="times [s]")
-    omega_body: list[Vector] = Field(description="angular velocity in the principal frame [rad/s]")
-    omega: list[Vector] = Field(description="angular velocity in the input frame [rad/s]")
-    quaternion: list[Quaternion] = Field(description="attitude relative to t = 0, [w, x, y, z]")
-
-
-class MotionDiagnosticsOut(_Out):
-    elapsed_s: float = Field(description="[s]")
-    energy_drift: float | None = Field(None, description="max |E(t) - E(0)| / E(0) over the trajectory [1]")
-    momentum_drift: float | None = Field(None, description="max |M(t) - M(0)| / |M(0)| over the trajectory [1]")
-
-
-class PrecessionOut(_Out):
-    regime: Literal["rest", "permanent_rotation", "spherical", "regular_precession", "asymmetric", "rotator"]
-    angular_momentum: Vector = Field(description="[kg m^2/s], input frame")
-    angular_momentum_magnitude: float = Field(description="[kg m^2/s]")
-    kinetic_energy: float = Field(description="[J]")
-    omega_body: Vector = Field(description="initial angular velocity, principal frame [rad/s]")
-    body_precession_rate: float | None = Field(None, description="[rad/s]")
-    space_precession_rate: float | None = Field(None, description="[rad/s]")
-    spin_rate: float | None = Field(None, description="[rad/s]")
-    nutation_angle: float | None = Field(None, description="[rad]")
-    period: float | None = Field(None, description="[s]")
-    stable: bool | None = None
-    flip_interval: float | None = Field(None, description="[s]")
-    trajectory: TrajectoryOut | None = None
-    diagnostics: MotionDiagnosticsOut
-
-
-class PartOut(_Out):
-    name: str
-    mass: float = Field(description="[kg]")
-    volume: float | None = Field(None, description="[m^3], solids only")
-    density: float | None = Field(None, description="[kg/m^3], solids of one density")
-    area: float | None = Field(None, description="[m^2], thin shells: the area that carries the mass")
-    center_of_mass: Vector = Field(description="[m], scene frame")
-    inertia_tensor: Tensor = Field(description="about the part's own centre of mass [kg m^2]")
-    surface_area: float | None = Field(None, description="[m^2]")
-    principal: PrincipalOut
-    classification: ClassificationOut
-    warnings: list[str] | None = None
-
-
-class RotationalConstantsOut(_Out):
-    MHz: list[float] = Field(description="A >= B >= C [MHz]; B alone for a linear molecule")
-    cm_1: list[float] = Field(alias="cm-1", description="A >= B >= C [cm^-1]; B alone for a linear molecule")
-
-
-class FrameOut(_Out):
-    quaternion: Quaternion = Field(description="[w, x, y, z]: the named frame's axes -> input frame")
-    center_of_mass: Vector = Field(description="[m], along the named axes, from the input origin or the reference")
-    inertia_tensor: Tensor = Field(description="about the centre of mass [kg m^2], named-frame axes")
-    reference_inertia: Tensor | None = Field(None, description="about the reference point [kg m^2], named-frame axes")
-
-
-class ExportPartOut(_Out):
-    name: str
-    text: str
-
-
-class ExportOut(_Out):
-    format: ExportName
-    text: str = Field(description="the format's inertial element, SI units, 17 significant digits")
-    parts: list[ExportPartOut] | None = None
-
-
-class AnalysisOut(_Out):
-    """One analysis result (API.md); sections appear only when asked for."""
-
-    source: SourceOut  # type: ignore[valid-type]
-    mass: float = Field(description="[kg]")
-    volume: float | None = Field(None, description="[m^3], solids only")
-    density: float | None = Field(None, description="[kg/m^3], solids only")
-    area: float | None = Field(None, description="[m^2], thin shells: the area that carries the mass")
-    center_of_mass: Vector = Field(description="[m], input frame")
-    inertia_tensor: Tensor = Field(description="about the centre of mass [kg m^2], input frame")
-    reference_inertia: ReferenceInertiaOut | None = None
-    surface_area: float | None = Field(None, description="[m^2], surface meshes and CAD solids")
-    principal: PrincipalOut
-    classification: ClassificationOut
-    rotational_constants: RotationalConstantsOut | None = None
-    frame: FrameOut | None = None
-    export: ExportOut | None = None
-    precession: PrecessionOut | None = None
-    parts: list[PartOut] | None = None
-    warnings: list[str]
-    diagnostics: DiagnosticsOut  # type: ignore[valid-type]
-
-
-class PrecessionResponse(_Out):
-    principal: PrincipalOut
-    classification: ClassificationOut
-    precession: PrecessionOut
-    warnings: list[str]
-    diagnostics: DiagnosticsOut  # type: ignore[valid-type]
+AnalysisOut = response_model(AnalysisDocument)
+PrecessionResponse = response_model(PrecessionDocument)
+PrecessionOut = response_model(PrecessionSection)
 
 
 class ErrorBody(_Out):

@@ -1,9 +1,10 @@
 """One result row per input file, as a JSON line or as a flat table row.
 
-A JSON line is exactly what ``POST /v1/batch`` streams: the analysis result of
-the contract (``AnalysisResult.as_dict()``), or ``{"source": {"filename":
-name}, "error": {...}}`` for a file that failed.  ``source.filename`` is the
-input's name, the key ``--resume`` uses.
+A row is typed: the analysis result's document (``sections.AnalysisDocument``)
+or an :class:`ErrorRow`.  Its JSON line (``as_dict()``) is exactly what
+``POST /v1/batch`` streams: the analysis result of the contract, or
+``{"source": {"filename": name}, "error": {...}}`` (the envelope) for a file
+that failed.  ``source.filename`` is the input's name, the key ``--resume`` uses.
 
 A flat row (CSV, Parquet) has the columns of :data:`COLUMNS`, all SI:
 ``mass`` kg, ``volume`` m^3 (empty for shells and points), ``com_*`` m, the six
@@ -20,11 +21,15 @@ asymmetry (empty where the contract leaves it out), ``warnings`` joined by
 
 from __future__ import annotations
 
-from typing import Any
+import json
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import Any, TypeAlias
 
-from ..errors import ServiceError
+from ..errors import ServiceError, envelope
+from ..sections import AnalysisDocument
 
-__all__ = ["COLUMNS", "FLOAT_COLUMNS", "error_row", "flat_row", "row_name"]
+__all__ = ["COLUMNS", "FLOAT_COLUMNS", "ErrorRow", "Row", "error_row", "flat_row", "row_name"]
 
 COLUMNS = (
     "name",
@@ -68,9 +73,27 @@ _AXES = tuple(f"axis{i}_{c}" for i in (1, 2, 3) for c in "xyz")
 _TENSOR = (("Ixx", 0, 0), ("Iyy", 1, 1), ("Izz", 2, 2), ("Ixy", 0, 1), ("Ixz", 0, 2), ("Iyz", 1, 2))
 
 
-def error_row(name: str, error: ServiceError) -> dict[str, Any]:
-    """The JSON line of a file that failed: the API's error envelope plus its name."""
-    return {"source": {"filename": name}, **error.as_dict()}
+@dataclass(frozen=True, slots=True)
+class ErrorRow:
+    """The row of a file that failed: its name and the error of the envelope."""
+
+    name: str
+    code: str
+    message: str
+    details: Mapping[str, Any]
+
+    def as_dict(self) -> dict[str, Any]:
+        """The JSON line: the API's error envelope plus the file's name."""
+        return {"source": {"filename": self.name}, **envelope(self.code, self.message, self.details)}
+
+
+Row: TypeAlias = AnalysisDocument | ErrorRow
+
+
+def error_row(name: str, error: ServiceError) -> ErrorRow:
+    """The row of a file that failed; details become plain JSON (they may hold numpy scalars or paths)."""
+    details: dict[str, Any] = json.loads(json.dumps(error.details, default=str))
+    return ErrorRow(name, error.code, error.message, details)
 
 
 def row_name(row: dict[str, Any]) -> str:
@@ -78,28 +101,27 @@ def row_name(row: dict[str, Any]) -> str:
     return str(row["source"]["filename"])
 
 
-def flat_row(row: dict[str, Any]) -> dict[str, Any]:
-    """The CSV/Parquet row of a JSON line; missing values are None."""
+def flat_row(row: Row) -> dict[str, Any]:
+    """The CSV/Parquet row of a row; missing values are None."""
     out: dict[str, Any] = dict.fromkeys(COLUMNS)
-    out["name"] = row_name(row)
-    if "error" in row:
-        err = row["error"]
-        out["error"] = f"{err['code']}: {err['message']}"
+    if isinstance(row, ErrorRow):
+        out["name"] = row.name
+        out["error"] = f"{row.code}: {row.message}"
         return out
-    out["format"] = row["source"].get("format")
-    out["mass"] = row["mass"]
-    out["volume"] = row.get("volume")
-    out["com_x"], out["com_y"], out["com_z"] = row["center_of_mass"]
-    tensor = row["inertia_tensor"]
+    out["name"] = row.source.filename
+    out["format"] = row.source.format
+    out["mass"] = row.mass
+    out["volume"] = row.volume
+    out["com_x"], out["com_y"], out["com_z"] = row.center_of_mass
+    tensor = row.inertia_tensor
     for column, i, j in _TENSOR:
         out[column] = tensor[i][j]
-    principal = row["principal"]
-    out["I1"], out["I2"], out["I3"] = principal["moments"]
-    out.update(zip(_AXES, (x for axis in principal["axes"] for x in axis)))
-    out["q_w"], out["q_x"], out["q_y"], out["q_z"] = principal["quaternion"]
-    cls = row["classification"]
-    out["class"] = cls["kind"]
-    out["kappa"] = cls.get("asymmetry")
-    out["warnings"] = "; ".join(row.get("warnings", []))
+    principal = row.principal
+    out["I1"], out["I2"], out["I3"] = principal.moments
+    out.update(zip(_AXES, (x for axis in principal.axes for x in axis)))
+    out["q_w"], out["q_x"], out["q_y"], out["q_z"] = principal.quaternion
+    out["class"] = row.classification.kind.value
+    out["kappa"] = row.classification.asymmetry
+    out["warnings"] = "; ".join(row.warnings)
     out["error"] = ""
     return out

@@ -29,7 +29,7 @@ from typing import IO, Any, Protocol
 
 from ..errors import InvalidParameterError
 from .extras import require
-from .rows import COLUMNS, FLOAT_COLUMNS, flat_row, row_name
+from .rows import COLUMNS, FLOAT_COLUMNS, Row, flat_row, row_name
 
 __all__ = ["OUTPUT_FORMATS", "Sink", "done_names", "open_sink", "render"]
 
@@ -38,7 +38,7 @@ PARQUET_ROW_GROUP = 4096  # rows per Parquet row group: ~1 MB of columns, few en
 
 
 class Sink(Protocol):
-    def write(self, row: dict[str, Any]) -> None: ...
+    def write(self, row: Row) -> None: ...
     def write_rendered(self, rendered: Any) -> None:
         """Append a row already rendered by :func:`render` for this sink's format."""
 
@@ -136,11 +136,11 @@ def _csv_names(fh: IO[str], path: str) -> set[str]:
 # writers
 
 
-def render(row: dict[str, Any], fmt: str) -> Any:
-    """A JSON line as the sink of ``fmt`` writes it: a line of text (JSONL, CSV) or a Parquet row tuple."""
+def render(row: Row, fmt: str) -> Any:
+    """A row as the sink of ``fmt`` writes it: a line of text (JSONL, CSV) or a Parquet row tuple."""
     if fmt == "jsonl":
         # allow_nan=False: the contract never sends NaN, so one here is a bug to see
-        return json.dumps(row, allow_nan=False) + "\n"
+        return json.dumps(row.as_dict(), allow_nan=False) + "\n"
     flat = flat_row(row)
     if fmt == "csv":
         buf = io.StringIO()
@@ -165,7 +165,7 @@ class JsonlSink:
     def __init__(self, path: str, append: bool) -> None:
         self._fh = open(path, "a" if append else "w", encoding="utf-8")  # noqa: SIM115  closed by close()
 
-    def write(self, row: dict[str, Any]) -> None:
+    def write(self, row: Row) -> None:
         self._fh.write(render(row, "jsonl"))
 
     def write_rendered(self, rendered: Any) -> None:
@@ -185,7 +185,7 @@ class CsvSink:
         if not append:
             self._writer.writeheader()
 
-    def write(self, row: dict[str, Any]) -> None:
+    def write(self, row: Row) -> None:
         self._fh.write(render(row, "csv"))
 
     def write_rendered(self, rendered: Any) -> None:
@@ -217,7 +217,7 @@ class ParquetSink:
             for i in range(old.num_row_groups):
                 self._writer.write_table(old.read_row_group(i).select(list(COLUMNS)).cast(self._schema))
 
-    def write(self, row: dict[str, Any]) -> None:
+    def write(self, row: Row) -> None:
         self.write_rendered(render(row, "parquet"))
 
     def write_rendered(self, rendered: Any) -> None:

@@ -18,6 +18,7 @@ from ..errors import InvalidParameterError
 from ..integrals import Sums, point_sums, simplex_sums
 from ..solid import closed_surface
 from ..vocabulary import Model
+from . import points as small_points
 
 __all__ = ["DIMENSION", "Geometry", "QuadBlock", "body_geometry"]
 
@@ -25,6 +26,11 @@ QuadBlock = tuple[str, NDArray[np.int64], NDArray[np.float64] | None]
 
 DIMENSION = {"apex": 3, "tet": 3, "tri": 2, "points": 0}
 """The length power of each kind's measure: volume, volume, area, a count."""
+
+
+_OVERFLOW = (
+    "the coordinates or masses are so large that the inertia integrals overflow floating point; express the input in other units"
+)
 
 
 class Geometry:
@@ -42,6 +48,7 @@ class Geometry:
         self.points, self.cells, self.kind, self.weight = points, cells, kind, weight
         self.coordinate_eps = coordinate_eps  # unit roundoff of the stored coordinates (float32: 2**-24)
         self.blocks = blocks  # volume cells other than linear tetrahedra: (type, nodes, weight), by quadrature
+        self._small: tuple[list[float], list[list[float]]] | None = None  # a small point set as Python floats
 
     @property
     def referenced_points(self) -> int:
@@ -54,6 +61,14 @@ class Geometry:
 
     def sums(self, origin: NDArray[np.float64], rotation: NDArray[np.float64] | None) -> Sums:
         """The integrals about ``origin`` in the frame ``rotation`` (columns), or raise on overflow."""
+        if self.kind == "points" and len(self.points) <= small_points.SMALL_POINTS:  # the same sums without numpy's overheads
+            assert self.weight is not None
+            if self._small is None:
+                self._small = (self.weight.tolist(), self.points.tolist())
+            found = small_points.small_point_sums(*self._small, origin, rotation)
+            if found is None:
+                raise InvalidParameterError(_OVERFLOW)
+            return found
         try:
             with np.errstate(over="raise", invalid="raise"):
                 x = self.points - origin if rotation is None else rotated(self.points, origin, rotation)
@@ -64,10 +79,7 @@ class Geometry:
                     return simplex_sums(x, self.cells, self.kind, self.weight)
                 return _volume_sums(x, self.cells, self.weight, self.blocks)
         except FloatingPointError as exc:
-            raise InvalidParameterError(
-                "the coordinates or masses are so large that the inertia integrals overflow floating point; "
-                "express the input in other units"
-            ) from exc
+            raise InvalidParameterError(_OVERFLOW) from exc
 
 
 def _volume_sums(

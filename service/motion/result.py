@@ -7,7 +7,6 @@ vectors in the input frame unless the name says ``_body``.
 
 from __future__ import annotations
 
-import enum
 from dataclasses import dataclass
 from typing import Any
 
@@ -15,22 +14,12 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..arrays import frozen_array
-from ..vocabulary import MotionMethod
+from ..sections import MotionDiagnosticsSection, PrecessionSection, TrajectorySection
+from ..vocabulary import MotionMethod, Regime
 
 __all__ = ["Regime", "MotionMethod", "Trajectory", "MotionDiagnostics", "FreeMotion"]
 
 Array = NDArray[np.float64]
-
-
-class Regime(enum.Enum):
-    """The API's ``precession.regime``."""
-
-    REST = "rest"
-    PERMANENT_ROTATION = "permanent_rotation"
-    SPHERICAL = "spherical"
-    REGULAR_PRECESSION = "regular_precession"
-    ASYMMETRIC = "asymmetric"
-    ROTATOR = "rotator"
 
 
 @dataclass(frozen=True, slots=True)
@@ -58,13 +47,13 @@ class Trajectory:
                 raise ValueError(f"{name} has {arr.shape[0]} rows for {self.t.shape[0]} times")
             object.__setattr__(self, name, arr)
 
+    def section(self) -> TrajectorySection:
+        return TrajectorySection(
+            t=self.t.tolist(), omega_body=self.omega_body.tolist(), omega=self.omega.tolist(), quaternion=self.quaternion.tolist()
+        )
+
     def as_dict(self) -> dict[str, Any]:
-        return {
-            "t": self.t.tolist(),
-            "omega_body": self.omega_body.tolist(),
-            "omega": self.omega.tolist(),
-            "quaternion": self.quaternion.tolist(),
-        }
+        return self.section().as_dict()
 
 
 @dataclass(frozen=True, slots=True)
@@ -80,13 +69,13 @@ class MotionDiagnostics:
     energy_drift: float | None = None
     momentum_drift: float | None = None
 
+    def section(self) -> MotionDiagnosticsSection:
+        return MotionDiagnosticsSection(
+            elapsed_s=self.elapsed_s, energy_drift=self.energy_drift, momentum_drift=self.momentum_drift
+        )
+
     def as_dict(self) -> dict[str, Any]:
-        out: dict[str, Any] = {"elapsed_s": self.elapsed_s}
-        if self.energy_drift is not None:
-            out["energy_drift"] = self.energy_drift
-        if self.momentum_drift is not None:
-            out["momentum_drift"] = self.momentum_drift
-        return out
+        return self.section().as_dict()
 
 
 _OPTIONAL_SCALARS = (
@@ -139,24 +128,25 @@ class FreeMotion:
         if not finite or not np.all(np.isfinite(self.angular_momentum)):
             raise ValueError("FreeMotion holds a non-finite number")  # a bug, never an input error
 
-    def as_dict(self) -> dict[str, Any]:
+    def section(self) -> PrecessionSection:
         """The API's ``precession`` section: only the keys that apply."""
-        out: dict[str, Any] = {
-            "regime": self.regime.value,
-            "angular_momentum": self.angular_momentum.tolist(),
-            "angular_momentum_magnitude": self.angular_momentum_magnitude,
-            "kinetic_energy": self.kinetic_energy,
-            "omega_body": self.omega_body.tolist(),
-        }
-        for key in _OPTIONAL_SCALARS:
-            value = getattr(self, key)
-            if value is not None:
-                out[key] = value
-        if self.stable is not None:
-            out["stable"] = self.stable
-        if self.flip_interval is not None:
-            out["flip_interval"] = self.flip_interval
-        if self.trajectory is not None:
-            out["trajectory"] = self.trajectory.as_dict()
-        out["diagnostics"] = self.diagnostics.as_dict()
-        return out
+        return PrecessionSection(
+            regime=self.regime,
+            angular_momentum=self.angular_momentum.tolist(),
+            angular_momentum_magnitude=self.angular_momentum_magnitude,
+            kinetic_energy=self.kinetic_energy,
+            omega_body=self.omega_body.tolist(),
+            body_precession_rate=self.body_precession_rate,
+            space_precession_rate=self.space_precession_rate,
+            spin_rate=self.spin_rate,
+            nutation_angle=self.nutation_angle,
+            period=self.period,
+            stable=self.stable,
+            flip_interval=self.flip_interval,
+            trajectory=None if self.trajectory is None else self.trajectory.section(),
+            diagnostics=self.diagnostics.section(),
+        )
+
+    def as_dict(self) -> dict[str, Any]:
+        """The API's ``precession`` section as JSON."""
+        return self.section().as_dict()

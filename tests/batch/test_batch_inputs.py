@@ -15,6 +15,7 @@ from typing import Any
 import pytest
 
 from inertia.batch import runner, workers
+from inertia.batch.rows import Row
 from inertia.batch.sources import Source, iter_inputs, iter_zip_bytes, list_sources, read_source
 from inertia.batch.tasks import analyze_source, analyze_sources
 from inertia.cli import main
@@ -164,16 +165,17 @@ def test_groups_are_sized_by_bytes_largest_files_first() -> None:
 
 
 def test_rendered_rows_are_the_sinks_own_lines(library: Library, tmp_path: Path) -> None:
+    from inertia.batch.rows import ErrorRow
     from inertia.batch.sinks import open_sink, render
-    from inertia.batch.tasks import render_sources
+    from inertia.batch.tasks import analyze_rows, render_sources
 
     sources = list_sources([str(library[0])])[:6]
     for fmt in ("jsonl", "csv", "parquet"):
         if fmt == "parquet":
             pytest.importorskip("pyarrow")
-        rows = analyze_sources(sources, AnalysisOptions())
+        rows = analyze_rows(sources, AnalysisOptions())
         rendered = render_sources(sources, AnalysisOptions(), fmt)
-        assert [e for _, e in rendered] == ["error" in r for r in rows]
+        assert [e for _, e in rendered] == [isinstance(r, ErrorRow) for r in rows]
         a, b = tmp_path / f"a.{fmt}", tmp_path / f"b.{fmt}"
         sink_a, sink_b = open_sink(str(a), False), open_sink(str(b), False)
         for row, (text, _) in zip(rows, rendered, strict=True):
@@ -208,8 +210,8 @@ class _Rows:
     def __init__(self) -> None:
         self.rows: list[dict[str, Any]] = []
 
-    def write(self, row: dict[str, Any]) -> None:
-        self.rows.append(row)
+    def write(self, row: Row) -> None:
+        self.rows.append(row.as_dict())
 
     def write_rendered(self, rendered: str) -> None:
         self.rows.append(json.loads(rendered))
