@@ -111,9 +111,9 @@ def test_weld_float64_merges_bit_identical_rows_only() -> None:
     assert len(wv) == len(v) + 1
 
 
-@pytest.mark.parametrize("key_bits", [30, 60, 64])
+@pytest.mark.parametrize("key_bits", [30, 35, 45, 60, 64])
 def test_edge_sort_paths_agree(key_bits: int) -> None:
-    """Packed sort, bucketed packed sort and the argsort fallback order edges alike."""
+    """Packed sort, bucketed packed sort (few and many buckets) and the argsort fallback order edges alike."""
     v, f = _torus(40, 25)
     key, _ = topology._edge_keys(f, len(v))
     reference = np.argsort(key, kind="stable")
