@@ -357,7 +357,8 @@ class Server:
 
     Its output goes to ``log_dir/<log_name>-<port>.log`` (read back by :meth:`output`), or nowhere
     without ``log_dir``. ``command(host, port)`` gives its command line (``python -m inertia serve``
-    by default). A server that does not come up leaves no process or open file behind.
+    by default), run in ``cwd`` (the repository root by default). A server that does not come up
+    leaves no process or open file behind.
     """
 
     def __init__(
@@ -369,6 +370,7 @@ class Server:
         log_name: str = "serve",
         command: Callable[[str, int], list[str]] = serve_command,
         host: str = "127.0.0.1",
+        cwd: Path = ROOT,
     ) -> None:
         self.port = free_port(host)
         self.url = f"http://{host}:{self.port}"
@@ -380,7 +382,7 @@ class Server:
             self.log = open(log_dir / f"{log_name}-{self.port}.log", "w+b")  # noqa: SIM115  (open until stop())
         self.process = subprocess.Popen(
             command(host, self.port),
-            cwd=ROOT,
+            cwd=cwd,
             env=full_env,
             stdout=self.log if self.log is not None else subprocess.DEVNULL,
             stderr=subprocess.STDOUT,
