@@ -216,15 +216,17 @@ def _torus_stl(n: int, m: int) -> bytes:
     return b"\0" * 80 + len(faces).to_bytes(4, "little") + records.tobytes()
 
 
-def _cpu_us(fn: Callable[[], object], number: int = 300, repeat: int = 5) -> float:
-    """CPU microseconds of one call: the best of ``repeat`` batches (the least disturbed by other work)."""
-    best = float("inf")
+def _cpu_us(fns: dict[str, Callable[[], object]], number: int = 200, repeat: int = 7) -> dict[str, float]:
+    """CPU microseconds of one call of each function: the best of ``repeat`` batches, taken in turn (so
+    that a busy moment of the shared machine hits every function alike, not one of them)."""
+    best = dict.fromkeys(fns, float("inf"))
     for _ in range(repeat):
-        start = time.process_time()
-        for _ in range(number):
-            fn()
-        best = min(best, (time.process_time() - start) / number)
-    return best * 1e6
+        for name, fn in fns.items():
+            start = time.process_time()
+            for _ in range(number):
+                fn()
+            best[name] = min(best[name], (time.process_time() - start) / number)
+    return {name: 1e6 * t for name, t in best.items()}
 
 
 def in_process_breakdown() -> list[tuple[str, float]]:
@@ -285,35 +287,41 @@ def in_process_breakdown() -> list[tuple[str, float]]:
 
         await app(scope, receive, send)
 
-    access = logging.getLogger("inertia.api.access")
-    disabled, access.disabled = access.disabled, True
-    loop = asyncio.new_event_loop()
-    try:
-        paths = ("/bench/bare", "/bench/parsed", "/v1/analyze/points")
-        route = {path: _cpu_us(lambda p=path: loop.run_until_complete(call(p))) for path in paths}
-    finally:
-        loop.close()
-        access.disabled = disabled
     request = PointsRequest.model_validate_json(body)
     records, options = request.records(), request.as_options()
     job = PointsJob(records, options)
     doc = run_job(job)
-    loaded = load_points(records, None)
-    point_body = loaded.parts[0].body
-    analysis = _cpu_us(lambda: run_job(job))
-    serialised = _cpu_us(lambda: to_json(doc))
-    parse = route["/bench/parsed"] - route["/bench/bare"]
+    point_body = load_points(records, None).parts[0].body
+    access = logging.getLogger("inertia.api.access")
+    disabled, access.disabled = access.disabled, True
+    loop = asyncio.new_event_loop()
+    try:
+        t = _cpu_us(
+            {
+                "bare": lambda: loop.run_until_complete(call("/bench/bare")),
+                "parsed": lambda: loop.run_until_complete(call("/bench/parsed")),
+                "points": lambda: loop.run_until_complete(call("/v1/analyze/points")),
+                "run_job": lambda: run_job(job),
+                "mass": lambda: mass_properties(point_body),
+                "load": lambda: load_points(records, None),
+                "json": lambda: to_json(doc),
+            }
+        )
+    finally:
+        loop.close()
+        access.disabled = disabled
+    parse = t["parsed"] - t["bare"]
     return [
-        ("bare route (ASGI call, no sockets)", route["/bench/bare"]),
-        ("/v1/analyze/points (ASGI call, no sockets)", route["/v1/analyze/points"]),
+        ("bare route (ASGI call, no sockets)", t["bare"]),
+        ("/v1/analyze/points (ASGI call, no sockets)", t["points"]),
         ("of which FastAPI's body parse and validation (a route with the same body returning a constant, less bare)", parse),
-        ("of which the analysis alone: `run_job` (load, mass, frame, class, result dict, checks)", analysis),
-        ("... of it `mass_properties` (two or three refinement passes, error bound)", _cpu_us(lambda: mass_properties(point_body))),
-        ("... of it `load_points` (records to a validated body)", _cpu_us(lambda: load_points(records, None))),
-        ("of which the response JSON (`to_json`)", serialised),
+        ("of which the analysis alone: `run_job` (load, mass, frame, class, result dict, checks)", t["run_job"]),
+        ("... of it `mass_properties` (two or three refinement passes, error bound)", t["mass"]),
+        ("... of it `load_points` (records to a validated body)", t["load"]),
+        ("of which the response JSON (`to_json`)", t["json"]),
         (
-            "remainder (the analysis runs slower inside a request than in a loop of its own: shared caches)",
-            route["/v1/analyze/points"] - route["/bench/bare"] - parse - analysis - serialised,
+            "remainder (the route's own steps: options, job; and the analysis running colder inside a request)",
+            t["points"] - t["bare"] - parse - t["run_job"] - t["json"],
         ),
     ]
 
@@ -428,7 +436,8 @@ def report(result: dict[str, object], sampler: MemorySampler, args: argparse.Nam
         "### Where a 3-point request's CPU goes",
         "",
         "Measured in the benchmark's own process after the server run: the app called as an ASGI callable "
-        "(no sockets, no uvicorn, access log off, hot caches), best of 5 batches of 300 calls. In the server "
+        "(no sockets, no uvicorn, access log off, hot caches), best of 7 batches of 200 calls, the parts "
+        "measured in turn. In the server "
         "above every figure is larger (uvicorn's HTTP parsing and the socket writes come on top of both routes, "
         "and caches are shared with the load generator), so read the rows as proportions.",
         "",
