@@ -2,6 +2,7 @@
 
     python -m benchmarks.mass            # 1e4, 1e5, 1e6, 5e6, 2e7 triangles -> docs/performance.md
     python -m benchmarks.mass --quick    # 1e4, 1e5 only (a smoke run)
+    python -m benchmarks.mass --sizes 2e7 --repeat 1 --out docs/performance-2e7.md   # the 1 GB file alone
 
 2e7 triangles (a 1 GB file) runs a tool only where the machine has the
 memory it needs free (trimesh needs ~12x the file size); otherwise the cell
@@ -394,6 +395,7 @@ def main(argv: list[str] | None = None) -> int:
         + (" --quick" if args.quick and not args.sizes else "")
         + (f" --sizes {' '.join(args.sizes)}" if args.sizes else "")
         + (f" --repeat {args.repeat}" if args.repeat != 3 else "")
+        + (f" --out {args.out}" if args.out not in ("docs/performance.md", "-") else "")
     )
     text = report(results, stages, command)
     if args.out == "-":

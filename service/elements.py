@@ -20,10 +20,11 @@ from functools import cache
 from typing import Any
 
 from .errors import InvalidParameterError
+from .vocabulary import Isotopes, values
 
 __all__ = ["ISOTOPE_CHOICES", "atomic_mass", "dalton_kg", "element_symbol"]
 
-ISOTOPE_CHOICES = ("standard", "abundant")
+ISOTOPE_CHOICES = values(Isotopes)
 
 _SPEC = re.compile(r"^\s*(\d*)\s*([A-Za-z]{1,3})\s*$")
 _HYDROGEN_ALIASES = {"D": 2, "T": 3}  # deuterium and tritium, IUPAC-recognised symbols
@@ -61,7 +62,7 @@ def element_symbol(spec: str | int) -> str:
 
 
 @cache
-def atomic_mass(spec: str, isotopes: str = "standard") -> float:
+def atomic_mass(spec: str, isotopes: str = Isotopes.STANDARD) -> float:
     """Mass [u] of one atom named ``spec`` ("O", "13C", "D", "2H").
 
     isotopes : "standard" (standard atomic weight of a bare symbol) or

@@ -117,7 +117,7 @@ def _check(body: Inertial, fmt: str, name: str) -> None:
             format=fmt,
             moments=body.moments.tolist(),
         )
-    if fmt in ("mjcf", "urdf") and (body.mass < MJ_MINVAL or i1 < MJ_MINVAL):
+    if fmt in (ExportFormat.MJCF, ExportFormat.URDF) and (body.mass < MJ_MINVAL or i1 < MJ_MINVAL):
         raise InvalidInertiaError(
             f"{who}MuJoCo refuses a moving body whose mass or principal moment is below mjMINVAL = 1e-15 "
             f"(here mass {body.mass:.3g} kg, smallest moment {i1:.3g} kg m^2); scale the model up or use sdf",
@@ -168,9 +168,9 @@ def inertial_snippet(fmt: str, body: Inertial, name: str = "") -> Snippet:
         raise InvalidParameterError(f"export must be one of {', '.join(EXPORT_FORMATS)}, got {fmt!r}", parameter="export")
     _check(body, fmt, name)
     # MJCF states the principal moments themselves, compared exactly by MuJoCo; URDF and SDF readers re-diagonalise
-    moments, tensor, warnings = _triangle(body, 0.0 if fmt == "mjcf" else PLANAR_MARGIN, name)
+    moments, tensor, warnings = _triangle(body, 0.0 if fmt == ExportFormat.MJCF else PLANAR_MARGIN, name)
     c = body.center_of_mass
-    if fmt == "mjcf":
+    if fmt == ExportFormat.MJCF:
         text = (
             f'<inertial pos="{_nums(c)}" quat="{_nums(body.quaternion)}" mass="{_num(body.mass)}" diaginertia="{_nums(moments)}"/>'
         )
@@ -183,7 +183,7 @@ def inertial_snippet(fmt: str, body: Inertial, name: str = "") -> Snippet:
         "iyz": tensor[1, 2],
         "izz": tensor[2, 2],
     }
-    if fmt == "urdf":
+    if fmt == ExportFormat.URDF:
         components = " ".join(f'{k}="{_num(v)}"' for k, v in t.items())
         text = (
             f'<inertial>\n  <origin xyz="{_nums(c)}" rpy="0 0 0"/>\n  <mass value="{_num(body.mass)}"/>\n'

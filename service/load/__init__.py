@@ -12,7 +12,7 @@ from numpy.typing import NDArray
 from ..body import Body, BrepBody, MeshBody, Part, PointBody, VolumeBody
 from ..conventions import length_scale
 from ..errors import EmptyGeometryError, UnreadableFileError
-from ..vocabulary import SourceKind, UnitsFrom
+from ..vocabulary import Isotopes, MassUnit, SourceKind, UnitsFrom
 from .guard import check_upload
 from .sniff import CAD_FORMATS, FORMATS, POINT_FORMATS, SCENE_FORMATS, SURFACE_FORMATS, VOLUME_FORMATS, sniff_format
 from .upload import pick_model_file, unpack_zip
@@ -55,7 +55,7 @@ def load_body(
     filename: str | None = None,
     format: str | None = None,
     units: str | None = None,
-    isotopes: str = "standard",
+    isotopes: str = Isotopes.STANDARD,
 ) -> Loaded:
     """Read a mesh or points file into bodies in file units.
 
@@ -90,14 +90,14 @@ def load_body(
     return _load_bytes(data, filename, format, units, isotopes)
 
 
-def _load_files(files: list[tuple[str, bytes]], format: str | None, units: str | None, isotopes: str = "standard") -> Loaded:
+def _load_files(files: list[tuple[str, bytes]], format: str | None, units: str | None, isotopes: str = Isotopes.STANDARD) -> Loaded:
     """The model file of a multi-file upload, read with the others as its companions."""
     main, companions = pick_model_file(files, format)
     data = dict(files)[main]
     return _load_bytes(bytes(data), os.path.basename(main), format, units, isotopes, companions)
 
 
-def _load_path(path: str, filename: str, format: str | None, units: str | None, isotopes: str = "standard") -> Loaded:
+def _load_path(path: str, filename: str, format: str | None, units: str | None, isotopes: str = Isotopes.STANDARD) -> Loaded:
     """A file on disk; a binary STL is read in blocks, never held whole beside its vertices."""
     try:
         fh = open(path, "rb")  # noqa: SIM115  (closed by the with below; only opening errors are caught here)
@@ -124,7 +124,7 @@ def _load_bytes(
     filename: str | None,
     format: str | None,
     units: str | None,
-    isotopes: str = "standard",
+    isotopes: str = Isotopes.STANDARD,
     companions: Mapping[str, bytes] | None = None,
 ) -> Loaded:
     if not len(data):
@@ -186,7 +186,7 @@ def _load_bytes(
 
 
 def load_points(
-    records: list[dict[str, object]], units: str | None = None, *, isotopes: str = "standard", mass_unit: str = "kg"
+    records: list[dict[str, object]], units: str | None = None, *, isotopes: str = Isotopes.STANDARD, mass_unit: str = MassUnit.KG
 ) -> Loaded:
     """Point masses given as records ``{"mass": m, "position": [x, y, z]}`` (or ``"element"``)."""
     from .points import names_elements, points_from_records

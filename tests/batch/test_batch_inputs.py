@@ -15,6 +15,7 @@ from typing import Any
 import pytest
 
 from inertia.batch import runner, workers
+from inertia.batch.rows import Row
 from inertia.batch.sources import Source, iter_inputs, iter_zip_bytes, list_sources, read_source
 from inertia.batch.tasks import analyze_source, analyze_sources
 from inertia.cli import main
@@ -209,8 +210,8 @@ class _Rows:
     def __init__(self) -> None:
         self.rows: list[dict[str, Any]] = []
 
-    def write(self, row: dict[str, Any]) -> None:
-        self.rows.append(row)
+    def write(self, row: Row) -> None:
+        self.rows.append(row.as_dict())
 
     def write_rendered(self, rendered: str) -> None:
         self.rows.append(json.loads(rendered))
