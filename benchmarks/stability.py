@@ -7,7 +7,7 @@
 Reference values never come from the service: the exact principal moments of
 the polyhedron *as stored* (the float64 vertices every tool receives) come from
 rational integration with Python integers and 50-digit eigenvalues
-(``tests/exact.py``); motion references are mpmath closed forms (Jacobi
+(``benchmarks/exact.py``); motion references are mpmath closed forms (Jacobi
 elliptic functions, L&L §37; the symmetric top, L&L §33) at 40 digits.
 
 Peers get the same arrays: trimesh (``Trimesh(process=False)``), numpy-stl

@@ -358,6 +358,5 @@ def two_box_scene() -> Any:
     return scene, rot[:3, :3]
 
 
-TWO_CUBES_MOMENTS = [1500.0, 1500 + 1000 * (0.5 - 12.5 / 9) ** 2 + 8000 * (1.5 - 12.5 / 9) ** 2] * 1
-
-TWO_CUBES_MOMENTS = [1500.0, TWO_CUBES_MOMENTS[1], TWO_CUBES_MOMENTS[1]]
+_TWO_CUBES_PERPENDICULAR = 1500 + 1000 * (0.5 - 12.5 / 9) ** 2 + 8000 * (1.5 - 12.5 / 9) ** 2
+TWO_CUBES_MOMENTS = [1500.0, _TWO_CUBES_PERPENDICULAR, _TWO_CUBES_PERPENDICULAR]
