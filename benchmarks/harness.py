@@ -12,6 +12,9 @@ so that each one states the same things the same way:
   peak resident set of it and every process it starts (sampled from ``/proc`` every
   ``SAMPLE_S``; the peak is the kernel's own high-water mark, ``VmHWM``, so no peak is missed
   between samples), its exit status and output;
+- ``run_tool(args)``: one process's wall time, CPU time and its own peak resident set, exactly
+  (GNU time's ``%M`` where ``/usr/bin/time`` exists: a child's ``ru_maxrss`` would include the
+  high-water mark of a large parent it was forked from), for tools compared on memory;
 - ``interleaved(contenders, rounds)``: rounds in which every contender runs once, their order
   rotated from round to round, and the best run of each kept: robust to a machine that is
   busy with other work for part of the time;
@@ -56,10 +59,15 @@ __all__ = [
     "timed",
     "best_of",
     "ProcStat",
+    "proc_stat",
+    "descendants",
     "TreeLog",
     "sampled",
     "ProcessRun",
     "run_process",
+    "ToolRun",
+    "run_tool",
+    "available_memory",
     "Best",
     "interleaved",
     "free_port",
@@ -145,11 +153,12 @@ def best_of(call: Callable[[], T], repeat: int = 1, budget_s: float = math.inf) 
 
 @dataclass(frozen=True)
 class ProcStat:
-    """CPU seconds, peak resident set [bytes] and command line of one live process (``/proc``)."""
+    """CPU seconds, peak and current resident set [bytes] and command line of one live process (``/proc``)."""
 
     cpu_s: float
     peak_rss_bytes: int
     command: str
+    rss_bytes: int = 0
 
 
 def _children() -> dict[int, list[int]]:
@@ -165,6 +174,11 @@ def _children() -> dict[int, list[int]]:
     return kids
 
 
+def descendants(pid: int) -> list[int]:
+    """The processes started by ``pid``, and theirs, and so on (not ``pid`` itself)."""
+    return [p for p in _tree([pid]) if p != pid]
+
+
 def _tree(roots: Sequence[int]) -> list[int]:
     kids = _children()
     out, todo = [], list(roots)
@@ -175,19 +189,22 @@ def _tree(roots: Sequence[int]) -> list[int]:
     return out
 
 
-def _proc(pid: int) -> ProcStat | None:
+def proc_stat(pid: int) -> ProcStat | None:
+    """What ``/proc`` says of a live process (None once it is gone)."""
     try:
         with open(f"/proc/{pid}/stat") as fh:
             fields = fh.read().rsplit(")", 1)[1].split()
         cpu = (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
-        hwm = 0
+        hwm = rss = 0
         with open(f"/proc/{pid}/status") as fh:
             for line in fh:
                 if line.startswith("VmHWM:"):
                     hwm = int(line.split()[1]) * 1024
+                elif line.startswith("VmRSS:"):
+                    rss = int(line.split()[1]) * 1024
         with open(f"/proc/{pid}/cmdline", "rb") as fh:
             cmd = fh.read().replace(b"\0", b" ").decode(errors="replace")
-        return ProcStat(cpu, hwm, cmd)
+        return ProcStat(cpu, hwm, cmd, rss)
     except (OSError, IndexError, ValueError):
         return None
 
@@ -201,7 +218,7 @@ class TreeLog:
 
     def sample(self, roots: Sequence[int]) -> None:
         for pid in _tree(roots):
-            got = _proc(pid)
+            got = proc_stat(pid)
             if got is not None:
                 self.seen[pid] = got
                 self.start_cpu.setdefault(pid, got.cpu_s)
@@ -295,6 +312,62 @@ def run_process(
     return ProcessRun(tuple(args), proc.pid, proc.returncode, wall, log.cpu(), out, err, log)
 
 
+GNU_TIME = "/usr/bin/time"
+
+
+@dataclass(frozen=True)
+class ToolRun:
+    """Wall time, the process's own peak RSS [bytes], its stdout and its CPU time (user + system)."""
+
+    wall_s: float
+    peak_rss_bytes: int
+    stdout: str
+    cpu_s: float
+
+
+def run_tool(args: Sequence[str]) -> ToolRun:
+    """Run ``args`` to its end; a non-zero exit raises ``RuntimeError`` with the end of its stderr.
+
+    Linux carries a process's high-water RSS across fork and exec into the child's ``ru_maxrss``,
+    so a child of a large benchmark process would report at least that process's own peak.  GNU
+    time, itself tiny, forks the tool and reports the tool's own peak; without it, ``os.wait4``.
+    """
+    import tempfile
+
+    cmd = list(args)
+    wrapped = os.path.exists(GNU_TIME)
+    with tempfile.TemporaryFile() as out, tempfile.NamedTemporaryFile("r") as rss_file:
+        full = [GNU_TIME, "-f", "%M %U %S", "-o", rss_file.name, *cmd] if wrapped else cmd
+        clock = Stopwatch()
+        proc = subprocess.Popen(full, stdout=out, stderr=subprocess.PIPE)
+        _, status, usage = os.wait4(proc.pid, 0)
+        wall = clock.wall_s
+        proc.returncode = os.waitstatus_to_exitcode(status)
+        err = proc.stderr.read().decode() if proc.stderr else ""
+        if proc.stderr:
+            proc.stderr.close()
+        if proc.returncode != 0:
+            raise RuntimeError(f"{cmd[:3]} failed ({proc.returncode}): {err[-2000:]}")
+        if wrapped:
+            fields = rss_file.read().split()[-3:]
+            peak_kb, cpu = int(fields[0]), float(fields[1]) + float(fields[2])
+        else:
+            peak_kb, cpu = usage.ru_maxrss, usage.ru_utime + usage.ru_stime
+        out.seek(0)
+        return ToolRun(wall, peak_kb * 1024, out.read().decode(), cpu)
+
+
+def available_memory() -> int:
+    """MemAvailable of /proc/meminfo in bytes (0 where unknown)."""
+    try:
+        for line in Path("/proc/meminfo").read_text().splitlines():
+            if line.startswith("MemAvailable:"):
+                return int(line.split()[1]) * 1024
+    except (OSError, ValueError, IndexError):
+        pass
+    return 0
+
+
 # ---------------------------------------------------------------------------
 # rounds
 
@@ -357,7 +430,8 @@ class Server:
 
     Its output goes to ``log_dir/<log_name>-<port>.log`` (read back by :meth:`output`), or nowhere
     without ``log_dir``. ``command(host, port)`` gives its command line (``python -m inertia serve``
-    by default). A server that does not come up leaves no process or open file behind.
+    by default), run in ``cwd`` (the repository root by default). A server that does not come up
+    leaves no process or open file behind.
     """
 
     def __init__(
@@ -369,6 +443,7 @@ class Server:
         log_name: str = "serve",
         command: Callable[[str, int], list[str]] = serve_command,
         host: str = "127.0.0.1",
+        cwd: Path = ROOT,
     ) -> None:
         self.port = free_port(host)
         self.url = f"http://{host}:{self.port}"
@@ -380,7 +455,7 @@ class Server:
             self.log = open(log_dir / f"{log_name}-{self.port}.log", "w+b")  # noqa: SIM115  (open until stop())
         self.process = subprocess.Popen(
             command(host, self.port),
-            cwd=ROOT,
+            cwd=cwd,
             env=full_env,
             stdout=self.log if self.log is not None else subprocess.DEVNULL,
             stderr=subprocess.STDOUT,

@@ -7,7 +7,7 @@
 Reference values never come from the service: the exact principal moments of
 the polyhedron *as stored* (the float64 vertices every tool receives) come from
 rational integration with Python integers and 50-digit eigenvalues
-(``tests/exact.py``); motion references are mpmath closed forms (Jacobi
+(``benchmarks/exact.py``); motion references are mpmath closed forms (Jacobi
 elliptic functions, L&L §37; the symmetric top, L&L §33) at 40 digits.
 
 Peers get the same arrays: trimesh (``Trimesh(process=False)``), numpy-stl
@@ -36,7 +36,7 @@ from numpy.typing import NDArray
 from scipy.spatial.transform import Rotation
 
 from benchmarks.cases import BOX_FACES, box, centred_box, flat_shells, prism, stl_bytes, uv_sphere
-from benchmarks.exact import exact_eigenvalues, exact_points, exact_solid, exact_tetrahedra, relative_error
+from benchmarks.exact import elliptic_omega, exact_eigenvalues, exact_points, exact_solid, exact_tetrahedra, relative_error
 from benchmarks.harness import Report, Stopwatch, timed
 from inertia.body import MeshBody, PointBody, VolumeBody
 from inertia.classification import RotorClass, classify
@@ -616,14 +616,14 @@ def reference_omega(moments: Sequence[float], omega: Sequence[float], t: Array, 
     Symmetric top (two equal moments): the perpendicular part turns at the
     body precession rate (I_s - I_p) / I_p Omega_s (L&L §33).  Asymmetric top:
     Jacobi elliptic functions (L&L §37, eq. 37.10 and its 1 <-> 3 variant below
-    the separatrix), phase from Omega(0), signs fixed by Euler's equations.
+    the separatrix; ``benchmarks.exact.elliptic_omega``), phase from Omega(0), signs fixed by Euler's equations.
     """
     with mpmath.workdps(digits):
         I = [mpmath.mpf(x) for x in moments]
         w = [mpmath.mpf(x) for x in omega]
         if I[0] == I[1] or I[1] == I[2]:
             return _symmetric_reference(I, w, t)
-        return _elliptic_reference(I, w, t)
+    return elliptic_omega(moments, omega, t, dps=digits)
 
 
 def _symmetric_reference(I: list[mpmath.mpf], w: list[mpmath.mpf], t: Array) -> Array:
@@ -639,52 +639,6 @@ def _symmetric_reference(I: list[mpmath.mpf], w: list[mpmath.mpf], t: Array) -> 
         out[n, p] = float(w[p] * c - w[q] * sn)
         out[n, q] = float(w[p] * sn + w[q] * c)
     return out
-
-
-def _elliptic_reference(I: list[mpmath.mpf], w: list[mpmath.mpf], t: Array) -> Array:
-    E2 = sum(i * x * x for i, x in zip(I, w))  # 2E
-    M2 = sum((i * x) ** 2 for i, x in zip(I, w))
-    # above the separatrix Omega_3 keeps its sign (dn), below Omega_1 does
-    d, c = (2, 0) if E2 * I[1] < M2 else (0, 2)
-    i1, i2, i3 = I
-    if d == 2:
-        amp = [
-            mpmath.sqrt((E2 * i3 - M2) / (i1 * (i3 - i1))),
-            mpmath.sqrt((E2 * i3 - M2) / (i2 * (i3 - i2))),
-            mpmath.sqrt((M2 - E2 * i1) / (i3 * (i3 - i1))),
-        ]
-        rate = mpmath.sqrt((i3 - i2) * (M2 - E2 * i1) / (i1 * i2 * i3))
-        m = (i2 - i1) * (E2 * i3 - M2) / ((i3 - i2) * (M2 - E2 * i1))
-    else:
-        amp = [
-            mpmath.sqrt((E2 * i3 - M2) / (i1 * (i3 - i1))),
-            mpmath.sqrt((M2 - E2 * i1) / (i2 * (i2 - i1))),
-            mpmath.sqrt((M2 - E2 * i1) / (i3 * (i3 - i1))),
-        ]
-        rate = mpmath.sqrt((i2 - i1) * (E2 * i3 - M2) / (i1 * i2 * i3))
-        m = (i3 - i2) * (M2 - E2 * i1) / ((i2 - i1) * (E2 * i3 - M2))
-    sd = 1 if w[d] > 0 else -1
-    best = None
-    for sigma in (1, -1):
-        phi0 = mpmath.atan2(w[1] / (sigma * amp[1]), w[c] / amp[c])
-        tau0 = mpmath.ellipf(phi0, m)
-
-        def at(tau: mpmath.mpf, sigma: int = sigma) -> list[mpmath.mpf]:
-            sn, cn, dn = (mpmath.ellipfun(k, tau, m=m) for k in ("sn", "cn", "dn"))
-            out = [mpmath.mpf(0)] * 3
-            out[c], out[1], out[d] = amp[c] * cn, sigma * amp[1] * sn, sd * amp[d] * dn
-            return out
-
-        h = mpmath.mpf(10) ** -15
-        plus, minus = at(tau0 + rate * h), at(tau0 - rate * h)
-        deriv = [(a - b) / (2 * h) for a, b in zip(plus, minus)]
-        euler = [(i2 - i3) / i1 * w[1] * w[2], (i3 - i1) / i2 * w[2] * w[0], (i1 - i2) / i3 * w[0] * w[1]]
-        mismatch = max(abs(a - b) for a, b in zip(deriv, euler)) + max(abs(a - b) for a, b in zip(at(tau0), w))
-        if best is None or mismatch < best[0]:
-            best = (mismatch, at, tau0)
-    assert best is not None
-    _, at, tau0 = best
-    return np.array([[float(x) for x in at(tau0 + rate * mpmath.mpf(float(tt)))] for tt in t])
 
 
 class ScipyCell(TypedDict, total=False):

@@ -98,3 +98,27 @@ def test_machine_names_the_cpu_cores_and_package_versions() -> None:
     m = harness.machine(("numpy", "no-such-package-here"))
     assert m["cpu"] and int(m["cores"]) >= int(m["usable"]) >= 1
     assert m["numpy"][0].isdigit() and m["no-such-package-here"] == "not installed"
+
+
+def test_run_tool_reports_the_tools_own_peak_memory_and_its_output() -> None:
+    code = "b = bytearray(96 * 2**20)\nfor i in range(0, len(b), 4096): b[i] = 1\nprint(len(b))"
+    run = harness.run_tool([sys.executable, "-c", code])
+    assert run.stdout.strip() == str(96 * 2**20) and run.cpu_s > 0 and run.wall_s > 0
+    assert 96 * 2**20 <= run.peak_rss_bytes < 96 * 2**20 + 2**30
+    with pytest.raises(RuntimeError, match="failed"):
+        harness.run_tool([sys.executable, "-c", "raise SystemExit(2)"])
+
+
+def test_proc_stat_and_descendants_see_live_processes() -> None:
+    import os
+    import subprocess
+
+    me = harness.proc_stat(os.getpid())
+    assert me is not None and me.rss_bytes > 0 and me.peak_rss_bytes >= me.rss_bytes and "python" in me.command
+    child = subprocess.Popen([sys.executable, "-c", "import time; time.sleep(30)"])
+    try:
+        assert child.pid in harness.descendants(os.getpid())
+    finally:
+        child.kill()
+        child.wait()
+    assert harness.proc_stat(child.pid) is None
