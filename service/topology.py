@@ -204,7 +204,11 @@ def _resolve_collisions(
     table: NDArray[np.unsignedinteger], order: NDArray[np.int64], same_hash: NDArray[np.bool_], same: NDArray[np.bool_]
 ) -> NDArray[np.int64]:
     """Re-sort the hash runs that hold distinct rows by (run, columns, index); ``same`` is updated for the new order."""
-    run = np.cumsum(np.r_[True, ~same_hash])
+    n = len(order)
+    run = np.empty(n, dtype=order.dtype)  # the hash run of each sorted row, from 1
+    run[0] = 1
+    np.cumsum(~same_hash, dtype=order.dtype, out=run[1:])
+    run[1:] += 1
     bad_runs = np.zeros(int(run[-1]) + 1, dtype=bool)
     bad_runs[run[1:][same_hash & ~same]] = True
     pos = np.flatnonzero(bad_runs[run])
@@ -318,7 +322,7 @@ def _edge_keys(faces: NDArray[np.int64], n_vertices: int) -> tuple[NDArray[np.ui
     return key.reshape(-1), forward.reshape(-1)
 
 
-def _edge_order(key: NDArray[np.uint64], key_bits: int) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
+def _edge_order(key: NDArray[np.uint64], key_bits: int) -> tuple[NDArray[np.signedinteger], NDArray[np.signedinteger]]:
     """Half-edges sorted by key (ties in index order) and the start of each run of equal key.
 
     The key and the index are packed into one uint64 and value-sorted; when
@@ -336,22 +340,23 @@ def _edge_order(key: NDArray[np.uint64], key_bits: int) -> tuple[NDArray[np.int6
         ks = key[order]
         return order, np.flatnonzero(np.r_[True, ks[1:] != ks[:-1]])
     low_bits = key_bits - spill
+    small = np.int32 if m < 2**31 else np.int64  # order and starts: half the memory of int64
     bucket = (key >> np.uint64(low_bits)).astype(np.uint16)
-    by_bucket = np.argsort(bucket, kind="stable")  # radix sort for 16-bit keys
+    few = spill <= 4  # a few buckets: each found by a comparison, no full permutation held
+    by_bucket = None if few else np.argsort(bucket, kind="stable")  # radix sort for 16-bit keys
     bounds = np.zeros((1 << spill) + 1, dtype=np.int64)
-    if spill <= 4:  # a few buckets: counted in place (bincount would widen every id to intp first)
+    if few:  # counted in place (bincount would widen every id to intp first)
         np.cumsum([np.count_nonzero(bucket == b) for b in range(1 << spill)], out=bounds[1:])
     else:
         np.cumsum(np.bincount(bucket, minlength=1 << spill), out=bounds[1:])
-    del bucket
     low = np.uint64((1 << low_bits) - 1)
     index_mask = np.uint64((1 << index_bits) - 1)
-    order = np.empty(m, dtype=np.int64)
+    order = np.empty(m, dtype=small)
     starts = []
-    for b0, b1 in itertools.pairwise(bounds):
+    for b, (b0, b1) in enumerate(itertools.pairwise(bounds)):
         if b1 == b0:
             continue
-        sub = by_bucket[b0:b1]
+        sub = np.flatnonzero(bucket == b) if by_bucket is None else by_bucket[b0:b1]  # ascending either way
         part = np.empty(b1 - b0, dtype=np.uint64)
         for start in range(0, len(part), BLOCK):  # the low key bits and the index, packed in blocks
             block = part[start : start + BLOCK]
@@ -359,15 +364,18 @@ def _edge_order(key: NDArray[np.uint64], key_bits: int) -> tuple[NDArray[np.int6
             block &= low
             block <<= np.uint64(index_bits)
             block |= sub[start : start + BLOCK].view(np.uint64)
+        del sub
         part.sort()
         same = np.empty(len(part) - 1, dtype=bool)
         for start in range(0, len(part) - 1, BLOCK):
             stop = min(len(part) - 1, start + BLOCK)
             np.less_equal(part[start + 1 : stop + 1] ^ part[start:stop], index_mask, out=same[start:stop])
-        starts.append(b0 + np.flatnonzero(np.r_[True, ~same]))
+        first: NDArray[np.signedinteger] = np.flatnonzero(np.r_[True, ~same]).astype(small)
+        first += b0
+        starts.append(first)
         for start in range(0, len(part), BLOCK):
             part[start : start + BLOCK] &= index_mask
-        order[b0:b1] = part.view(np.int64)
+        order[b0:b1] = part
     return order, np.concatenate(starts)
 
 

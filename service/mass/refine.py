@@ -182,7 +182,8 @@ def _check_resolution(
     volume = abs(s.measure)
     along = y @ rotation  # principal-frame coordinates (columns of rotation are the axes)
     sq = along * along
-    reach = np.array([float(np.max(sq.sum(axis=1) - sq[:, k])) for k in range(3)])
+    total = sq.sum(axis=1)  # once, not once per axis
+    reach = np.array([float(np.max(total - sq[:, k])) for k in range(3)])
     ratio_v = moved / volume if volume > 0 else math.inf
     ratio_i = float(np.max(moved * weight * reach / values))
     ratio = max(ratio_v, ratio_i)
