@@ -38,13 +38,9 @@ from __future__ import annotations
 import argparse
 import contextlib
 import json
-import math
 import os
-import platform
 import shutil
 import statistics
-import struct
-import subprocess
 import sys
 import tempfile
 import threading
@@ -52,9 +48,22 @@ import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
+
+from benchmarks.cases import box, triangles_stl_bytes, uv_sphere
+from benchmarks.harness import (
+    Stopwatch,
+    available_cores,
+    cpu_model,
+    interleaved,
+    machine,
+    peak_rss_bytes,
+    run_process,
+    timed,
+    write_section,
+)
 
 ROOT = Path(__file__).resolve().parents[1]
 DOC = ROOT / "docs" / "batch.md"
@@ -68,54 +77,11 @@ ROUNDS = 6
 # inputs
 
 
-def uv_sphere(nlat: int, nlon: int) -> tuple[np.ndarray, np.ndarray]:
-    """Closed, outward-wound UV sphere of radius 1: 2 nlon (nlat - 1) triangles."""
-    theta = np.linspace(0.0, np.pi, nlat + 1)[1:-1]
-    phi = np.linspace(0.0, 2 * np.pi, nlon, endpoint=False)
-    t, p = np.meshgrid(theta, phi, indexing="ij")
-    ring = np.stack([np.sin(t) * np.cos(p), np.sin(t) * np.sin(p), np.cos(t)], -1).reshape(-1, 3)
-    v = np.vstack([[0.0, 0.0, 1.0], ring, [0.0, 0.0, -1.0]])
-    south = len(v) - 1
-    j = np.arange(nlon)
-
-    def idx(i: int | np.ndarray, jj: np.ndarray) -> np.ndarray:
-        return 1 + np.asarray(i) * nlon + (jj % nlon)
-
-    i = np.arange(nlat - 2)[:, None]
-    a, b, c, d = idx(i, j), idx(i, j + 1), idx(i + 1, j), idx(i + 1, j + 1)
-    bands = np.concatenate([np.stack([a, c, b], -1), np.stack([b, c, d], -1)], axis=1).reshape(-1, 3)
-    north = np.stack([np.zeros(nlon, dtype=int), idx(0, j), idx(0, j + 1)], -1)
-    bottom = np.stack([np.full(nlon, south), idx(nlat - 2, j + 1), idx(nlat - 2, j)], -1)
-    return v, np.vstack([north, bands, bottom])
-
-
-BOX = (
-    np.array([[(k & 1), (k >> 1) & 1, (k >> 2) & 1] for k in range(8)], dtype=float),
-    np.array(
-        [
-            [0, 2, 1],
-            [1, 2, 3],
-            [4, 5, 6],
-            [5, 7, 6],
-            [0, 1, 4],
-            [1, 5, 4],
-            [2, 6, 3],
-            [3, 6, 7],
-            [0, 4, 2],
-            [2, 4, 6],
-            [1, 3, 5],
-            [3, 7, 5],
-        ]
-    ),
-)
+BOX = box(1.0, 1.0, 1.0)
 
 
 def write_stl(path: Path, triangles: np.ndarray) -> None:
-    rec = np.zeros(len(triangles), dtype=[("n", "<f4", (3,)), ("v", "<f4", (3, 3)), ("a", "<u2")])
-    rec["v"] = triangles
-    with open(path, "wb") as fh:
-        fh.write(b"inertia batch benchmark".ljust(80, b" ") + struct.pack("<I", len(triangles)))
-        fh.write(rec.tobytes())
+    path.write_bytes(triangles_stl_bytes(triangles, b"inertia batch benchmark".ljust(80, b" ")))
 
 
 def generate(folder: Path, count: int, shape: Callable[[np.random.Generator], tuple[np.ndarray, np.ndarray]], seed: int) -> int:
@@ -157,22 +123,26 @@ def trimesh_loop(files: list[Path]) -> tuple[float, float]:
     """(wall s, CPU s) of the serial trimesh loop, in this process (import excluded)."""
     import trimesh
 
-    start, cpu = time.perf_counter(), time.process_time()
-    for path in files:
-        mesh = trimesh.load(str(path))
-        props = mesh.mass_properties
-        _ = (props["mass"], props["center_mass"], props["inertia"])
-    return time.perf_counter() - start, time.process_time() - cpu
+    def loop() -> None:
+        for path in files:
+            mesh = cast("trimesh.Trimesh", trimesh.load(str(path)))  # one STL: one mesh
+            props = mesh.mass_properties
+            _ = (props["mass"], props["center_mass"], props["inertia"])
+
+    _, t = timed(loop)
+    return t.wall_s, t.cpu_s
 
 
 def analyze_loop(files: list[Path]) -> tuple[float, float]:
     """(wall s, CPU s) of the serial loop over our pipeline, in this process (import excluded)."""
     from inertia.pipeline import analyze
 
-    start, cpu = time.perf_counter(), time.process_time()
-    for path in files:
-        analyze(path).as_dict()
-    return time.perf_counter() - start, time.process_time() - cpu
+    def loop() -> None:
+        for path in files:
+            analyze(path).as_dict()
+
+    _, t = timed(loop)
+    return t.wall_s, t.cpu_s
 
 
 # The same loops as whole programs: a fresh interpreter imports the library and loops over the file
@@ -200,14 +170,10 @@ print(len(files))
 
 def whole_process(script: str, file_list: Path, count: int) -> float:
     """Wall s of ``python -c script file_list`` from launch to exit."""
-    t0 = time.perf_counter()
-    done = subprocess.run([sys.executable, "-c", script, str(file_list)], cwd=ROOT, capture_output=True, text=True, check=False)
-    wall = time.perf_counter() - t0
-    if done.returncode != 0:
-        raise RuntimeError(f"loop process failed (exit {done.returncode}):\n{done.stderr}")
+    done = run_process([sys.executable, "-c", script, str(file_list)])
     if int(done.stdout.split()[-1]) != count:
         raise RuntimeError(f"loop process did {done.stdout.split()[-1]} files, not {count}")
-    return wall
+    return done.wall_s
 
 
 def check_rows(out: Path, files: list[Path]) -> None:
@@ -225,31 +191,9 @@ def cli_run(folder: Path, out: Path, workers: int, files: list[Path]) -> float:
     """Wall s of the real ``inertia batch`` command in a fresh process, from launch to exit."""
     out.unlink(missing_ok=True)
     command = [sys.executable, "-m", "inertia", "batch", str(folder), "--out", str(out), "--workers", str(workers), "--no-progress"]
-    t0 = time.perf_counter()
-    done = subprocess.run(command, cwd=ROOT, capture_output=True, text=True, check=False)
-    wall = time.perf_counter() - t0
-    if done.returncode != 0:
-        raise RuntimeError(f"`{' '.join(command)}` failed (exit {done.returncode}):\n{done.stderr}")
+    done = run_process(command)
     check_rows(out, files)
-    return wall
-
-
-SPIN = "import time\nt = time.perf_counter()\nwhile time.perf_counter() - t < {s}: pass\nprint(time.process_time())"
-
-
-def available_cores(processes: int = 2, seconds: float = 1.0) -> float:
-    """CPU seconds per second that ``processes`` busy processes of this session get right now.
-
-    2.0 on an idle 2-core machine.  With the kernel's autogroup scheduling, a
-    busy session elsewhere cuts it towards 1.0, whatever the number of our
-    processes: parallel speed-ups are then capped.
-    """
-    procs = [
-        subprocess.Popen([sys.executable, "-c", SPIN.format(s=seconds)], stdout=subprocess.PIPE, text=True)
-        for _ in range(processes)
-    ]
-    cpu = sum(float(p.communicate()[0]) for p in procs)
-    return cpu / seconds
+    return done.wall_s
 
 
 # ---------------------------------------------------------------------------
@@ -269,12 +213,6 @@ def _cpu_s() -> float:
     return float(t.user + t.system)
 
 
-def _peak_rss() -> int:
-    import resource
-
-    return int(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss) * 1024  # Linux: KiB
-
-
 @dataclass
 class MemoryLog:
     """RSS of each worker over time, sampled by a second client."""
@@ -284,13 +222,13 @@ class MemoryLog:
     passes: list[tuple[float, float]] = field(default_factory=list)  # (start, end) of each pass over the files
 
 
-def _sample(address: str, log: MemoryLog, stop: threading.Event, t0: float) -> None:
+def _sample(address: str, log: MemoryLog, stop: threading.Event, clock: Stopwatch) -> None:
     from distributed import Client
 
     with Client(address, timeout="30s") as client:
         while not stop.is_set():
             with contextlib.suppress(Exception):  # a sample lost at shutdown is no result
-                log.samples.append((time.perf_counter() - t0, client.run(_rss)))
+                log.samples.append((clock.wall_s, client.run(_rss)))
             stop.wait(SAMPLE_EVERY_S)
 
 
@@ -298,27 +236,27 @@ def _child(folder: str, out: str, workers: int) -> None:
     """In a fresh process: start the local cluster, run the batch on it, print timings and memory as JSON."""
     from inertia.batch.runner import connect, run_batch
 
-    t0 = time.perf_counter()
+    clock = Stopwatch()
     client, cluster = connect(None, workers)
     log = MemoryLog()
     stop = threading.Event()
-    sampler = threading.Thread(target=_sample, args=(cluster.scheduler_address, log, stop, t0), daemon=True)
+    sampler = threading.Thread(target=_sample, args=(cluster.scheduler_address, log, stop, clock), daemon=True)
     sampler.start()
     try:
         workers_cpu = client.run(_cpu_s)
-        t1, cpu1 = time.perf_counter(), time.process_time()
-        summary = run_batch([folder], out, client=client, progress=False)
-        run_s, client_cpu = time.perf_counter() - t1, time.process_time() - cpu1
+        t1 = clock.wall_s
+        summary, timing = timed(lambda: run_batch([folder], out, client=client, progress=False))
+        run_s, client_cpu = timing.wall_s, timing.cpu_s
         assert summary.errors == 0, f"{summary.errors} files failed"
         worker_cpu = sum(client.run(_cpu_s).values()) - sum(workers_cpu.values())
-        passes = [(t1 - t0, t1 - t0 + run_s)]
+        passes = [(t1, t1 + run_s)]
         for k in range(1, MEMORY_PASSES):  # the same files again on the same workers: does memory grow?
             again = f"{out}.pass{k}.jsonl"
-            start = time.perf_counter()
+            start = clock.wall_s
             run_batch([folder], again, client=client, progress=False)
-            passes.append((start - t0, time.perf_counter() - t0))
+            passes.append((start, clock.wall_s))
             os.remove(again)
-        log.peaks = client.run(_peak_rss)
+        log.peaks = client.run(peak_rss_bytes)
     finally:
         stop.set()
         sampler.join()
@@ -357,17 +295,8 @@ class Instrumented:
 def instrumented_run(folder: Path, out: Path, workers: int, files: list[Path]) -> Instrumented:
     """Memory and CPU of ``run_batch(client=...)`` on a local cluster started first, in a fresh process."""
     out.unlink(missing_ok=True)
-    t0 = time.perf_counter()
-    done = subprocess.run(
-        [sys.executable, "-m", "benchmarks.batch", "--child", str(folder), str(out), str(workers)],
-        cwd=ROOT,
-        capture_output=True,
-        text=True,
-        check=False,
-    )
-    wall = time.perf_counter() - t0
-    if done.returncode != 0:
-        raise RuntimeError(f"instrumented batch failed:\n{done.stderr}")
+    done = run_process([sys.executable, "-m", "benchmarks.batch", "--child", str(folder), str(out), str(workers)])
+    wall = done.wall_s
     check_rows(out, files)
     doc = json.loads(done.stdout.strip().splitlines()[-1])
     log = MemoryLog([(t, dict(s)) for t, s in doc["samples"]], dict(doc["peaks"]), [tuple(p) for p in doc["passes"]])
@@ -538,15 +467,15 @@ def throughput_table(rows: list[Row], workers: int) -> list[str]:
 
 
 def render(rows: list[Row], workers: int, quick: bool, command: str, loads: list[float], rounds: int) -> str:
-    import dask
     import trimesh
 
+    versions = machine(("dask",))
     lines = [
         "## Throughput",
         "",
         (
-            f"Measured by `{command}` on {_today()}: {_cpu_model()}, {os.cpu_count()} cores, Python "
-            f"{platform.python_version()}, dask {dask.__version__}, trimesh {trimesh.__version__}. "
+            f"Measured by `{command}` on {time.strftime('%Y-%m-%d')}: {cpu_model()}, {os.cpu_count()} cores, Python "
+            f"{versions['python']}, dask {versions['dask']}, trimesh {trimesh.__version__}. "
             "Cores this run could use, probed before each round by two busy processes (2.00 = an idle 2-core "
             f"machine): {', '.join(f'{x:.2f}' for x in loads)}. {rounds} interleaved rounds per data set "
             f"({max(1, rounds // 3)} for the large one), every contender in each round, their order rotated from "
@@ -614,36 +543,6 @@ def render(rows: list[Row], workers: int, quick: bool, command: str, loads: list
     return "\n".join(lines)
 
 
-START, END = "<!-- benchmark:start -->", "<!-- benchmark:end -->"
-
-
-def write_section(path: Path, text: str) -> None:
-    """Replace the benchmark section of ``path`` (between the markers), or write the file."""
-    section = f"{START}\n{text.rstrip()}\n{END}"
-    old = path.read_text() if path.exists() else ""
-    if START in old and END in old:
-        new = old[: old.index(START)] + section + old[old.index(END) + len(END) :]
-    else:
-        new = old + ("\n" if old else "") + section + "\n"
-    path.parent.mkdir(parents=True, exist_ok=True)
-    path.write_text(new)
-
-
-def _cpu_model() -> str:
-    try:
-        with open("/proc/cpuinfo") as fh:
-            for line in fh:
-                if line.startswith("model name"):
-                    return line.split(":", 1)[1].strip()
-    except OSError:
-        pass
-    return platform.processor() or platform.machine()
-
-
-def _today() -> str:
-    return time.strftime("%Y-%m-%d")
-
-
 # ---------------------------------------------------------------------------
 # rounds
 
@@ -663,21 +562,15 @@ def measure(
         ("batch", lambda: cli_run(folder, work / f"{name}.jsonl", workers, files)),
         ("instrumented", lambda: instrumented_run(folder, work / f"{name}.instrumented.jsonl", workers, files)),
     ]
-    best: dict[str, Any] = {}
 
     def wall(key: str, got: Any) -> float:
-        return got.wall_s if key == "instrumented" else got[0] if isinstance(got, tuple) else got
+        return float(got.wall_s if key == "instrumented" else got[0] if isinstance(got, tuple) else got)
 
-    for r in range(rounds):  # interleaved rounds, best of each: robust to a busy machine
-        load = available_cores()
-        loads.append(load)
-        k = r % len(contenders)
-        got: dict[str, Any] = {}
-        for key, run in contenders[k:] + contenders[:k]:
-            got[key] = run()
-            if key not in best or wall(key, got[key]) < wall(key, best[key]):
-                best[key] = got[key]
-        best["steady"] = min(best.get("steady", math.inf), got["instrumented"].run_s)
+    def probe(r: int) -> None:  # the cores this round can use, before its contenders run
+        loads.append(available_cores())
+
+    def report(r: int, got: dict[str, Any]) -> None:
+        load = loads[-1]
         inst = got["instrumented"]
         print(
             f"[{name}] round {r + 1}/{rounds}: trimesh {got['trimesh'][0]:.2f} s in-process, "
@@ -686,6 +579,11 @@ def measure(
             f"{inst.wall_s:.2f} s (run_batch {inst.run_s:.2f} s); cores available {load:.2f}",
             file=sys.stderr,
         )
+
+    # interleaved rounds, best of each: robust to a busy machine
+    rounds_run = interleaved(contenders, rounds, wall, after_round=report, before_round=probe)
+    best: dict[str, Any] = dict(rounds_run.best)
+    best["steady"] = min(inst.run_s for inst in rounds_run.runs["instrumented"])
     return best
 
 
@@ -726,12 +624,12 @@ def main(argv: list[str] | None = None) -> int:
             if args.only and name not in args.only:
                 continue
             folder = work / name
-            t = time.perf_counter()
+            clock = Stopwatch()
             triangles = generate(folder, count, shape, seed)
             files = sorted(folder.glob("*.stl"))
             megabytes = sum(p.stat().st_size for p in files) / 1e6
             print(
-                f"[{name}] generated {count} files, {triangles:,} triangles, {megabytes:.0f} MB in {time.perf_counter() - t:.1f} s",
+                f"[{name}] generated {count} files, {triangles:,} triangles, {megabytes:.0f} MB in {clock.wall_s:.1f} s",
                 file=sys.stderr,
             )
             rounds = args.rounds if name != "large" else max(1, args.rounds // 3)

@@ -17,6 +17,8 @@ __all__ = [
     "BOX_FACES",
     "box",
     "centred_box",
+    "box_inertia",
+    "cube",
     "prism",
     "icosahedron",
     "l_bracket",
@@ -54,6 +56,17 @@ def box(a: float, b: float, c: float, origin: Any = (0.0, 0.0, 0.0)) -> tuple[np
     o = np.asarray(origin, dtype=float)
     v = np.array([[(k & 1) * a, ((k >> 1) & 1) * b, ((k >> 2) & 1) * c] for k in range(8)]) + o
     return v, BOX_FACES.copy()
+
+
+def cube(side: float, origin: Any = (0.0, 0.0, 0.0)) -> tuple[np.ndarray, np.ndarray]:
+    """``box`` with three equal sides."""
+    return box(side, side, side, origin)
+
+
+def box_inertia(mass: float, a: float, b: float, c: float) -> np.ndarray:
+    """Inertia tensor of a solid a x b x c box of ``mass`` about its centre, along its edges:
+    m (b^2 + c^2) / 12, ... (any mechanics text, e.g. Landau & Lifshitz §32, problem 2)."""
+    return mass / 12 * np.diag([b * b + c * c, a * a + c * c, a * a + b * b])
 
 
 def centred_box(a: float, b: float, c: float) -> tuple[np.ndarray, np.ndarray]:

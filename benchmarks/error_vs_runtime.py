@@ -3,8 +3,10 @@
 Regenerate ``docs/error-vs-runtime.md`` and ``docs/error-vs-runtime.png`` from the repo root with
 
     python -m benchmarks.error_vs_runtime
+    python -m benchmarks.error_vs_runtime --quick --doc /tmp/evr.md --png /tmp/evr.png  # a smoke run
 
-(a few minutes on one core).  For a generic asymmetric top (I = 1, 2, 3 kg m^2,
+(a few minutes on one core; ``--quick``: T = 10 s and the small meshes only, about a minute).
+For a generic asymmetric top (I = 1, 2, 3 kg m^2,
 Omega0 = (0.3, 0.2, 1.0) rad/s, period 6.31 s) and horizons T = 10, 1e3, 1e5 s
 it measures, for each method and several tolerances or step sizes: the max
 error of Omega(t) (relative to |Omega0|) and of R(t) (max matrix entry) at 64
@@ -25,17 +27,20 @@ V (R^2 + 3 r^2 / 4), across V (R^2 / 2 + 5 r^2 / 8), V = 2 pi^2 R r^2).
 
 from __future__ import annotations
 
-import math
+import argparse
 import os
 import platform
 import sys
-import time
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from functools import partial
 from pathlib import Path
 
 import mpmath as mp
 import numpy as np
 
+from benchmarks.cases import torus
+from benchmarks.harness import Report, best_of, cpu_model, load_average, timed
 from inertia.motion import quaternions as quat
 from inertia.motion.integrators import integrate_scipy, integrate_splitting
 from inertia.motion.invariants import RigidProblem, invariant_drifts
@@ -132,18 +137,14 @@ def _problem() -> RigidProblem:
     return RigidProblem(MOMENTS, OMEGA0, np.eye(3), np.array([1.0, 0.0, 0.0, 0.0]))
 
 
-def _measure(method: str, setting: str, horizon: float, solve, ref) -> Run:  # type: ignore[no-untyped-def]
+Solver = Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]]
+
+
+def _measure(method: str, setting: str, horizon: float, solve: Solver, ref: tuple[np.ndarray, np.ndarray]) -> Run:
     t = np.linspace(0.0, horizon, SAMPLES)
     # best of up to 5 runs while they stay short (timeit's rule: the minimum is the least disturbed run)
-    seconds = math.inf
-    spent = 0.0
-    for _ in range(5):
-        started = time.perf_counter()
-        omega, attitude = solve(t)
-        elapsed = time.perf_counter() - started
-        seconds, spent = min(seconds, elapsed), spent + elapsed
-        if spent > 0.5:
-            break
+    (omega, attitude), timing = best_of(lambda: solve(t), repeat=5, budget_s=0.5)
+    seconds = timing.wall_s
     idx = np.arange(0, SAMPLES, (SAMPLES - 1) // CHECKS)
     w_ref, r_ref = ref
     omega_error = float(np.max(np.abs(omega[idx] - w_ref)) / np.linalg.norm(OMEGA0))
@@ -159,25 +160,21 @@ def _exact(t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 def exact_cost_per_sample(horizon: float) -> float:
     """Best of 3 wall-clock seconds per sample for Omega and attitude at TIMING_SAMPLES samples."""
     t = np.linspace(0.0, horizon, TIMING_SAMPLES)
-    best = math.inf
-    for _ in range(3):
-        started = time.perf_counter()
-        _exact(t)
-        best = min(best, time.perf_counter() - started)
-    return best / TIMING_SAMPLES
+    _, timing = best_of(lambda: _exact(t), repeat=3)
+    return timing.wall_s / TIMING_SAMPLES
 
 
-def run_all() -> tuple[list[Run], dict[float, float]]:
+def run_all(horizons: Sequence[float] = HORIZONS) -> tuple[list[Run], dict[float, float]]:
     runs: list[Run] = []
     per_sample: dict[float, float] = {}
     cost_at_1e3: dict[tuple[str, str], float] = {}
     problem = _problem()
     integrate_scipy(problem, np.linspace(0.0, 1.0, 3), "dop853", 1e-6, ATOL_REL, 10**9)  # warm-up: import and caches
-    for horizon in HORIZONS:
+    for horizon in horizons:
         t_checks = np.linspace(0.0, horizon, SAMPLES)[:: (SAMPLES - 1) // CHECKS]
         ref = reference(t_checks)
         print(f"T = {horizon:g}: reference ready", file=sys.stderr)
-        configs = [("exact", "closed form", _exact)]
+        configs: list[tuple[str, str, Solver]] = [("exact", "closed form", _exact)]
         configs += [("dop853", f"rtol {r:.0e}", _scipy("dop853", r, problem)) for r in DOP853_RTOLS]
         configs += [("rk45", f"rtol {r:.0e}", _scipy("rk45", r, problem)) for r in RK45_RTOLS]
         configs += [("splitting", f"h {h:g} s", _split(h, problem)) for h in SPLITTING_STEPS]
@@ -198,11 +195,11 @@ def run_all() -> tuple[list[Run], dict[float, float]]:
     return runs, per_sample
 
 
-def _scipy(method: str, rtol: float, problem: RigidProblem):  # type: ignore[no-untyped-def]
+def _scipy(method: str, rtol: float, problem: RigidProblem) -> Solver:
     return lambda t: integrate_scipy(problem, t, method, rtol, ATOL_REL, 10**9)
 
 
-def _split(step: float, problem: RigidProblem):  # type: ignore[no-untyped-def]
+def _split(step: float, problem: RigidProblem) -> Solver:
     return lambda t: integrate_splitting(problem, t, step, 10**9)
 
 
@@ -268,21 +265,6 @@ def icosphere(level: int) -> tuple[np.ndarray, np.ndarray]:
     return np.array(verts), np.array(faces, dtype=np.int64)
 
 
-def torus(n_major: int, n_minor: int, R: float = 1.0, r: float = 0.4) -> tuple[np.ndarray, np.ndarray]:
-    """Torus about z, vertices on the exact surface, 2 n_major n_minor outward triangles."""
-    u = 2 * np.pi * np.arange(n_major) / n_major
-    v = 2 * np.pi * np.arange(n_minor) / n_minor
-    uu, vv = np.meshgrid(u, v, indexing="ij")
-    verts = np.stack([(R + r * np.cos(vv)) * np.cos(uu), (R + r * np.cos(vv)) * np.sin(uu), r * np.sin(vv)], -1).reshape(-1, 3)
-    i, j = np.meshgrid(np.arange(n_major), np.arange(n_minor), indexing="ij")
-    a = i * n_minor + j
-    b = ((i + 1) % n_major) * n_minor + j
-    c = ((i + 1) % n_major) * n_minor + (j + 1) % n_minor
-    d = i * n_minor + (j + 1) % n_minor
-    faces = np.concatenate([np.stack([a, b, c], -1).reshape(-1, 3), np.stack([a, c, d], -1).reshape(-1, 3)])
-    return verts, faces.astype(np.int64)
-
-
 def mesh_moments(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
     """Principal moments at unit density through inertia.mass."""
     from inertia.body import MeshBody
@@ -292,26 +274,26 @@ def mesh_moments(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
     return np.sort(np.asarray(props.principal_moments))
 
 
-def mesh_rows() -> list[tuple[str, int, float, float]]:
+def mesh_rows(
+    levels: Sequence[int] = range(7), tori: Sequence[int] = (8, 16, 32, 64, 128, 256, 512)
+) -> list[tuple[str, int, float, float]]:
     rows = []
     sphere_exact = 8 * np.pi / 15
-    for level in range(0, 7):
+    for level in levels:
         v, f = icosphere(level)
         if not _outward(v, f):
             f = f[:, ::-1]
-        started = time.perf_counter()
-        moments = mesh_moments(v, f)
-        rows.append(("sphere", len(f), time.perf_counter() - started, float(np.max(np.abs(moments / sphere_exact - 1)))))
+        moments, timing = timed(partial(mesh_moments, v, f))
+        rows.append(("sphere", len(f), timing.wall_s, float(np.max(np.abs(moments / sphere_exact - 1)))))
     R, r = 1.0, 0.4
     volume = 2 * np.pi**2 * R * r * r
     torus_exact = np.array([volume * (R**2 / 2 + 5 * r**2 / 8)] * 2 + [volume * (R**2 + 3 * r**2 / 4)])
-    for n in (8, 16, 32, 64, 128, 256, 512):
+    for n in tori:
         v, f = torus(2 * n, n, R, r)
         if not _outward(v, f):
             f = f[:, ::-1]
-        started = time.perf_counter()
-        moments = mesh_moments(v, f)
-        rows.append(("torus", len(f), time.perf_counter() - started, float(np.max(np.abs(moments / torus_exact - 1)))))
+        moments, timing = timed(partial(mesh_moments, v, f))
+        rows.append(("torus", len(f), timing.wall_s, float(np.max(np.abs(moments / torus_exact - 1)))))
     return rows
 
 
@@ -323,7 +305,11 @@ def _outward(v: np.ndarray, f: np.ndarray) -> bool:
 # -- report ----------------------------------------------------------------------------------
 
 
-def plot(runs: list[Run], meshes: list[tuple[str, int, float, float]]) -> None:
+def _horizons(runs: list[Run]) -> list[float]:
+    return sorted({r.horizon for r in runs})
+
+
+def plot(runs: list[Run], meshes: list[tuple[str, int, float, float]], png: Path = PNG) -> None:
     import matplotlib
 
     matplotlib.use("Agg")
@@ -338,7 +324,7 @@ def plot(runs: list[Run], meshes: list[tuple[str, int, float, float]]) -> None:
         (axes[1], "attitude_error", "max |R - R_ref| (matrix entries)"),
     ):
         for method in colours:
-            for horizon in HORIZONS:
+            for horizon in _horizons(runs):
                 pts = [(r.seconds, max(getattr(r, attr), floor)) for r in runs if r.method == method and r.horizon == horizon]
                 if pts:
                     x, y = zip(*sorted(pts))
@@ -360,25 +346,26 @@ def plot(runs: list[Run], meshes: list[tuple[str, int, float, float]]) -> None:
     axes[2].legend()
     axes[2].grid(True, which="both", alpha=0.3)
     fig.tight_layout()
-    fig.savefig(PNG, dpi=110)
+    fig.savefig(png, dpi=110)
 
 
-def write_doc(runs: list[Run], per_sample: dict[float, float], meshes: list[tuple[str, int, float, float]]) -> str:
+def write_doc(runs: list[Run], per_sample: dict[float, float], meshes: list[tuple[str, int, float, float]]) -> Report:
     import scipy
 
     exact = {r.horizon: r for r in runs if r.method == "exact"}
+    report = Report(
+        "Error against run time: torque-free motion methods and mesh tessellation", "python -m benchmarks.error_vs_runtime"
+    )
     lines = [
-        "# Error against run time: torque-free motion methods and mesh tessellation",
-        "",
         "Generated by `benchmarks/error_vs_runtime.py`; regenerate from the repo root with",
         "",
         "```",
-        "python -m benchmarks.error_vs_runtime",
+        report.regenerate,
         "```",
         "",
-        f"Machine: {platform.machine()}, {platform.processor() or 'cpu'}; Python {platform.python_version()}, "
+        f"Machine: {platform.machine()}, {cpu_model()}; Python {platform.python_version()}, "
         f"numpy {np.__version__}, scipy {scipy.__version__}, mpmath {mp.__version__}; single thread, wall clock; "
-        f"load average at the end of the run {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores "
+        f"load average at the end of the run {load_average():.1f} on {os.cpu_count()} cores "
         "(a shared machine inflates every time alike; ratios are from the same run).",
         "",
         "Problem: generic asymmetric top, I = (1, 2, 3) kg m^2, Omega0 = (0.3, 0.2, 1.0) rad/s (period "
@@ -391,7 +378,7 @@ def write_doc(runs: list[Run], per_sample: dict[float, float], meshes: list[tupl
         "## Headline figures",
         "",
     ]
-    for horizon in HORIZONS:
+    for horizon in _horizons(runs):
         lines.append(
             f"- Exact method, T = {horizon:g} s: **{per_sample[horizon] * 1e6:.2f} µs per sample** for Omega and attitude "
             f"together at {TIMING_SAMPLES - 1:.0e} samples (best of 3); errors Omega {exact[horizon].omega_error:.1e}, "
@@ -446,12 +433,13 @@ def write_doc(runs: list[Run], per_sample: dict[float, float], meshes: list[tupl
         "the ratios above compare against DOP853's most accurate run when no run reaches the exact accuracy "
         "(a lower bound on the ratio at equal accuracy).",
     ]
-    return "\n".join(lines) + "\n"
+    report.add(*lines)
+    return report
 
 
 def _comparisons(runs: list[Run], per_sample: dict[float, float]) -> list[str]:
     out = []
-    for horizon in HORIZONS:
+    for horizon in _horizons(runs):
         ex = next(r for r in runs if r.method == "exact" and r.horizon == horizon)
         dop = [r for r in runs if r.method == "dop853" and r.horizon == horizon]
         six = next((r for r in dop if r.setting == "rtol 1e-06"), None)
@@ -479,13 +467,17 @@ def _skipped(runs: list[Run]) -> str:
     return ", ".join(f"{m} {s}" for m, s in sorted(at_1e3 - at_1e5))
 
 
-def main() -> None:
-    runs, per_sample = run_all()
-    meshes = mesh_rows()
-    DOC.parent.mkdir(exist_ok=True)
-    plot(runs, meshes)
-    DOC.write_text(write_doc(runs, per_sample, meshes), encoding="utf-8")
-    print(f"wrote {DOC} and {PNG}", file=sys.stderr)
+def main(argv: list[str] | None = None) -> None:
+    parser = argparse.ArgumentParser(prog="python -m benchmarks.error_vs_runtime", description=__doc__.split("\n")[0])
+    parser.add_argument("--doc", type=Path, default=DOC)
+    parser.add_argument("--png", type=Path, default=PNG)
+    parser.add_argument("--quick", action="store_true", help="T = 10 s and the small meshes only: a smoke run")
+    args = parser.parse_args(argv)
+    runs, per_sample = run_all((10.0,) if args.quick else HORIZONS)
+    meshes = mesh_rows(range(3), (8, 16)) if args.quick else mesh_rows()
+    plot(runs, meshes, args.png)
+    write_doc(runs, per_sample, meshes).write(args.doc)
+    print(f"wrote {args.doc} and {args.png}", file=sys.stderr)
 
 
 if __name__ == "__main__":

@@ -24,7 +24,7 @@ from typing import Any
 
 import numpy as np
 
-from benchmarks.cases import box, stl_bytes
+from benchmarks.cases import box, obj_bytes, stl_bytes
 
 ROOT = Path(__file__).resolve().parents[1]
 SAMPLES = ROOT / "sample_meshes"
@@ -48,18 +48,6 @@ def _torus(n: int, m: int, major: float, minor: float, offset: float) -> tuple[n
     c, d = ((i + 1) % n) * m + (j + 1) % m, i * m + (j + 1) % m
     faces = np.concatenate([np.stack([a, b, c], -1).reshape(-1, 3), np.stack([a, c, d], -1).reshape(-1, 3)])
     return pts + offset, faces
-
-
-def _obj_parts(parts: list[tuple[str, np.ndarray, np.ndarray]]) -> bytes:
-    """One OBJ file with an ``o`` object per part."""
-    lines: list[str] = []
-    base = 1
-    for name, v, f in parts:
-        lines.append(f"o {name}")
-        lines += [f"v {x!r} {y!r} {z!r}" for x, y, z in v.tolist()]
-        lines += [f"f {a + base} {b + base} {c + base}" for a, b, c in f.tolist()]
-        base += len(v)
-    return ("\n".join(lines) + "\n").encode()
 
 
 def _vtu_box(offset: float, densities: bool) -> bytes:
@@ -158,7 +146,7 @@ def cases() -> Iterator[tuple[str, Callable[[], dict[str, Any]]]]:
     t = (t[0] + [0.0, -4.0, 1.0], t[1])
     for offset in (0.0, 1e5):
         parts = [("left", a[0] + offset, a[1]), ("right", b[0] + offset, b[1]), ("ring", t[0] + offset, t[1])]
-        data = _obj_parts(parts)
+        data = obj_bytes(parts)
         assembly: tuple[tuple[str, dict[str, Any]], ...] = (
             ("default", {}),
             ("densities", {"densities": {"right": 2000.0, "ring": 8900.0}}),

@@ -3,6 +3,7 @@
 Every benchmark under ``benchmarks/`` measures with these and writes its document through them,
 so that each one states the same things the same way:
 
+- ``Stopwatch()``: wall and CPU seconds since it was started (for a stretch of code);
 - ``timed(call)``: wall and CPU seconds of an in-process call (``time.perf_counter`` and
   ``time.process_time``), and this process's peak resident set after it;
 - ``best_of(call, repeat, budget_s)``: the least disturbed of several runs (timeit's rule: the
@@ -11,9 +12,14 @@ so that each one states the same things the same way:
   peak resident set of it and every process it starts (sampled from ``/proc`` every
   ``SAMPLE_S``; the peak is the kernel's own high-water mark, ``VmHWM``, so no peak is missed
   between samples), its exit status and output;
+- ``run_tool(args)``: one process's wall time, CPU time and its own peak resident set, exactly
+  (GNU time's ``%M`` where ``/usr/bin/time`` exists: a child's ``ru_maxrss`` would include the
+  high-water mark of a large parent it was forked from), for tools compared on memory;
 - ``interleaved(contenders, rounds)``: rounds in which every contender runs once, their order
   rotated from round to round, and the best run of each kept: robust to a machine that is
   busy with other work for part of the time;
+- ``Server``: a real ``python -m inertia serve`` process on a free loopback port, ready when
+  ``/healthz`` answers (the tests' live servers are built on it);
 - ``available_cores()`` and ``machine()``: what the run had to work with;
 - ``Report``: a markdown document with a title, a header line that names the command that
   regenerates it and the machine, and ``write`` (the whole file, or only the section between
@@ -30,30 +36,42 @@ import os
 import platform
 import resource
 import shlex
+import socket
 import subprocess
 import sys
 import threading
 import time
-from collections.abc import Callable, Iterator, Mapping, Sequence
+import urllib.error
+import urllib.request
+from collections.abc import Callable, Hashable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Generic, TypeVar
+from types import TracebackType
+from typing import IO, Generic, TypeVar
 
 __all__ = [
     "ROOT",
     "SAMPLE_S",
     "START",
     "END",
+    "Stopwatch",
     "Timing",
     "timed",
     "best_of",
     "ProcStat",
+    "proc_stat",
+    "descendants",
     "TreeLog",
     "sampled",
     "ProcessRun",
     "run_process",
+    "ToolRun",
+    "run_tool",
+    "available_memory",
     "Best",
     "interleaved",
+    "free_port",
+    "Server",
     "peak_rss_bytes",
     "available_cores",
     "load_average",
@@ -69,6 +87,7 @@ SAMPLE_S = 0.05  # process-tree sampling period
 START, END = "<!-- benchmark:start -->", "<!-- benchmark:end -->"
 
 T = TypeVar("T")
+K = TypeVar("K", bound=Hashable)
 
 
 # ---------------------------------------------------------------------------
@@ -84,6 +103,21 @@ class Timing:
     peak_rss_bytes: int
 
 
+class Stopwatch:
+    """Wall seconds (``time.perf_counter``) and CPU seconds of this process (``time.process_time``) since creation."""
+
+    def __init__(self) -> None:
+        self._wall0, self._cpu0 = time.perf_counter(), time.process_time()
+
+    @property
+    def wall_s(self) -> float:
+        return time.perf_counter() - self._wall0
+
+    @property
+    def cpu_s(self) -> float:
+        return time.process_time() - self._cpu0
+
+
 def peak_rss_bytes() -> int:
     """This process's peak resident set so far (``ru_maxrss``, KiB on Linux)."""
     return int(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss) * 1024
@@ -91,9 +125,9 @@ def peak_rss_bytes() -> int:
 
 def timed(call: Callable[[], T]) -> tuple[T, Timing]:
     """``call()`` and its wall time, CPU time (this process, all threads) and the peak RSS after it."""
-    wall0, cpu0 = time.perf_counter(), time.process_time()
+    clock = Stopwatch()
     out = call()
-    wall, cpu = time.perf_counter() - wall0, time.process_time() - cpu0
+    wall, cpu = clock.wall_s, clock.cpu_s
     return out, Timing(wall, cpu, peak_rss_bytes())
 
 
@@ -119,11 +153,12 @@ def best_of(call: Callable[[], T], repeat: int = 1, budget_s: float = math.inf) 
 
 @dataclass(frozen=True)
 class ProcStat:
-    """CPU seconds, peak resident set [bytes] and command line of one live process (``/proc``)."""
+    """CPU seconds, peak and current resident set [bytes] and command line of one live process (``/proc``)."""
 
     cpu_s: float
     peak_rss_bytes: int
     command: str
+    rss_bytes: int = 0
 
 
 def _children() -> dict[int, list[int]]:
@@ -139,6 +174,11 @@ def _children() -> dict[int, list[int]]:
     return kids
 
 
+def descendants(pid: int) -> list[int]:
+    """The processes started by ``pid``, and theirs, and so on (not ``pid`` itself)."""
+    return [p for p in _tree([pid]) if p != pid]
+
+
 def _tree(roots: Sequence[int]) -> list[int]:
     kids = _children()
     out, todo = [], list(roots)
@@ -149,19 +189,22 @@ def _tree(roots: Sequence[int]) -> list[int]:
     return out
 
 
-def _proc(pid: int) -> ProcStat | None:
+def proc_stat(pid: int) -> ProcStat | None:
+    """What ``/proc`` says of a live process (None once it is gone)."""
     try:
         with open(f"/proc/{pid}/stat") as fh:
             fields = fh.read().rsplit(")", 1)[1].split()
         cpu = (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
-        hwm = 0
+        hwm = rss = 0
         with open(f"/proc/{pid}/status") as fh:
             for line in fh:
                 if line.startswith("VmHWM:"):
                     hwm = int(line.split()[1]) * 1024
+                elif line.startswith("VmRSS:"):
+                    rss = int(line.split()[1]) * 1024
         with open(f"/proc/{pid}/cmdline", "rb") as fh:
             cmd = fh.read().replace(b"\0", b" ").decode(errors="replace")
-        return ProcStat(cpu, hwm, cmd)
+        return ProcStat(cpu, hwm, cmd, rss)
     except (OSError, IndexError, ValueError):
         return None
 
@@ -175,7 +218,7 @@ class TreeLog:
 
     def sample(self, roots: Sequence[int]) -> None:
         for pid in _tree(roots):
-            got = _proc(pid)
+            got = proc_stat(pid)
             if got is not None:
                 self.seen[pid] = got
                 self.start_cpu.setdefault(pid, got.cpu_s)
@@ -252,7 +295,7 @@ def run_process(
     log = TreeLog()
     if extra_roots:
         log.sample(extra_roots)
-    t0 = time.perf_counter()
+    clock = Stopwatch()
     proc = subprocess.Popen(
         list(args), cwd=cwd, env=None if env is None else dict(env), stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True
     )
@@ -263,10 +306,66 @@ def run_process(
             proc.kill()
             out, err = proc.communicate()
             raise RuntimeError(f"`{command_line(args)}` ran past {timeout_s} s:\n{err[-3000:]}") from None
-    wall = time.perf_counter() - t0
+    wall = clock.wall_s
     if check and proc.returncode != 0:
         raise RuntimeError(f"`{command_line(args)}` failed (exit {proc.returncode}):\n{err[-3000:]}")
     return ProcessRun(tuple(args), proc.pid, proc.returncode, wall, log.cpu(), out, err, log)
+
+
+GNU_TIME = "/usr/bin/time"
+
+
+@dataclass(frozen=True)
+class ToolRun:
+    """Wall time, the process's own peak RSS [bytes], its stdout and its CPU time (user + system)."""
+
+    wall_s: float
+    peak_rss_bytes: int
+    stdout: str
+    cpu_s: float
+
+
+def run_tool(args: Sequence[str]) -> ToolRun:
+    """Run ``args`` to its end; a non-zero exit raises ``RuntimeError`` with the end of its stderr.
+
+    Linux carries a process's high-water RSS across fork and exec into the child's ``ru_maxrss``,
+    so a child of a large benchmark process would report at least that process's own peak.  GNU
+    time, itself tiny, forks the tool and reports the tool's own peak; without it, ``os.wait4``.
+    """
+    import tempfile
+
+    cmd = list(args)
+    wrapped = os.path.exists(GNU_TIME)
+    with tempfile.TemporaryFile() as out, tempfile.NamedTemporaryFile("r") as rss_file:
+        full = [GNU_TIME, "-f", "%M %U %S", "-o", rss_file.name, *cmd] if wrapped else cmd
+        clock = Stopwatch()
+        proc = subprocess.Popen(full, stdout=out, stderr=subprocess.PIPE)
+        _, status, usage = os.wait4(proc.pid, 0)
+        wall = clock.wall_s
+        proc.returncode = os.waitstatus_to_exitcode(status)
+        err = proc.stderr.read().decode() if proc.stderr else ""
+        if proc.stderr:
+            proc.stderr.close()
+        if proc.returncode != 0:
+            raise RuntimeError(f"{cmd[:3]} failed ({proc.returncode}): {err[-2000:]}")
+        if wrapped:
+            fields = rss_file.read().split()[-3:]
+            peak_kb, cpu = int(fields[0]), float(fields[1]) + float(fields[2])
+        else:
+            peak_kb, cpu = usage.ru_maxrss, usage.ru_utime + usage.ru_stime
+        out.seek(0)
+        return ToolRun(wall, peak_kb * 1024, out.read().decode(), cpu)
+
+
+def available_memory() -> int:
+    """MemAvailable of /proc/meminfo in bytes (0 where unknown)."""
+    try:
+        for line in Path("/proc/meminfo").read_text().splitlines():
+            if line.startswith("MemAvailable:"):
+                return int(line.split()[1]) * 1024
+    except (OSError, ValueError, IndexError):
+        pass
+    return 0
 
 
 # ---------------------------------------------------------------------------
@@ -274,26 +373,31 @@ def run_process(
 
 
 @dataclass
-class Best(Generic[T]):
+class Best(Generic[K, T]):
     """The best result of each contender over interleaved rounds, and every result of each."""
 
-    best: dict[str, T] = field(default_factory=dict)
-    runs: dict[str, list[T]] = field(default_factory=dict)
+    best: dict[K, T] = field(default_factory=dict)
+    runs: dict[K, list[T]] = field(default_factory=dict)
 
 
 def interleaved(
-    contenders: Sequence[tuple[str, Callable[[], T]]],
+    contenders: Sequence[tuple[K, Callable[[], T]]],
     rounds: int,
-    wall: Callable[[str, T], float],
-    after_round: Callable[[int, dict[str, T]], None] | None = None,
-) -> Best[T]:
-    """``rounds`` rounds, every contender once in each, the order rotated by one from round to round;
-    the best of each contender is the one with the least ``wall(name, result)``. ``after_round(r, got)``
+    wall: Callable[[K, T], float],
+    after_round: Callable[[int, dict[K, T]], None] | None = None,
+    before_round: Callable[[int], None] | None = None,
+    rotate: int = 1,
+) -> Best[K, T]:
+    """``rounds`` rounds, every contender once in each, the order rotated by ``rotate`` places from
+    round to round; the best of each contender is the one with the least ``wall(name, result)``.
+    ``before_round(r)`` runs first in each round (e.g. ``available_cores``), ``after_round(r, got)``
     sees each round's results (to print progress)."""
-    out: Best[T] = Best()
+    out: Best[K, T] = Best()
     for r in range(rounds):
-        k = r % len(contenders) if contenders else 0
-        got: dict[str, T] = {}
+        if before_round is not None:
+            before_round(r)
+        k = (r * rotate) % len(contenders) if contenders else 0
+        got: dict[K, T] = {}
         for name, run in [*contenders[k:], *contenders[:k]]:
             got[name] = run()
             out.runs.setdefault(name, []).append(got[name])
@@ -302,6 +406,102 @@ def interleaved(
         if after_round is not None:
             after_round(r, got)
     return out
+
+
+# ---------------------------------------------------------------------------
+# a live server
+
+
+def free_port(host: str = "127.0.0.1") -> int:
+    """A port nobody listens on right now."""
+    with socket.socket() as s:
+        s.bind((host, 0))
+        return int(s.getsockname()[1])
+
+
+def serve_command(host: str, port: int) -> list[str]:
+    """``python -m inertia serve`` on ``host:port``."""
+    return [sys.executable, "-m", "inertia", "serve", "--host", host, "--port", str(port)]
+
+
+class Server:
+    """A server process on a free loopback port, with the given ``INERTIA_*`` environment (the
+    caller's own ``INERTIA_*`` variables are dropped), ready once ``/healthz`` answers 200.
+
+    Its output goes to ``log_dir/<log_name>-<port>.log`` (read back by :meth:`output`), or nowhere
+    without ``log_dir``. ``command(host, port)`` gives its command line (``python -m inertia serve``
+    by default), run in ``cwd`` (the repository root by default). A server that does not come up
+    leaves no process or open file behind.
+    """
+
+    def __init__(
+        self,
+        env: Mapping[str, str] | None = None,
+        *,
+        startup_s: float = 30.0,
+        log_dir: Path | None = None,
+        log_name: str = "serve",
+        command: Callable[[str, int], list[str]] = serve_command,
+        host: str = "127.0.0.1",
+        cwd: Path = ROOT,
+    ) -> None:
+        self.port = free_port(host)
+        self.url = f"http://{host}:{self.port}"
+        full_env = {k: v for k, v in os.environ.items() if not k.startswith("INERTIA_")}
+        full_env.update(env or {})
+        self.log: IO[bytes] | None = None
+        if log_dir is not None:
+            log_dir.mkdir(parents=True, exist_ok=True)
+            self.log = open(log_dir / f"{log_name}-{self.port}.log", "w+b")  # noqa: SIM115  (open until stop())
+        self.process = subprocess.Popen(
+            command(host, self.port),
+            cwd=cwd,
+            env=full_env,
+            stdout=self.log if self.log is not None else subprocess.DEVNULL,
+            stderr=subprocess.STDOUT,
+        )
+        try:
+            self._wait_ready(startup_s)
+        except BaseException:
+            self.stop()
+            raise
+
+    def _wait_ready(self, startup_s: float) -> None:
+        deadline = time.monotonic() + startup_s
+        while time.monotonic() < deadline:
+            if self.process.poll() is not None:
+                raise RuntimeError(f"server exited: {self.output()}")
+            try:
+                with urllib.request.urlopen(f"{self.url}/healthz", timeout=1.0) as reply:
+                    if reply.status == 200:
+                        return
+            except (urllib.error.URLError, OSError):
+                time.sleep(0.1)
+        raise RuntimeError(f"server did not start in {startup_s} s: {self.output()}")
+
+    def output(self) -> str:
+        """What the server wrote so far (empty without a log)."""
+        if self.log is None:
+            return ""
+        self.log.flush()
+        self.log.seek(0)
+        return self.log.read().decode(errors="replace")
+
+    def stop(self) -> None:
+        self.process.terminate()
+        try:
+            self.process.wait(10)
+        except subprocess.TimeoutExpired:
+            self.process.kill()
+            self.process.wait()
+        if self.log is not None:
+            self.log.close()
+
+    def __enter__(self) -> Server:
+        return self
+
+    def __exit__(self, kind: type[BaseException] | None, exc: BaseException | None, tb: TracebackType | None) -> None:
+        self.stop()
 
 
 # ---------------------------------------------------------------------------

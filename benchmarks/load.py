@@ -216,6 +216,120 @@ def _torus_stl(n: int, m: int) -> bytes:
     return b"\0" * 80 + len(faces).to_bytes(4, "little") + records.tobytes()
 
 
+def _cpu_us(fns: dict[str, Callable[[], object]], number: int = 200, repeat: int = 7) -> dict[str, float]:
+    """CPU microseconds of one call of each function: the best of ``repeat`` batches, taken in turn (so
+    that a busy moment of the shared machine hits every function alike, not one of them)."""
+    best = dict.fromkeys(fns, float("inf"))
+    for _ in range(repeat):
+        for name, fn in fns.items():
+            start = time.process_time()
+            for _ in range(number):
+                fn()
+            best[name] = min(best[name], (time.process_time() - start) / number)
+    return {name: 1e6 * t for name, t in best.items()}
+
+
+def in_process_breakdown() -> list[tuple[str, float]]:
+    """Where a 3-point request's CPU goes, measured in this process without sockets (hot caches).
+
+    The app is called as an ASGI callable, so uvicorn's HTTP parsing and the socket writes (common to
+    both routes) are left out; the access log is off.  The analysis and its parts are then timed alone.
+    """
+    import json
+    import logging
+
+    from pydantic_core import to_json
+
+    from inertia.api import Settings, create_app
+    from inertia.api.jobs import PointsJob, run_job
+    from inertia.api.schemas import PointsRequest
+    from inertia.load import load_points
+    from inertia.mass import mass_properties
+
+    app = create_app(Settings())
+
+    @app.post("/bench/bare")
+    async def bare() -> dict[str, str]:
+        return {"status": "ok"}
+
+    @app.post("/bench/parsed")
+    async def parsed(body: PointsRequest) -> dict[str, str]:  # the points route's body handling, no analysis
+        return {"status": "ok"}
+
+    body = json.dumps(POINTS).encode()
+
+    async def call(path: str) -> None:
+        scope = {
+            "type": "http",
+            "asgi": {"version": "3.0"},
+            "http_version": "1.1",
+            "method": "POST",
+            "scheme": "http",
+            "path": path,
+            "raw_path": path.encode(),
+            "query_string": b"",
+            "root_path": "",
+            "headers": [(b"host", HOST.encode()), (b"content-type", b"application/json"), (b"content-length", b"%d" % len(body))],
+            "client": (HOST, 1),
+            "server": (HOST, 8000),
+        }
+        sent = False
+
+        async def receive() -> dict[str, object]:
+            nonlocal sent
+            if sent:
+                await asyncio.sleep(3600)
+            sent = True
+            return {"type": "http.request", "body": body, "more_body": False}
+
+        async def send(message: object) -> None:
+            return None
+
+        await app(scope, receive, send)
+
+    request = PointsRequest.model_validate_json(body)
+    records, options = request.records(), request.as_options()
+    job = PointsJob(records, options)
+    doc = run_job(job)
+    point_body = load_points(records, None).parts[0].body
+    access = logging.getLogger("inertia.api.access")
+    disabled, access.disabled = access.disabled, True
+    loop = asyncio.new_event_loop()
+    try:
+        t = _cpu_us(
+            {
+                "bare": lambda: loop.run_until_complete(call("/bench/bare")),
+                "parsed": lambda: loop.run_until_complete(call("/bench/parsed")),
+                "points": lambda: loop.run_until_complete(call("/v1/analyze/points")),
+                "run_job": lambda: run_job(job),
+                "mass": lambda: mass_properties(point_body),
+                "load": lambda: load_points(records, None),
+                "json": lambda: to_json(doc),
+            }
+        )
+    finally:
+        loop.close()
+        access.disabled = disabled
+    parse = t["parsed"] - t["bare"]
+    return [
+        ("bare route (ASGI call, no sockets)", t["bare"]),
+        ("/v1/analyze/points (ASGI call, no sockets)", t["points"]),
+        ("of which FastAPI's body parse and validation (a route with the same body returning a constant, less bare)", parse),
+        ("of which the analysis alone: `run_job` (load, mass, frame, class, result dict, checks)", t["run_job"]),
+        ("... of it `mass_properties` (two or three refinement passes, error bound)", t["mass"]),
+        ("... of it `load_points` (records to a validated body)", t["load"]),
+        ("of which the response JSON (`to_json`)", t["json"]),
+        (
+            "remainder (the route's own steps: options, job; and the analysis running colder inside a request)",
+            t["points"] - t["bare"] - parse - t["run_job"] - t["json"],
+        ),
+    ]
+
+
+def _load(values: tuple[float, float, float]) -> str:
+    return ", ".join(f"{v:.1f}" for v in values) + f" on {os.cpu_count()} cores"
+
+
 def _row(p: Phase) -> str:
     return f"| {p.name} | {len(p.latencies)} | {p.rate:.0f} | {p.quantile(0.5):.1f} | {p.quantile(0.99):.1f} | {p.errors} |"
 
@@ -289,7 +403,8 @@ def report(result: dict[str, object], sampler: MemorySampler, args: argparse.Nam
         f"(an `async def` returning a constant, behind the same middleware): the peer in the same run. "
         f"{args.clients} concurrent keep-alive clients (asyncio + httpx in one process on the same machine), "
         f"{args.seconds:g} s per phase. The machine is shared with other work: absolute rates are noisy and the "
-        "client itself takes CPU from the server; the ratio within each round is the figure that counts.",
+        "client itself takes CPU from the server; the ratio within each round is the figure that counts. "
+        f"Load average (1, 5, 15 min) at the start: {_load(args.load_before)}; at the end: {_load(args.load_after)}.",
         "",
         "## Small requests against the bare route",
         "",
@@ -311,13 +426,28 @@ def report(result: dict[str, object], sampler: MemorySampler, args: argparse.Nam
         "",
         "Read both: the throughput ratio is what clients on this machine saw (the load generator shares the "
         "cores, which narrows the gap); the CPU ratio is what the server spends. The transport part of a "
-        "small request is now the bare route's (no process round trip, no pickling); what remains is the "
-        "analysis itself, mass properties with their error estimate, about 1-3 ms of CPU for three points "
-        "on this machine.",
+        "small request is the bare route's (no process round trip, no pickling); what remains is the "
+        "analysis itself and FastAPI's handling of a JSON body.",
         "",
         "Requests of at most "
         "1,000 point masses without a trajectory (and precession without samples) run in the server process; "
         "every other job goes to a compute process.",
+        "",
+        "### Where a 3-point request's CPU goes",
+        "",
+        "Measured in the benchmark's own process after the server run: the app called as an ASGI callable "
+        "(no sockets, no uvicorn, access log off, hot caches), best of 7 batches of 200 calls, the parts "
+        "measured in turn. In the server "
+        "above every figure is larger (uvicorn's HTTP parsing and the socket writes come on top of both routes, "
+        "and caches are shared with the load generator), so read the rows as proportions.",
+        "",
+        "| part | CPU per request [us] |",
+        "|---|---|",
+    ]
+    breakdown = result.get("breakdown", [])
+    assert isinstance(breakdown, list)
+    lines += [f"| {name} | {us:.0f} |" for name, us in breakdown]
+    lines += [
         "",
         "## Small meshes, and a mix with 1,000,000-triangle meshes",
         "",
@@ -392,6 +522,8 @@ def main() -> None:
         finally:
             sampler.done.set()
             sampler.join()
+    args.load_after = os.getloadavg()
+    result["breakdown"] = in_process_breakdown()
     text = report(result, sampler, args, time.monotonic() - start)
     args.doc.write_text(text)
     print(text)

@@ -2,6 +2,7 @@
 
     python -m benchmarks.mass            # 1e4, 1e5, 1e6, 5e6, 2e7 triangles -> docs/performance.md
     python -m benchmarks.mass --quick    # 1e4, 1e5 only (a smoke run)
+    python -m benchmarks.mass --sizes 2e7 --repeat 1 --out docs/performance-2e7.md   # the 1 GB file alone
 
 2e7 triangles (a 1 GB file) runs a tool only where the machine has the
 memory it needs free (trimesh needs ~12x the file size); otherwise the cell
@@ -358,12 +359,20 @@ def report(results: dict[str, dict[str, Any]], stages: dict[str, dict[str, float
 
 
 def main(argv: list[str] | None = None) -> int:
+    global MEMORY_MARGIN
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--quick", action="store_true", help="only 1e4 and 1e5 triangles")
     parser.add_argument("--sizes", nargs="+", choices=list(SIZES), help="triangle counts to run")
     parser.add_argument("--repeat", type=int, default=3, help="runs per tool and size (median reported)")
     parser.add_argument("--out", default="docs/performance.md", help="report to write ('-' for stdout)")
+    parser.add_argument(
+        "--memory-margin",
+        type=float,
+        default=8.0,
+        help="GiB of memory to leave free for the rest of the machine; a tool that would leave less is not run",
+    )
     args = parser.parse_args(argv)
+    MEMORY_MARGIN = int(args.memory_margin * 2**30)
     sizes = args.sizes or (list(QUICK) if args.quick else list(SIZES))
     results: dict[str, dict[str, Any]] = {}
     stages: dict[str, dict[str, float]] = {}
@@ -394,6 +403,8 @@ def main(argv: list[str] | None = None) -> int:
         + (" --quick" if args.quick and not args.sizes else "")
         + (f" --sizes {' '.join(args.sizes)}" if args.sizes else "")
         + (f" --repeat {args.repeat}" if args.repeat != 3 else "")
+        + (f" --out {args.out}" if args.out not in ("docs/performance.md", "-") else "")
+        + (f" --memory-margin {args.memory_margin:g}" if args.memory_margin != 8 else "")
     )
     text = report(results, stages, command)
     if args.out == "-":

@@ -38,22 +38,23 @@ import argparse
 import contextlib
 import json
 import os
-import platform
 import shutil
 import signal
 import subprocess
 import sys
 import tempfile
-import threading
 import time
-from collections.abc import Iterator
-from dataclasses import dataclass, field
+from collections.abc import Callable
+from dataclasses import dataclass
+from functools import partial
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from benchmarks.batch import ANALYZE_SCRIPT, TRIMESH_SCRIPT, available_cores, uv_sphere, write_section, write_stl
+from benchmarks.batch import ANALYZE_SCRIPT, TRIMESH_SCRIPT, write_stl
+from benchmarks.cases import box, uv_sphere
+from benchmarks.harness import Report, TreeLog, available_cores, interleaved, machine, run_process, sampled
 
 ROOT = Path(__file__).resolve().parents[1]
 DOC = ROOT / "docs" / "scaling.md"
@@ -85,89 +86,6 @@ def generate(folder: Path, count: int, triangles: int, seed: int) -> int:
 
 
 # ---------------------------------------------------------------------------
-# process-tree sampling
-
-
-def _children() -> dict[int, list[int]]:
-    kids: dict[int, list[int]] = {}
-    for entry in os.listdir("/proc"):
-        if entry.isdigit():
-            try:
-                with open(f"/proc/{entry}/stat") as fh:
-                    ppid = int(fh.read().rsplit(")", 1)[1].split()[1])
-            except (OSError, IndexError, ValueError):
-                continue
-            kids.setdefault(ppid, []).append(int(entry))
-    return kids
-
-
-def _tree(roots: list[int]) -> list[int]:
-    kids = _children()
-    out, todo = [], list(roots)
-    while todo:
-        pid = todo.pop()
-        out.append(pid)
-        todo.extend(kids.get(pid, []))
-    return out
-
-
-def _proc(pid: int) -> tuple[float, int, str] | None:
-    """(CPU s, peak RSS bytes, command line) of a live process."""
-    try:
-        with open(f"/proc/{pid}/stat") as fh:
-            fields = fh.read().rsplit(")", 1)[1].split()
-        cpu = (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
-        hwm = 0
-        with open(f"/proc/{pid}/status") as fh:
-            for line in fh:
-                if line.startswith("VmHWM:"):
-                    hwm = int(line.split()[1]) * 1024
-        with open(f"/proc/{pid}/cmdline", "rb") as fh:
-            cmd = fh.read().replace(b"\0", b" ").decode(errors="replace")
-        return cpu, hwm, cmd
-    except (OSError, IndexError, ValueError):
-        return None
-
-
-@dataclass
-class TreeLog:
-    """The last CPU time, peak RSS and command line seen of each process of a tree."""
-
-    seen: dict[int, tuple[float, int, str]] = field(default_factory=dict)
-    start_cpu: dict[int, float] = field(default_factory=dict)
-
-    def sample(self, roots: list[int]) -> None:
-        for pid in _tree(roots):
-            got = _proc(pid)
-            if got is not None:
-                self.seen[pid] = got
-                self.start_cpu.setdefault(pid, got[0])
-
-    def cpu(self, pids: list[int] | None = None) -> float:
-        """CPU seconds the processes used while sampled (all of them by default)."""
-        keys = self.seen if pids is None else [p for p in pids if p in self.seen]
-        return sum(self.seen[p][0] - self.start_cpu[p] for p in keys)
-
-
-@contextlib.contextmanager
-def sampled(roots: list[int], log: TreeLog, extra: list[int] | None = None) -> Iterator[None]:
-    stop = threading.Event()
-
-    def loop() -> None:
-        while not stop.is_set():
-            log.sample(roots + (extra or []))
-            stop.wait(SAMPLE_S)
-
-    thread = threading.Thread(target=loop, daemon=True)
-    thread.start()
-    try:
-        yield
-    finally:
-        stop.set()
-        thread.join()
-
-
-# ---------------------------------------------------------------------------
 # runs
 
 
@@ -187,21 +105,10 @@ def check_rows(out: Path, count: int) -> None:
 
 
 def timed(cmd: list[str], extra_roots: list[int] | None = None) -> Run:
-    """Run ``cmd`` from launch to exit, sampling its process tree (and ``extra_roots``'s)."""
-    log = TreeLog()
-    if extra_roots:
-        log.sample(extra_roots)  # the cluster's CPU counts from here
-    t0 = time.perf_counter()
-    proc = subprocess.Popen(cmd, cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    with sampled([proc.pid], log, extra_roots):
-        _, err = proc.communicate()
-    wall = time.perf_counter() - t0
-    if proc.returncode != 0:
-        raise RuntimeError(f"`{' '.join(cmd)}` failed (exit {proc.returncode}):\n{err[-3000:]}")
-    client = log.seen.get(proc.pid, (0.0, 0, ""))[0] - log.start_cpu.get(proc.pid, 0.0)
-    workers = [pid for pid in log.seen if pid != proc.pid and (not extra_roots or pid not in extra_roots[:1])]
-    peak = max((log.seen[p][1] for p in workers), default=0)
-    return Run(wall, log.cpu(), client, peak)
+    """Run ``cmd`` from launch to exit, sampling its process tree (and ``extra_roots``'s, whose CPU counts from here)."""
+    done = run_process(cmd, extra_roots=extra_roots or ())
+    workers = [pid for pid in done.tree.seen if pid != done.pid and (not extra_roots or pid not in extra_roots[:1])]
+    return Run(done.wall_s, done.cpu_s, done.own_cpu_s, done.tree.peak(workers))
 
 
 def loop_run(script: str, file_list: Path, count: int) -> Run:
@@ -383,23 +290,15 @@ print(json.dumps({"wall_s": w, "client_cpu_s": c, "tasks": tasks}))
 
 
 def overhead_pool(workers: int, tasks: int) -> dict[str, Any]:
-    done = subprocess.run(
-        [sys.executable, "-c", OVERHEAD_POOL_SCRIPT, str(workers), str(tasks)], cwd=ROOT, capture_output=True, text=True, check=True
-    )
+    done = run_process([sys.executable, "-c", OVERHEAD_POOL_SCRIPT, str(workers), str(tasks)])
     return dict(json.loads(done.stdout.splitlines()[-1]))
 
 
 def overhead_dask(cluster: Cluster, tasks: int) -> dict[str, Any]:
     log = TreeLog()
     log.sample(cluster.roots)
-    with sampled([], log, cluster.roots):
-        done = subprocess.run(
-            [sys.executable, "-c", OVERHEAD_DASK_SCRIPT, cluster.address, str(tasks)],
-            cwd=ROOT,
-            capture_output=True,
-            text=True,
-            check=True,
-        )
+    with sampled(cluster.roots, log):
+        done = run_process([sys.executable, "-c", OVERHEAD_DASK_SCRIPT, cluster.address, str(tasks)])
     got = dict(json.loads(done.stdout.splitlines()[-1]))
     got["cluster_cpu_s"] = log.cpu()
     return got
@@ -407,30 +306,6 @@ def overhead_dask(cluster: Cluster, tasks: int) -> dict[str, Any]:
 
 # ---------------------------------------------------------------------------
 # report
-
-
-def _machine() -> dict[str, str]:
-    import importlib.metadata as md
-
-    model = platform.processor() or platform.machine()
-    with contextlib.suppress(OSError), open("/proc/cpuinfo") as fh:
-        for line in fh:
-            if line.startswith("model name"):
-                model = line.split(":", 1)[1].strip()
-                break
-    versions = {}
-    for pkg in ("numpy", "trimesh", "dask", "distributed"):
-        try:
-            versions[pkg] = md.version(pkg)
-        except md.PackageNotFoundError:
-            versions[pkg] = "not installed"
-    return {
-        "cpu": model,
-        "cores": str(os.cpu_count()),
-        "usable": str(len(os.sched_getaffinity(0))),
-        "python": platform.python_version(),
-        **versions,
-    }
 
 
 def _f(x: float, digits: int = 2) -> str:
@@ -497,10 +372,11 @@ def render(
     loads: list[float],
     rounds: int,
     command: str,
-) -> str:
-    m = _machine()
+) -> Report:
+    m = machine(("numpy", "trimesh", "dask", "distributed"))
+    report = Report("", command)
     lines = [
-        f"Regenerate: `{command}` (from the repository root; needs the `batch` extra, trimesh and psutil).",
+        report.regenerate_line("needs the `batch` extra, trimesh and psutil"),
         "",
         f"Machine: {m['cpu']}, **{m['cores']} cores** ({m['usable']} usable by this process), Python {m['python']}, "
         f"numpy {m['numpy']}, trimesh {m['trimesh']}, dask {m['dask']}, distributed {m['distributed']}; "
@@ -576,7 +452,8 @@ def render(
                 f"{p['vs_trimesh']:.1f}x |"
             )
         lines.append("")
-    return "\n".join(lines)
+    report.add(*lines)
+    return report
 
 
 # ---------------------------------------------------------------------------
@@ -643,66 +520,63 @@ def main(argv: list[str] | None = None) -> int:
             file_list.write_text("".join(f"{p}\n" for p in files), encoding="utf-8")
             megabytes = sum(p.stat().st_size for p in files) / 1e6
             print(f"[{name}] {count} files, {total:,} triangles, {megabytes:,.0f} MB", file=sys.stderr)
-            best: dict[tuple[str, int], Run] = {}
             out = work / f"{name}.jsonl"
             plan = _plan(workers, local_n, not args.no_cluster, work, folder, file_list, out, count)
-            for r in range(rounds):
-                loads.append(available_cores())
-                k = (r * 3) % len(plan)
-                for key, fn in plan[k:] + plan[:k]:
-                    run = fn()
+
+            def progress(r: int, got: dict[tuple[str, int], Run], name: str = name) -> None:
+                for key, run in got.items():
                     print(
                         f"[{name}] round {r + 1}: {key[0]} x{key[1]}: {run.wall_s:.2f} s, CPU {run.cpu_s:.2f} s "
                         f"(command {run.client_cpu_s:.2f} s), peak worker {run.peak_worker_bytes / 2**20:.0f} MiB",
                         file=sys.stderr,
                     )
-                    if key not in best or run.wall_s < best[key].wall_s:
-                        best[key] = run
+
+            best = interleaved(
+                plan,
+                rounds,
+                lambda _key, run: run.wall_s,
+                after_round=progress,
+                before_round=lambda _r: loads.append(available_cores()),
+                rotate=3,
+            ).best
             ordered = {key: best[key] for key, _ in plan}
             results.append(SetResult(name, count, total, megabytes, ordered))
             shutil.rmtree(folder)
     finally:
         shutil.rmtree(work, ignore_errors=True)
-    text = render(results, workers, overheads, starts, loads, rounds, command.strip())
-    if str(args.out) == "-":
-        print(text)
-    else:  # the measured part, between the markers; text around them is kept
-        write_section(args.out, text)
-        print(text)
+    report = render(results, workers, overheads, starts, loads, rounds, command.strip())
+    if str(args.out) != "-":  # the measured part, between the markers; text around them is kept
+        report.write(args.out, section=True)
+    print(report.text())
     return 0
 
 
 def _plan(
     workers: list[int], local_n: int, cluster: bool, work: Path, folder: Path, file_list: Path, out: Path, count: int
-) -> list[tuple[tuple[str, int], Any]]:
-    plan: list[tuple[tuple[str, int], Any]] = [
+) -> list[tuple[tuple[str, int], Callable[[], Run]]]:
+    plan: list[tuple[tuple[str, int], Callable[[], Run]]] = [
         (("trimesh loop", 1), lambda: loop_run(TRIMESH_SCRIPT, file_list, count)),
         (("analyze loop", 1), lambda: loop_run(ANALYZE_SCRIPT, file_list, count)),
     ]
     for n in workers:
-        plan.append((("inertia batch", n), lambda n=n: command_run(folder, out, count, n)))
+        plan.append((("inertia batch", n), partial(command_run, folder, out, count, n)))
     plan.append((("Dask LocalCluster", local_n), lambda: localcluster_run(folder, out, count, local_n)))
     if cluster:
         for n in workers:
-            plan.append((("dask scheduler + workers", n), lambda n=n: _with_cluster(n, work, folder, out, count)))
+            plan.append((("dask scheduler + workers", n), partial(_with_cluster, n, work, folder, out, count)))
     return plan
 
 
 def startup(work: Path, workers: list[int], rounds: int) -> dict[int, Run]:
     """The command on N files of 12 triangles with N workers (best of ``rounds``): its start-up and shutdown."""
-    from benchmarks.batch import BOX
-
     best: dict[int, Run] = {}
     for n in workers:
         folder = work / f"startup-{n}"
         folder.mkdir()
-        v, f = BOX
+        v, f = box(1.0, 1.0, 1.0)
         for i in range(n):
             write_stl(folder / f"box_{i:03d}.stl", (v * (1.0 + i))[f])
-        for _ in range(rounds):
-            run = command_run(folder, work / "startup.jsonl", n, n)
-            if n not in best or run.wall_s < best[n].wall_s:
-                best[n] = run
+        best[n] = min((command_run(folder, work / "startup.jsonl", n, n) for _ in range(rounds)), key=lambda run: run.wall_s)
         shutil.rmtree(folder)
     return best
 

@@ -14,16 +14,14 @@ Playwright (as the end-to-end tests do) and saves three views:
 from __future__ import annotations
 
 import argparse
-import os
 import shutil
-import socket
-import subprocess
-import sys
-import time
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
-import httpx
+from benchmarks.harness import Server
+
+if TYPE_CHECKING:
+    from playwright.sync_api import FloatRect
 
 ROOT = Path(__file__).resolve().parents[1]
 SAMPLES = ROOT / "sample_meshes"
@@ -42,30 +40,6 @@ ARGS = [
     "--enable-unsafe-swiftshader",
 ]
 FLIP = {"omega": "0.01,1,0.01", "duration": "110", "samples": "1100"}
-
-
-def _serve() -> tuple[subprocess.Popen[bytes], str]:
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        port = int(s.getsockname()[1])
-    env = {k: v for k, v in os.environ.items() if not k.startswith("INERTIA_")}
-    env["INERTIA_COMPUTE_PROCESSES"] = "1"
-    process = subprocess.Popen(
-        [sys.executable, "-m", "inertia", "serve", "--host", "127.0.0.1", "--port", str(port)],
-        cwd=ROOT,
-        env=env,
-        stdout=subprocess.DEVNULL,
-        stderr=subprocess.DEVNULL,
-    )
-    url = f"http://127.0.0.1:{port}"
-    for _ in range(600):
-        try:
-            if httpx.get(f"{url}/healthz", timeout=1).status_code == 200:
-                return process, url
-        except httpx.TransportError:
-            time.sleep(0.1)
-    process.kill()
-    raise SystemExit("the server did not start")
 
 
 def _analyze(page: Any, url: str, name: str, **fields: str) -> None:
@@ -91,7 +65,7 @@ def _to_first_flip(page: Any) -> None:
     }""")
 
 
-def _clip(page: Any, *selectors: str) -> dict[str, float]:
+def _clip(page: Any, *selectors: str) -> FloatRect:
     boxes = [page.locator(s).bounding_box() for s in selectors]
     x0, y0 = min(b["x"] for b in boxes), min(b["y"] for b in boxes)
     x1, y1 = max(b["x"] + b["width"] for b in boxes), max(b["y"] + b["height"] for b in boxes)
@@ -106,25 +80,21 @@ def main() -> None:
     from playwright.sync_api import sync_playwright
 
     args.out.mkdir(parents=True, exist_ok=True)
-    process, url = _serve()
-    try:
-        with sync_playwright() as p:
-            browser = p.chromium.launch(executable_path=args.chromium, args=ARGS)
-            desktop = browser.new_page(viewport={"width": 1280, "height": 1400})
-            _analyze(desktop, url, "l_bracket.stl")
-            desktop.screenshot(path=args.out / "asymmetric.png", clip={"x": 0, "y": 0, "width": 1280, "height": 790})
-            _analyze(desktop, url, "box.stl", **FLIP)
-            _to_first_flip(desktop)
-            desktop.screenshot(path=args.out / "tennis-racket.png", clip=_clip(desktop, "#view-section", "#motion"))
-            phone = browser.new_page(viewport={"width": 390, "height": 844}, device_scale_factor=2)
-            _analyze(phone, url, "box.stl", **FLIP)
-            _to_first_flip(phone)
-            phone.evaluate("document.getElementById('view-section').scrollIntoView()")
-            phone.screenshot(path=args.out / "phone.png")
-            browser.close()
-    finally:
-        process.terminate()
-        process.wait(10)
+    with Server({"INERTIA_COMPUTE_PROCESSES": "1"}, startup_s=60.0) as server, sync_playwright() as p:
+        url = server.url
+        browser = p.chromium.launch(executable_path=args.chromium, args=ARGS)
+        desktop = browser.new_page(viewport={"width": 1280, "height": 1400})
+        _analyze(desktop, url, "l_bracket.stl")
+        desktop.screenshot(path=args.out / "asymmetric.png", clip={"x": 0, "y": 0, "width": 1280, "height": 790})
+        _analyze(desktop, url, "box.stl", **FLIP)
+        _to_first_flip(desktop)
+        desktop.screenshot(path=args.out / "tennis-racket.png", clip=_clip(desktop, "#view-section", "#motion"))
+        phone = browser.new_page(viewport={"width": 390, "height": 844}, device_scale_factor=2)
+        _analyze(phone, url, "box.stl", **FLIP)
+        _to_first_flip(phone)
+        phone.evaluate("document.getElementById('view-section').scrollIntoView()")
+        phone.screenshot(path=args.out / "phone.png")
+        browser.close()
     for name in ("asymmetric.png", "tennis-racket.png", "phone.png"):
         print(args.out / name)
 

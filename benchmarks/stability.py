@@ -7,7 +7,7 @@
 Reference values never come from the service: the exact principal moments of
 the polyhedron *as stored* (the float64 vertices every tool receives) come from
 rational integration with Python integers and 50-digit eigenvalues
-(``tests/exact.py``); motion references are mpmath closed forms (Jacobi
+(``benchmarks/exact.py``); motion references are mpmath closed forms (Jacobi
 elliptic functions, L&L §37; the symmetric top, L&L §33) at 40 digits.
 
 Peers get the same arrays: trimesh (``Trimesh(process=False)``), numpy-stl
@@ -23,10 +23,10 @@ from __future__ import annotations
 import argparse
 import math
 import sys
-import time
 from collections.abc import Callable, Sequence
 from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass, field
+from functools import partial
 from pathlib import Path
 from typing import TypedDict, cast
 
@@ -36,7 +36,8 @@ from numpy.typing import NDArray
 from scipy.spatial.transform import Rotation
 
 from benchmarks.cases import BOX_FACES, box, centred_box, flat_shells, prism, stl_bytes, uv_sphere
-from benchmarks.exact import exact_eigenvalues, exact_points, exact_solid, exact_tetrahedra, relative_error
+from benchmarks.exact import elliptic_omega, exact_eigenvalues, exact_points, exact_solid, exact_tetrahedra, relative_error
+from benchmarks.harness import Report, Stopwatch, timed
 from inertia.body import MeshBody, PointBody, VolumeBody
 from inertia.classification import RotorClass, classify
 from inertia.mass import mass_properties
@@ -240,12 +241,11 @@ def _worst(errors: Sequence[float], bounds: Sequence[float]) -> float:
 
 def measure_mesh(case: MeshCase, exact: Sequence[mpmath.mpf] | None = None) -> Row:
     """Our error and each peer's on one mesh, against its exact principal moments."""
-    start = time.perf_counter()
+    clock = Stopwatch()
     if exact is None:
         exact = exact_eigenvalues(exact_solid(case.vertices, case.faces)[2])
-    t0 = time.perf_counter()
-    props = mass_properties(MeshBody(case.vertices, case.faces), density=1.0)
-    ours_s = time.perf_counter() - t0
+    props, ours_timing = timed(lambda: mass_properties(MeshBody(case.vertices, case.faces), density=1.0))
+    ours_s = ours_timing.wall_s
     ours = np.sort(props.principal_moments)
     bounds = _bounds(case.thin)
     finite = bool(np.all(np.isfinite(props.principal_moments)) and np.isfinite(props.relative_error_estimate))
@@ -260,9 +260,8 @@ def measure_mesh(case: MeshCase, exact: Sequence[mpmath.mpf] | None = None) -> R
     for name, run in runners.items():
         if name not in case.peers:
             continue
-        t0 = time.perf_counter()
-        result = run()  # type: ignore[no-untyped-call]
-        peer_s[name] = time.perf_counter() - t0
+        result, peer = timed(run)
+        peer_s[name] = peer.wall_s
         peers[name] = result if isinstance(result, str) else _worst(moment_errors(result, exact), bounds)
     estimate = float(props.relative_error_estimate)
     passed = finite and all(e <= b for e, b in zip(errors, bounds)) and all(e <= estimate for e in errors)
@@ -278,7 +277,7 @@ def measure_mesh(case: MeshCase, exact: Sequence[mpmath.mpf] | None = None) -> R
         passed,
         estimate <= max(bounds),
         case.note,
-        time.perf_counter() - start,
+        clock.wall_s,
         {"errors": errors, "ours_s": ours_s, "peer_s": peer_s},
     )
 
@@ -333,7 +332,7 @@ def summation_cases(quick: bool) -> list[tuple[int, MeshCase]]:
 
 def two_material_case(ratio: float = 1e6, offset: float = 1e3) -> Row:
     """Two unit cubes of densities 1 and ``ratio`` (tetrahedra), rotated and moved ``offset`` sizes."""
-    start = time.perf_counter()
+    clock = Stopwatch()
     pts, tets, rho = two_material_boxes(ratio)
     pts = placed(pts, offset=offset * 2.0 * DIRECTION)
     _mass, _, tensor = exact_tetrahedra(pts, tets, rho)
@@ -365,14 +364,14 @@ def two_material_case(ratio: float = 1e6, offset: float = 1e3) -> Row:
         passed,
         estimate <= BOUND_EXACT,
         "VolumeBody cell_density; MuJoCo: two mesh geoms",
-        time.perf_counter() - start,
+        clock.wall_s,
         {"errors": errors},
     )
 
 
 def point_case(n: int) -> Row:
     """n point masses spanning 1e-12 .. 1e12 kg: exact integer sums vs ours and naive float64."""
-    start = time.perf_counter()
+    clock = Stopwatch()
     masses, positions = log_uniform_points(n)
     _, _, tensor = exact_points(masses, positions)
     exact = exact_eigenvalues(tensor)
@@ -396,7 +395,7 @@ def point_case(n: int) -> Row:
         passed,
         estimate <= BOUND_EXACT,
         f"naive float64 (sum about origin, then shift): {naive_err:.1e}",
-        time.perf_counter() - start,
+        clock.wall_s,
         {"errors": errors},
     )
 
@@ -617,14 +616,14 @@ def reference_omega(moments: Sequence[float], omega: Sequence[float], t: Array, 
     Symmetric top (two equal moments): the perpendicular part turns at the
     body precession rate (I_s - I_p) / I_p Omega_s (L&L §33).  Asymmetric top:
     Jacobi elliptic functions (L&L §37, eq. 37.10 and its 1 <-> 3 variant below
-    the separatrix), phase from Omega(0), signs fixed by Euler's equations.
+    the separatrix; ``benchmarks.exact.elliptic_omega``), phase from Omega(0), signs fixed by Euler's equations.
     """
     with mpmath.workdps(digits):
         I = [mpmath.mpf(x) for x in moments]
         w = [mpmath.mpf(x) for x in omega]
         if I[0] == I[1] or I[1] == I[2]:
             return _symmetric_reference(I, w, t)
-        return _elliptic_reference(I, w, t)
+    return elliptic_omega(moments, omega, t, dps=digits)
 
 
 def _symmetric_reference(I: list[mpmath.mpf], w: list[mpmath.mpf], t: Array) -> Array:
@@ -640,52 +639,6 @@ def _symmetric_reference(I: list[mpmath.mpf], w: list[mpmath.mpf], t: Array) -> 
         out[n, p] = float(w[p] * c - w[q] * sn)
         out[n, q] = float(w[p] * sn + w[q] * c)
     return out
-
-
-def _elliptic_reference(I: list[mpmath.mpf], w: list[mpmath.mpf], t: Array) -> Array:
-    E2 = sum(i * x * x for i, x in zip(I, w))  # 2E
-    M2 = sum((i * x) ** 2 for i, x in zip(I, w))
-    # above the separatrix Omega_3 keeps its sign (dn), below Omega_1 does
-    d, c = (2, 0) if E2 * I[1] < M2 else (0, 2)
-    i1, i2, i3 = I
-    if d == 2:
-        amp = [
-            mpmath.sqrt((E2 * i3 - M2) / (i1 * (i3 - i1))),
-            mpmath.sqrt((E2 * i3 - M2) / (i2 * (i3 - i2))),
-            mpmath.sqrt((M2 - E2 * i1) / (i3 * (i3 - i1))),
-        ]
-        rate = mpmath.sqrt((i3 - i2) * (M2 - E2 * i1) / (i1 * i2 * i3))
-        m = (i2 - i1) * (E2 * i3 - M2) / ((i3 - i2) * (M2 - E2 * i1))
-    else:
-        amp = [
-            mpmath.sqrt((E2 * i3 - M2) / (i1 * (i3 - i1))),
-            mpmath.sqrt((M2 - E2 * i1) / (i2 * (i2 - i1))),
-            mpmath.sqrt((M2 - E2 * i1) / (i3 * (i3 - i1))),
-        ]
-        rate = mpmath.sqrt((i2 - i1) * (E2 * i3 - M2) / (i1 * i2 * i3))
-        m = (i3 - i2) * (M2 - E2 * i1) / ((i2 - i1) * (E2 * i3 - M2))
-    sd = 1 if w[d] > 0 else -1
-    best = None
-    for sigma in (1, -1):
-        phi0 = mpmath.atan2(w[1] / (sigma * amp[1]), w[c] / amp[c])
-        tau0 = mpmath.ellipf(phi0, m)
-
-        def at(tau: mpmath.mpf, sigma: int = sigma) -> list[mpmath.mpf]:
-            sn, cn, dn = (mpmath.ellipfun(k, tau, m=m) for k in ("sn", "cn", "dn"))
-            out = [mpmath.mpf(0)] * 3
-            out[c], out[1], out[d] = amp[c] * cn, sigma * amp[1] * sn, sd * amp[d] * dn
-            return out
-
-        h = mpmath.mpf(10) ** -15
-        plus, minus = at(tau0 + rate * h), at(tau0 - rate * h)
-        deriv = [(a - b) / (2 * h) for a, b in zip(plus, minus)]
-        euler = [(i2 - i3) / i1 * w[1] * w[2], (i3 - i1) / i2 * w[2] * w[0], (i1 - i2) / i3 * w[0] * w[1]]
-        mismatch = max(abs(a - b) for a, b in zip(deriv, euler)) + max(abs(a - b) for a, b in zip(at(tau0), w))
-        if best is None or mismatch < best[0]:
-            best = (mismatch, at, tau0)
-    assert best is not None
-    _, at, tau0 = best
-    return np.array([[float(x) for x in at(tau0 + rate * mpmath.mpf(float(tt)))] for tt in t])
 
 
 class ScipyCell(TypedDict, total=False):
@@ -719,7 +672,7 @@ def measure_motion(case: MotionCase, samples: int = 2001, reference_samples: int
     """Invariant drift of our exact method (and scipy DOP853) over 1e5 time units; Omega error vs mpmath."""
     from inertia.pipeline import precession
 
-    start = time.perf_counter()
+    clock = Stopwatch()
     result = precession(
         case.omega, principal_moments=case.moments, tolerance=case.tolerance, duration=HORIZON, samples=samples, method="exact"
     )
@@ -747,7 +700,7 @@ def measure_motion(case: MotionCase, samples: int = 2001, reference_samples: int
         "service_drift": (result.motion.diagnostics.energy_drift, result.motion.diagnostics.momentum_drift),
         "passed": finite and e_drift <= BOUND_INVARIANT and m_drift <= BOUND_INVARIANT,
         "scipy": scipy_cell,
-        "seconds": time.perf_counter() - start,
+        "seconds": clock.wall_s,
     }
 
 
@@ -762,7 +715,7 @@ def _scipy_cell(case: MotionCase, moments: Array, omega_body0: Array, frame: obj
     if not run:
         return {"skipped": "skipped (--quick)"}
     t = np.linspace(0.0, horizon, 2001)
-    start = time.perf_counter()
+    clock = Stopwatch()
     try:
         w, q = scipy_motion(moments, omega_body0, t)
     except Exception as exc:  # a peer that fails gets that text in its cell
@@ -776,7 +729,7 @@ def _scipy_cell(case: MotionCase, moments: Array, omega_body0: Array, frame: obj
         "momentum_drift": m_drift,
         "omega_error": err,
         "horizon": horizon,
-        "seconds": time.perf_counter() - start,
+        "seconds": clock.wall_s,
     }
 
 
@@ -831,13 +784,12 @@ def render(
     quick: bool,
     elapsed: float,
     timings: dict[str, tuple[float, float]],
-) -> str:
+) -> Report:
     failures = [r for r in geometry + growth if not r.passed] + [m for m in motion if not m["passed"]]
     over = [r for r in geometry + growth if r.passed and not r.estimate_ok]
+    report = Report("Numerical stability report", "python -m benchmarks.stability")
     out = [
-        "# Numerical stability report",
-        "",
-        "Generated by `python -m benchmarks.stability` "
+        f"Generated by `{report.regenerate}` "
         + ("with `--quick` (largest cases skipped)" if quick else "(full battery)")
         + f" in {elapsed:.0f} s. Regenerate with that command; `--quick` skips the 1e6 and 1e7 cases. "
         "Every row's bound is also asserted by `tests/test_stability.py`.",
@@ -855,7 +807,7 @@ def render(
         "Errors are relative, per principal moment against its own exact value; a cell shows the worst moment "
         "(for needles and plates, the one nearest its bound). **Exact** values come from rational integration "
         "of the float64 vertices as stored (after rotation and translation) and 50-digit eigenvalues, never "
-        "from our code (`tests/exact.py`). Pass = our error within the bound and within our own "
+        "from our code (`benchmarks/exact.py`). Pass = our error within the bound and within our own "
         "`relative_error_estimate`.",
         "",
         "## Geometry",
@@ -919,7 +871,8 @@ def render(
                 out.append(
                     f"- motion {r['case']}: energy drift {r['energy_drift']:.2e}, |M| drift {r['momentum_drift']:.2e}, bound 1e-12"
                 )
-    return "\n".join(out) + "\n"
+    report.add(*out)
+    return report
 
 
 TOLERANCE_ADVICE = [
@@ -1144,7 +1097,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         help="compute only the 'Honest numbers' section (~15 s) and replace it in an existing report",
     )
     args = parser.parse_args(argv)
-    started = time.perf_counter()
+    clock = Stopwatch()
     if args.honest_only:
         section = "\n".join(honest_lines([tensor_estimate_row(), nearly_symmetric_row(), *float32_rows()])) + "\n"
         old = args.output.read_text() if args.output.exists() else ""
@@ -1161,9 +1114,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     growth: list[Row] = []
     timings: dict[str, tuple[float, float]] = {}
     for _n, case in summation_cases(args.quick):
-        t0 = time.perf_counter()
-        growth.append(measure_mesh(case))
-        timings[f"{len(case.faces):.1e} triangles"] = (growth[-1].extra["ours_s"], time.perf_counter() - t0)  # type: ignore[assignment]
+        row, whole = timed(partial(measure_mesh, case))
+        growth.append(row)
+        timings[f"{len(case.faces):.1e} triangles"] = (float(cast(float, row.extra["ours_s"])), whole.wall_s)
         print(f"  {case.name}: {growth[-1].seconds:.1f} s", file=sys.stderr)
     flip = near_symmetric_flip()
     tess = tessellation_rows()
@@ -1172,11 +1125,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     for m in motion:
         print(f"  {m['case']}: {m['seconds']:.1f} s", file=sys.stderr)
     honest = [tensor_estimate_row(), nearly_symmetric_row(), *float32_rows()]
-    text = render(geometry, growth, flip, tess, motion, args.quick, time.perf_counter() - started, timings)
-    text += "\n" + "\n".join(honest_lines(honest)) + "\n"
-    args.output.parent.mkdir(parents=True, exist_ok=True)
-    args.output.write_text(text)
-    print(text)
+    report = render(geometry, growth, flip, tess, motion, args.quick, clock.wall_s, timings)
+    report.add("", *honest_lines(honest))
+    report.write(args.output)
+    print(report.text())
     return 0
 
 

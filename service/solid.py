@@ -96,8 +96,7 @@ def _orient_outward(
     vertices: NDArray[np.float64], faces: NDArray[np.int64], topo: SurfaceTopology
 ) -> tuple[NDArray[np.int64], list[str]]:
     """Orient every shell by its nesting depth: material outward, cavities inward."""
-    x = vertices - local_origin(vertices)
-    det = _signed_volumes(x, faces)
+    det = _signed_volumes(vertices - local_origin(vertices), faces)
     if np.all(det >= 0):  # every face sees the local origin from outside: outward already
         return faces, []
     total = float(det.sum())
@@ -109,7 +108,7 @@ def _orient_outward(
         if total < 0:
             return faces[:, [0, 2, 1]], ["inverted winding corrected (all faces pointed inward)"]
         return faces, []
-    depth = _nesting_depth(x, faces, label, count)
+    depth = _nesting_depth(vertices - local_origin(vertices), faces, label, count)  # formed again: not held above
     if isinstance(depth, str):  # nesting undecidable: keep the file's orientation
         if total < 0 and np.all(vol <= 0):
             return faces[:, [0, 2, 1]], ["inverted winding corrected (all faces pointed inward)"]

@@ -71,6 +71,8 @@ def row_ids(
     columns = [table[:, j] for j in range(table.shape[1])]
     n = len(table)
     order, same_hash = _hash_order(_row_hash(columns))
+    index: type[np.signedinteger] = np.int32 if n < 2**31 else np.int64
+    order = order.astype(index, copy=False)  # half the memory of int64 while ids are built
     same = _equal_neighbours(table, order)
     collided = same_hash & ~same
     if np.any(collided):
@@ -85,17 +87,17 @@ def row_ids(
     is_head = np.zeros(n, dtype=bool)
     is_head[firsts] = True
     heads = np.flatnonzero(is_head)
-    index: type[np.signedinteger] = np.int32 if n < 2**31 else np.int64
     group_rank: NDArray[np.signedinteger] = np.cumsum(is_head, dtype=index)[firsts]
     group_rank -= 1  # hash-order group -> its number in order of first occurrence
     del is_head, firsts
-    group: NDArray[np.signedinteger] = np.cumsum(new, dtype=index)
-    group -= 1  # hash-order group of each sorted row
-    del new
     ids = np.empty(n, dtype=np.int64)
+    before = 0  # groups that start before this block
     for start in range(0, n, SCATTER_CHUNK):
         stop = start + SCATTER_CHUNK
-        ids[order[start:stop]] = group_rank[group[start:stop]]
+        group = np.cumsum(new[start:stop], dtype=index)  # hash-order group of each sorted row, less ``before``
+        group += before - 1
+        before = int(group[-1]) + 1
+        ids[order[start:stop]] = group_rank[group]
     return ids, heads
 
 
@@ -202,7 +204,11 @@ def _resolve_collisions(
     table: NDArray[np.unsignedinteger], order: NDArray[np.int64], same_hash: NDArray[np.bool_], same: NDArray[np.bool_]
 ) -> NDArray[np.int64]:
     """Re-sort the hash runs that hold distinct rows by (run, columns, index); ``same`` is updated for the new order."""
-    run = np.cumsum(np.r_[True, ~same_hash])
+    n = len(order)
+    run = np.empty(n, dtype=order.dtype)  # the hash run of each sorted row, from 1
+    run[0] = 1
+    np.cumsum(~same_hash, dtype=order.dtype, out=run[1:])
+    run[1:] += 1
     bad_runs = np.zeros(int(run[-1]) + 1, dtype=bool)
     bad_runs[run[1:][same_hash & ~same]] = True
     pos = np.flatnonzero(bad_runs[run])
@@ -231,7 +237,7 @@ class SurfaceTopology:
     open_edges: int
     unbalanced_edges: int
     nonmanifold_edges: int
-    edge_faces: NDArray[np.int64]  # (k, 2) pairs of faces sharing a manifold edge
+    edge_faces: NDArray[np.signedinteger]  # (k, 2) pairs of faces sharing a manifold edge (int32 when that holds twice the faces)
     edge_same_direction: NDArray[np.bool_]  # (k,) the pair traverses the edge the same way
 
     @property
@@ -246,11 +252,19 @@ def surface_topology(faces: NDArray[np.int64], n_vertices: int) -> SurfaceTopolo
     order, starts = _edge_order(half, key_bits)
     del half
     m = len(order)
-    counts = np.diff(np.r_[starts, m])
+    small: type[np.signedinteger] = np.int32 if m < 2**31 else np.int64  # order, starts, counts, balances: half the memory
+    order = order.astype(small, copy=False)
+    starts = starts.astype(small, copy=False)
+    counts: NDArray[np.signedinteger] = np.empty(len(starts), dtype=small)
+    np.subtract(starts[1:], starts[:-1], out=counts[:-1])
+    if len(starts):
+        counts[-1] = m - starts[-1]
     fwd = forward[order]
     del forward
-    balance = 2 * np.add.reduceat(fwd, starts, dtype=np.int64) - counts
+    balance = np.add.reduceat(fwd, starts, dtype=small)
     del fwd
+    balance *= 2
+    balance -= counts
     pair = counts == 2
     open_edges = int(np.count_nonzero(counts == 1))
     nonmanifold = int(np.count_nonzero(counts > 2))
@@ -259,16 +273,19 @@ def surface_topology(faces: NDArray[np.int64], n_vertices: int) -> SurfaceTopolo
     del balance, counts
     first = starts[pair]
     del starts, pair
-    # the two faces of each manifold edge, smaller index first; built in place to bound memory
-    face_a = order[first]
-    first += 1
-    face_b = order[first]
+    # the two faces of each manifold edge, smaller index first; built in blocks to bound memory
+    pair_index = np.int32 if 2 * (m // 3) < 2**31 else np.int64  # half the memory of every later pass over the pairs
+    edge_faces = np.empty((len(first), 2), dtype=pair_index)
+    for start in range(0, len(first), BLOCK):
+        at = first[start : start + BLOCK]
+        face_a = order[at]
+        at += 1
+        face_b = order[at]
+        face_a //= 3
+        face_b //= 3
+        np.minimum(face_a, face_b, out=edge_faces[start : start + BLOCK, 0])
+        np.maximum(face_a, face_b, out=edge_faces[start : start + BLOCK, 1])
     del first, order
-    face_a //= 3
-    face_b //= 3
-    edge_faces = np.empty((len(face_a), 2), dtype=np.int64)
-    np.minimum(face_a, face_b, out=edge_faces[:, 0])
-    np.maximum(face_a, face_b, out=edge_faces[:, 1])
     return SurfaceTopology(
         open_edges=open_edges,
         unbalanced_edges=unbalanced,
@@ -305,7 +322,7 @@ def _edge_keys(faces: NDArray[np.int64], n_vertices: int) -> tuple[NDArray[np.ui
     return key.reshape(-1), forward.reshape(-1)
 
 
-def _edge_order(key: NDArray[np.uint64], key_bits: int) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
+def _edge_order(key: NDArray[np.uint64], key_bits: int) -> tuple[NDArray[np.signedinteger], NDArray[np.signedinteger]]:
     """Half-edges sorted by key (ties in index order) and the start of each run of equal key.
 
     The key and the index are packed into one uint64 and value-sorted; when
@@ -323,29 +340,46 @@ def _edge_order(key: NDArray[np.uint64], key_bits: int) -> tuple[NDArray[np.int6
         ks = key[order]
         return order, np.flatnonzero(np.r_[True, ks[1:] != ks[:-1]])
     low_bits = key_bits - spill
+    small = np.int32 if m < 2**31 else np.int64  # order and starts: half the memory of int64
     bucket = (key >> np.uint64(low_bits)).astype(np.uint16)
-    by_bucket = np.argsort(bucket, kind="stable")  # radix sort for 16-bit keys
+    few = spill <= 4  # a few buckets: each found by a comparison, no full permutation held
+    by_bucket = None if few else np.argsort(bucket, kind="stable")  # radix sort for 16-bit keys
     bounds = np.zeros((1 << spill) + 1, dtype=np.int64)
-    np.cumsum(np.bincount(bucket, minlength=1 << spill), out=bounds[1:])
-    del bucket
-    order = np.empty(m, dtype=np.int64)
+    if few:  # counted in place (bincount would widen every id to intp first)
+        np.cumsum([np.count_nonzero(bucket == b) for b in range(1 << spill)], out=bounds[1:])
+    else:
+        np.cumsum(np.bincount(bucket, minlength=1 << spill), out=bounds[1:])
+    low = np.uint64((1 << low_bits) - 1)
+    index_mask = np.uint64((1 << index_bits) - 1)
+    order = np.empty(m, dtype=small)
     starts = []
-    for b0, b1 in itertools.pairwise(bounds):
+    for b, (b0, b1) in enumerate(itertools.pairwise(bounds)):
         if b1 == b0:
             continue
-        sub = by_bucket[b0:b1]
-        part = key[sub] & np.uint64((1 << low_bits) - 1)
-        part <<= np.uint64(index_bits)
-        part |= sub.view(np.uint64)
+        sub = np.flatnonzero(bucket == b) if by_bucket is None else by_bucket[b0:b1]  # ascending either way
+        part = np.empty(b1 - b0, dtype=np.uint64)
+        for start in range(0, len(part), BLOCK):  # the low key bits and the index, packed in blocks
+            block = part[start : start + BLOCK]
+            block[...] = key[sub[start : start + BLOCK]]
+            block &= low
+            block <<= np.uint64(index_bits)
+            block |= sub[start : start + BLOCK].view(np.uint64)
+        del sub
         part.sort()
-        diff = (part[1:] ^ part[:-1]) >> np.uint64(index_bits)
-        starts.append(b0 + np.flatnonzero(np.r_[True, diff != 0]))
-        part &= np.uint64((1 << index_bits) - 1)
-        order[b0:b1] = part.view(np.int64)
+        same = np.empty(len(part) - 1, dtype=bool)
+        for start in range(0, len(part) - 1, BLOCK):
+            stop = min(len(part) - 1, start + BLOCK)
+            np.less_equal(part[start + 1 : stop + 1] ^ part[start:stop], index_mask, out=same[start:stop])
+        first: NDArray[np.signedinteger] = np.flatnonzero(np.r_[True, ~same]).astype(small)
+        first += b0
+        starts.append(first)
+        for start in range(0, len(part), BLOCK):
+            part[start : start + BLOCK] &= index_mask
+        order[b0:b1] = part
     return order, np.concatenate(starts)
 
 
-def _components(n: int, a: NDArray[np.int64], b: NDArray[np.int64]) -> tuple[int, NDArray[np.int64]]:
+def _components(n: int, a: NDArray[np.signedinteger], b: NDArray[np.signedinteger]) -> tuple[int, NDArray[np.int64]]:
     """Connected components of the undirected graph on n nodes with edges (a, b).
 
     Vectorised union-find: every edge hooks the larger of its two roots onto
@@ -355,23 +389,30 @@ def _components(n: int, a: NDArray[np.int64], b: NDArray[np.int64]) -> tuple[int
     """
     index = np.int32 if n < 2**31 else np.int64  # half the memory of every temporary below
     parent = np.arange(n, dtype=index)
-    a, b = a.astype(index), b.astype(index)
-    while True:
+    while True:  # the first round reads the given (a, b) in place; later rounds keep compact copies
         ra, rb = parent[a], parent[b]
         join = ra != rb
         if not np.any(join):
             break
-        ra, rb = ra[join], rb[join]
-        np.minimum.at(parent, np.maximum(ra, rb), np.minimum(ra, rb))
+        ra = ra[join]
+        rb = rb[join]
+        hi = np.maximum(ra, rb)
+        np.minimum(ra, rb, out=ra)
+        del rb
+        np.minimum.at(parent, hi, ra)
+        del hi, ra
         while True:
             grand = parent[parent]
             if np.array_equal(grand, parent):
                 break
             parent = grand
-        a, b = a[join], b[join]
+        a, b = a[join].astype(index, copy=False), b[join].astype(index, copy=False)
     roots = parent == np.arange(n, dtype=index)
-    rank = np.cumsum(roots, dtype=np.int64) - 1
-    return int(rank[-1] + 1) if n else 0, rank[parent]
+    rank: NDArray[np.signedinteger] = np.cumsum(roots, dtype=index)
+    del roots
+    rank -= 1
+    label: NDArray[np.int64] = rank[parent].astype(np.int64)
+    return int(rank[-1] + 1) if n else 0, label
 
 
 def orient_consistently(faces: NDArray[np.int64], topo: SurfaceTopology) -> tuple[NDArray[np.int64], int]:
@@ -383,7 +424,7 @@ def orient_consistently(faces: NDArray[np.int64], topo: SurfaceTopology) -> tupl
     surface.  Returns the re-wound faces and the number of flipped faces.
     """
     n = len(faces)
-    f1, f2 = topo.edge_faces[:, 0], topo.edge_faces[:, 1]
+    f1, f2 = topo.edge_faces[:, 0].astype(np.int64), topo.edge_faces[:, 1].astype(np.int64)
     flip = topo.edge_same_direction.astype(np.int64) * n
     rows = np.concatenate([f1, f1 + n])
     cols = np.concatenate([f2 + flip, f2 + n - flip])

@@ -21,10 +21,12 @@ import subprocess
 import sys
 import warnings
 from pathlib import Path
-from typing import Any, cast
+from typing import Any
 
 import numpy as np
 import pytest
+
+from tests.support.motion import rotation, unit_quaternion_matrix
 
 mujoco = pytest.importorskip("mujoco")
 etree = pytest.importorskip("lxml.etree")
@@ -59,14 +61,8 @@ POINTS = [
 ]
 
 
-def _rotation(axis: list[float], angle: float) -> np.ndarray:
-    a = np.asarray(axis, dtype=float) / np.linalg.norm(axis)
-    K = np.array([[0, -a[2], a[1]], [a[2], 0, -a[0]], [-a[1], a[0], 0]])
-    return cast("np.ndarray", np.eye(3) + math.sin(angle) * K + (1 - math.cos(angle)) * K @ K)
-
-
 BOX = (0.4, 0.25, 0.1)  # edge lengths [m]
-BOX_R = _rotation([1.0, 2.0, 0.5], 0.7)
+BOX_R = rotation([1.0, 2.0, 0.5], 0.7)
 BOX_OFFSET = np.array([1.5, -0.75, 2.25])
 
 
@@ -84,20 +80,9 @@ def _mesh(client: Any, text: str, fmt: str, **params: Any) -> Any:
     return client.post("/v1/analyze/mesh", params={"export": fmt, **params}, files=files)
 
 
-def _quat_matrix(q: np.ndarray) -> np.ndarray:
-    w, x, y, z = q / np.linalg.norm(q)
-    return np.array(
-        [
-            [1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
-            [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
-            [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)],
-        ]
-    )
-
-
 def _compiled(model: Any, body: int) -> tuple[float, np.ndarray, np.ndarray]:
     """Mass, centre of mass (body frame) and tensor about it (body axes), as MuJoCo compiled them."""
-    R = _quat_matrix(np.array(model.body_iquat[body]))
+    R = unit_quaternion_matrix(np.array(model.body_iquat[body]))
     tensor = R @ np.diag(model.body_inertia[body]) @ R.T
     return float(model.body_mass[body]), np.array(model.body_ipos[body]), tensor
 
@@ -246,7 +231,7 @@ def test_molecule_scale_body_is_refused_for_mujoco_formats(client: Any, fmt: str
 def test_planar_bodies_load_in_mujoco(client: Any, seed: int) -> None:
     """I1 + I2 = I3 exactly for a planar set: the snippets must still pass MuJoCo's exact A + B >= C."""
     rng = np.random.default_rng(seed)
-    R = _rotation(list(rng.normal(size=3)), float(rng.uniform(0, math.pi)))
+    R = rotation(list(rng.normal(size=3)), float(rng.uniform(0, math.pi)))
     plane = [np.array([x, y, 0.0]) for x, y in rng.uniform(-1, 1, size=(5, 2))]
     points = [{"mass": float(m), "position": (R @ p + 3.0).tolist()} for m, p in zip(rng.uniform(0.5, 2, 5), plane)]
     for fmt, build, body in (("mjcf", _mjcf_model, "b0"), ("urdf", _urdf_model, "p0")):
@@ -317,7 +302,7 @@ def test_moments_rounded_just_past_the_triangle_inequality_still_load(fmt: str) 
     i3 = np.nextafter(np.nextafter(3.0, 4.0), 4.0)  # 1 + 2 = 3 < i3 by two ulps: MuJoCo refuses these moments as they are
     with pytest.raises(ValueError):
         _mjcf_model([f'<inertial pos="0 0 0" mass="1" diaginertia="1 2 {i3!r}"/>'])
-    R = _rotation([0.3, 1.0, -0.4], 1.1)
+    R = rotation([0.3, 1.0, -0.4], 1.1)
     body = Inertial(
         2.0,
         np.array([0.5, -0.25, 1.0]),

@@ -16,17 +16,12 @@ import numpy as np
 import pytest
 
 import inertia
-from benchmarks.cases import box, stl_bytes
+from benchmarks.cases import cube, stl_bytes
 from inertia import AnalysisOptions, analyze
 from inertia.errors import InvalidParameterError
 
 ROOT = Path(__file__).resolve().parents[1]
 SAMPLES = ROOT / "sample_meshes"
-
-
-def cube(side: float, offset: tuple[float, float, float] = (0.0, 0.0, 0.0)) -> tuple[np.ndarray, np.ndarray]:
-    """An axis-aligned cube as (vertices, faces), outward winding."""
-    return box(side, side, side, offset)
 
 
 def obj_two_boxes() -> bytes:

@@ -9,7 +9,6 @@ results that do not depend on the block size beyond the error estimate.
 
 from __future__ import annotations
 
-import struct
 from typing import Any
 
 import numpy as np
@@ -18,27 +17,17 @@ import pytest
 import inertia.integrals as integrals
 import inertia.mass as mass
 import inertia.topology as topology
+from benchmarks.cases import torus, triangles_stl_bytes
 from benchmarks.exact import exact_moments, exact_solid, relative_error
 from inertia.body import MeshBody
 from inertia.load.stl import read_stl
 from inertia.tolerances import EPS
 
 
-def _binary_stl(triangles: np.ndarray) -> bytes:
-    rec = np.zeros(len(triangles), dtype=[("n", "<f4", (3,)), ("v", "<f4", (3, 3)), ("a", "<u2")])
-    rec["v"] = triangles
-    return b"\0" * 80 + struct.pack("<I", len(triangles)) + rec.tobytes()
-
-
 def _torus(nu: int, nv: int) -> tuple[np.ndarray, np.ndarray]:
-    u, v = np.meshgrid(2 * np.pi * np.arange(nu) / nu, 2 * np.pi * np.arange(nv) / nv, indexing="ij")
-    ring = 3.0 + np.cos(v)
-    pts = np.stack([ring * np.cos(u), ring * np.sin(u), np.sin(v)], -1).reshape(-1, 3).astype(np.float32)
-    i, j = np.meshgrid(np.arange(nu), np.arange(nv), indexing="ij")
-    a, b = i * nv + j, (i + 1) % nu * nv + j
-    c, d = (i + 1) % nu * nv + (j + 1) % nv, i * nv + (j + 1) % nv
-    faces = np.concatenate([np.stack([a, b, c], -1).reshape(-1, 3), np.stack([a, c, d], -1).reshape(-1, 3)])
-    return pts.astype(np.float64), faces
+    """The 3/1 torus of ``benchmarks.cases`` with float32 vertices (as a binary STL stores them)."""
+    v, f = torus(nu, nv, 3.0, 1.0)
+    return v.astype(np.float32).astype(np.float64), f
 
 
 TETRA = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]], dtype=np.float64)
@@ -49,7 +38,7 @@ def test_stl_weld_merges_negative_zero_with_zero() -> None:
     tri = TETRA[TETRA_FACES].astype(np.float32)
     tri[0, 0] = [-0.0, -0.0, 0.0]  # the origin, written once with negative zeros
     tri[2, 0] = [0.0, -0.0, -0.0]
-    vertices, faces = read_stl(_binary_stl(tri))
+    vertices, faces = read_stl(triangles_stl_bytes(tri))
     assert vertices.shape == (4, 3)
     np.testing.assert_array_equal(vertices[faces], TETRA[TETRA_FACES])
     assert not np.any(np.signbit(vertices))
@@ -58,7 +47,7 @@ def test_stl_weld_merges_negative_zero_with_zero() -> None:
 def test_stl_weld_keeps_points_one_ulp_apart_and_numbers_by_first_appearance() -> None:
     tri = TETRA[TETRA_FACES].astype(np.float32)
     tri[3, 2, 2] = np.nextafter(np.float32(1.0), np.float32(2.0))  # a fifth, distinct point
-    vertices, faces = read_stl(_binary_stl(tri))
+    vertices, faces = read_stl(triangles_stl_bytes(tri))
     assert len(vertices) == 5
     np.testing.assert_array_equal(vertices[faces], tri.astype(np.float64))
     first = [int(np.flatnonzero(faces.ravel() == k)[0]) for k in range(len(vertices))]
@@ -79,7 +68,7 @@ def test_ascii_stl_comes_back_welded_like_binary() -> None:
         + "endsolid t\n"
     )
     vertices, faces = read_stl(text.encode())
-    binary_vertices, binary_faces = read_stl(_binary_stl(tri.astype(np.float32)))
+    binary_vertices, binary_faces = read_stl(triangles_stl_bytes(tri.astype(np.float32)))
     assert vertices.shape == (4, 3)
     np.testing.assert_array_equal(vertices, binary_vertices)
     np.testing.assert_array_equal(faces, binary_faces)
@@ -122,9 +111,9 @@ def test_weld_float64_merges_bit_identical_rows_only() -> None:
     assert len(wv) == len(v) + 1
 
 
-@pytest.mark.parametrize("key_bits", [30, 60, 64])
+@pytest.mark.parametrize("key_bits", [30, 35, 45, 60, 64])
 def test_edge_sort_paths_agree(key_bits: int) -> None:
-    """Packed sort, bucketed packed sort and the argsort fallback order edges alike."""
+    """Packed sort, bucketed packed sort (few and many buckets) and the argsort fallback order edges alike."""
     v, f = _torus(40, 25)
     key, _ = topology._edge_keys(f, len(v))
     reference = np.argsort(key, kind="stable")

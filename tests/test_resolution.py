@@ -2,7 +2,7 @@
 
 - A float32 STL of a part at growing offsets from the origin: while the stored
   coordinates still represent it, the moments are those of the stored float32
-  polyhedron (exact rational integration, ``tests/exact.py``) within the
+  polyhedron (exact rational integration, ``benchmarks/exact.py``) within the
   estimate; once float32 resolution at the offset is comparable to the part,
   the file is refused as ``insufficient_precision`` with a message that names
   the float32 resolution and says to export in float64 or nearer the origin.

@@ -1,7 +1,7 @@
 """Every bound of the stability report (docs/stability.md), asserted on fast versions of its rows.
 
 The battery and its exact references live in ``benchmarks/stability.py`` and
-``tests/exact.py`` (rational integration of the stored float64 vertices,
+``benchmarks/exact.py`` (rational integration of the stored float64 vertices,
 50-digit eigenvalues); here each row's bound is checked against our code so a
 regression fails CI.  Bounds (API.md, "Accuracy", and the stability report): every principal moment
 of an exact polyhedron to 1e-12 relative at any offset up to 1e8 sizes and any

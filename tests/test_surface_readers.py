@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 import trimesh
 
-from benchmarks.cases import box
+from benchmarks.cases import box, cube, obj_bytes
 from inertia.errors import (
     EmptyGeometryError,
     NotWatertightError,
@@ -27,9 +27,7 @@ from inertia.pipeline import AnalysisOptions, analyze, analyze_loaded
 
 
 def obj_text(v: np.ndarray, f: np.ndarray, extra: str = "") -> bytes:
-    lines = [f"v {float(x)!r} {float(y)!r} {float(z)!r}" for x, y, z in v]
-    lines += [f"f {a + 1} {b + 1} {c + 1}" for a, b, c in f]
-    return (extra + "\n".join(lines) + "\n").encode()
+    return extra.encode() + obj_bytes([(None, v, f)])
 
 
 # --- OBJ -------------------------------------------------------------------------------------------
@@ -141,10 +139,6 @@ def model(resources: str, build: str, unit: str = "millimeter", ns: str = "") ->
         f'<?xml version="1.0" encoding="UTF-8"?><model unit="{unit}" xmlns="{CORE}"{ns}>'
         f"<resources>{resources}</resources><build>{build}</build></model>"
     )
-
-
-def cube(a: float, origin: tuple[float, float, float] = (0.0, 0.0, 0.0)) -> tuple[np.ndarray, np.ndarray]:
-    return box(a, a, a, origin=origin)
 
 
 def test_3mf_support_objects_are_listed_not_weighed() -> None:

@@ -23,7 +23,7 @@ import math
 import sys
 import tempfile
 import time
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass
 from typing import Any
@@ -39,7 +39,7 @@ _OUT_OF_RANGE = (
     "(the result would overflow or divide by zero); rescale the input, e.g. other units"
 )
 
-__all__ = ["MeshJob", "PointsJob", "PrecessionJob", "Job", "run_job", "is_small"]
+__all__ = ["MeshJob", "PointsJob", "PrecessionJob", "Job", "run_job", "run_job_json", "is_small"]
 
 # point-mass jobs up to this size, without a trajectory, run in the server process itself: they take
 # well under a millisecond, less than the round trip to a compute process (they cannot hang: no file)
@@ -173,8 +173,29 @@ def run_job(job: Job) -> dict[str, Any]:
     logged with its traceback so that the stage which let it through can be
     made to say so itself.
     """
+    doc = _outcome(job)
+    _check_result(job, doc, _finite(doc))
+    return doc
+
+
+def run_job_json(job: Job, dumps: Callable[[Any], bytes]) -> bytes:
+    """``run_job``'s document as the JSON ``dumps`` writes, with the same checks.
+
+    ``dumps`` must write a non-finite float as ``NaN``, ``Infinity`` or
+    ``-Infinity`` (pydantic_core's ``to_json`` does). Then text without those
+    words holds only finite numbers, and the document is not walked a second
+    time to check them; where the words occur (a number, or a string naming
+    one) the walk decides as in ``run_job``.
+    """
+    doc = _outcome(job)
+    text = dumps(doc)
+    _check_result(job, doc, (b"NaN" not in text and b"Infinity" not in text) or _finite(doc))
+    return text
+
+
+def _outcome(job: Job) -> dict[str, Any]:
     try:
-        doc = job()
+        return job()
     except ArithmeticError as exc:
         log.warning("arithmetic failure in %s, reported as invalid_parameter", type(job).__name__, exc_info=exc)
         raise InvalidParameterError(_OUT_OF_RANGE, reason=type(exc).__name__) from exc
@@ -186,7 +207,10 @@ def run_job(job: Job) -> dict[str, Any]:
             + "; send a smaller or simpler file",
             limit_bytes=limit,
         ) from None
-    if not _finite(doc):
+
+
+def _check_result(job: Job, doc: dict[str, Any], finite: bool) -> None:
+    if not finite:
         log.warning("non-finite number in the result of %s, reported as invalid_parameter", type(job).__name__)
         raise InvalidParameterError(_OUT_OF_RANGE, reason="non-finite result")
     mass = doc.get("mass")
@@ -197,7 +221,6 @@ def run_job(job: Job) -> dict[str, Any]:
             parameter="density",
             mass=mass,
         )
-    return doc
 
 
 def _finite(value: Any) -> bool:

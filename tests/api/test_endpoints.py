@@ -12,6 +12,7 @@ import numpy as np
 import pytest
 from fastapi.testclient import TestClient
 
+from benchmarks.cases import box_inertia
 from tests.support.meshes import box_stl
 
 REL = 1e-12  # float32 box corners are exact; what is left is summation rounding
@@ -20,11 +21,6 @@ REL = 1e-12  # float32 box corners are exact; what is left is summation rounding
 def close(actual: object, expected: object, rel: float = REL) -> bool:
     a, e = np.asarray(actual, dtype=float), np.asarray(expected, dtype=float)
     return a.shape == e.shape and bool(np.all(np.abs(a - e) <= rel * max(1.0, float(np.abs(e).max()))))
-
-
-def box_tensor(m: float, a: float, b: float, c: float) -> np.ndarray:
-    # solid cuboid about its centre: I = m (b^2 + c^2) / 12, ... (any mechanics text)
-    return np.diag([m * (b * b + c * c) / 12, m * (a * a + c * c) / 12, m * (a * a + b * b) / 12])
 
 
 def upload(client: TestClient, data: bytes, name: str = "box.stl", **params: object) -> Any:
@@ -43,7 +39,7 @@ def test_box_mass_centre_and_tensor_match_closed_form(client: TestClient) -> Non
     assert doc["mass"] == pytest.approx(6000, rel=REL) and doc["volume"] == pytest.approx(6, rel=REL)
     assert doc["density"] == 1000
     assert close(doc["center_of_mass"], [0.5, 1, 1.5])
-    assert close(doc["inertia_tensor"], box_tensor(6000, 1, 2, 3))
+    assert close(doc["inertia_tensor"], box_inertia(6000, 1, 2, 3))
     assert close(doc["principal"]["moments"], [2500, 5000, 6500])
     assert np.linalg.det(np.array(doc["principal"]["axes"])) == pytest.approx(1, rel=1e-12)
     assert doc["classification"]["kind"] == "asymmetric_top"
@@ -71,7 +67,7 @@ def test_reference_tensor_follows_parallel_axis_theorem(client: TestClient) -> N
     doc = upload(client, box_stl(1, 2, 3), reference="0,0,0").json()
     d = np.array([0.5, 1.0, 1.5])
     # Steiner: I_O = I_G + m (|d|^2 E - d d^T)
-    expected = box_tensor(6000, 1, 2, 3) + 6000 * (d @ d * np.eye(3) - np.outer(d, d))
+    expected = box_inertia(6000, 1, 2, 3) + 6000 * (d @ d * np.eye(3) - np.outer(d, d))
     assert close(doc["reference_inertia"]["point"], [0, 0, 0])
     assert close(doc["reference_inertia"]["tensor"], expected)
 
@@ -80,7 +76,7 @@ def test_units_density_and_mass_options_scale_as_expected(client: TestClient) ->
     mm = upload(client, box_stl(10, 20, 30), units="mm", density=7850).json()
     m = 7850 * 6e-6
     assert mm["source"]["units"] == "mm" and mm["mass"] == pytest.approx(m, rel=1e-12)
-    assert close(mm["inertia_tensor"], box_tensor(m, 0.01, 0.02, 0.03), rel=1e-6)
+    assert close(mm["inertia_tensor"], box_inertia(m, 0.01, 0.02, 0.03), rel=1e-6)
     by_mass = upload(client, box_stl(1, 2, 3), mass=12).json()
     assert by_mass["mass"] == pytest.approx(12, rel=REL) and by_mass["density"] == pytest.approx(2, rel=REL)
 

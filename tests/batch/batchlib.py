@@ -9,6 +9,7 @@ from typing import Any, cast
 import numpy as np
 
 from benchmarks import cases
+from tests.support.motion import rotation
 
 N_FILES = 50
 BROKEN = {
@@ -21,9 +22,7 @@ BROKEN = {
 def box(size: tuple[float, float, float], angle: float, offset: tuple[float, float, float]) -> np.ndarray:
     """Triangles (n, 3, 3) of a box rotated by ``angle`` about (1, 1, 1) and moved by ``offset``."""
     v, faces = cases.box(*size)
-    axis = np.ones(3) / np.sqrt(3.0)
-    k = np.array([[0, -axis[2], axis[1]], [axis[2], 0, -axis[0]], [-axis[1], axis[0], 0]])
-    rot = np.eye(3) + np.sin(angle) * k + (1 - np.cos(angle)) * k @ k  # Rodrigues
+    rot = rotation(np.ones(3), angle)
     return cast("np.ndarray", (v @ rot.T + np.asarray(offset))[faces])
 
 
@@ -32,9 +31,8 @@ def stl_bytes(tri: np.ndarray) -> bytes:
 
 
 def obj_text(tri: np.ndarray) -> str:
-    lines = [f"v {x!r} {y!r} {z!r}" for x, y, z in tri.reshape(-1, 3).tolist()]
-    lines += [f"f {3 * i + 1} {3 * i + 2} {3 * i + 3}" for i in range(len(tri))]
-    return "\n".join(lines) + "\n"
+    """OBJ of a triangle soup: three vertices of its own per triangle."""
+    return cases.obj_bytes([(None, tri.reshape(-1, 3), np.arange(3 * len(tri)).reshape(-1, 3))]).decode()
 
 
 def make_library(root: Path) -> dict[str, str | None]:

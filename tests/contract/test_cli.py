@@ -13,6 +13,7 @@ from pathlib import Path
 import pytest
 from fastapi.testclient import TestClient
 
+from benchmarks.harness import Server
 from tests.contract.helpers import ROOT, SAMPLES, analyze, strip_elapsed
 
 
@@ -125,44 +126,13 @@ def test_cli_batch_tabular_outputs_have_one_row_per_file(tmp_path: Path, suffix:
 
 
 def test_inertia_serve_starts_the_http_service(tmp_path: Path) -> None:
-    import socket
-    import time
-
     import httpx
 
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        port = s.getsockname()[1]
-    env = {k: v for k, v in os.environ.items() if not k.startswith("INERTIA_")}
-    env["INERTIA_COMPUTE_PROCESSES"] = "1"
-    proc = subprocess.Popen(
-        [sys.executable, "-m", "inertia", "serve", "--host", "127.0.0.1", "--port", str(port)],
-        cwd=tmp_path,
-        env=env,
-        stdout=subprocess.DEVNULL,
-        stderr=subprocess.DEVNULL,
-    )
-    try:
-        deadline = time.monotonic() + 30
-        while True:
-            try:
-                r = httpx.get(f"http://127.0.0.1:{port}/healthz", timeout=1)
-                break
-            except httpx.TransportError:
-                assert proc.poll() is None and time.monotonic() < deadline, "server did not start"
-                time.sleep(0.1)
+    with Server({"INERTIA_COMPUTE_PROCESSES": "1"}, cwd=tmp_path) as server:  # ready once /healthz answers 200
+        r = httpx.get(f"{server.url}/healthz", timeout=1)
         assert r.json() == {"status": "ok"}
-        r = httpx.post(
-            f"http://127.0.0.1:{port}/v1/analyze/mesh", files={"file": ("box.stl", (SAMPLES / "box.stl").read_bytes())}, timeout=30
-        )
+        r = httpx.post(f"{server.url}/v1/analyze/mesh", files={"file": ("box.stl", (SAMPLES / "box.stl").read_bytes())}, timeout=30)
         assert r.status_code == 200 and r.json()["mass"] == pytest.approx(6000, rel=1e-14)
-    finally:
-        proc.terminate()
-        try:
-            proc.wait(10)
-        except subprocess.TimeoutExpired:
-            proc.kill()
-            proc.wait()
 
 
 @pytest.mark.filterwarnings("ignore:Port 8787 is already in use")  # a dashboard elsewhere on this machine

@@ -24,12 +24,12 @@ from tests.contract.helpers import (
     points_ok,
     post_precession,
     precession_ok,
-    quat_matrix,
     ray_kappa,
     reference_motion,
     rotation,
     thin_box_shell_inertia,
 )
+from tests.support.motion import unit_quaternion_matrix
 
 
 def ll_asymmetric_period(I: Any, Omega: Any) -> float:
@@ -216,7 +216,7 @@ def test_rest(client: TestClient) -> None:
     assert pre["angular_momentum_magnitude"] == 0 and pre["kinetic_energy"] == 0
     np.testing.assert_allclose(pre["angular_momentum"], [0, 0, 0], atol=0)
     for q in pre["trajectory"]["quaternion"]:
-        np.testing.assert_allclose(quat_matrix(q), np.eye(3), atol=1e-15)
+        np.testing.assert_allclose(unit_quaternion_matrix(q), np.eye(3), atol=1e-15)
     np.testing.assert_allclose(pre["trajectory"]["omega"], np.zeros((3, 3)), atol=0)
 
 
@@ -233,7 +233,7 @@ def test_permanent_rotation_about_a_principal_axis(client: TestClient, axis: Any
     if "stable" in pre:
         assert pre["stable"] is stable
     for t, q, w in zip(pre["trajectory"]["t"], pre["trajectory"]["quaternion"], pre["trajectory"]["omega"]):
-        np.testing.assert_allclose(quat_matrix(q), rotation(omega, 1.5 * t), atol=1e-12)
+        np.testing.assert_allclose(unit_quaternion_matrix(q), rotation(omega, 1.5 * t), atol=1e-12)
         np.testing.assert_allclose(w, omega, atol=1e-12)
 
 
@@ -249,7 +249,7 @@ def test_spherical_top_keeps_omega_constant(client: TestClient) -> None:
     for t, q, om, Wb in zip(*(pre["trajectory"][k] for k in ("t", "quaternion", "omega", "omega_body"))):
         np.testing.assert_allclose(om, omega, atol=1e-12)
         np.testing.assert_allclose(Wb, pre["omega_body"], atol=1e-12)
-        np.testing.assert_allclose(quat_matrix(q), rotation(omega, w * t), atol=1e-12)
+        np.testing.assert_allclose(unit_quaternion_matrix(q), rotation(omega, w * t), atol=1e-12)
 
 
 def test_linear_rotator_precession(client: TestClient) -> None:
@@ -269,7 +269,7 @@ def test_linear_rotator_precession(client: TestClient) -> None:
     tr = pre["trajectory"]
     np.testing.assert_allclose(tr["t"], [0, 1, 2, 3], atol=1e-15)
     for t, q, w in zip(tr["t"], tr["quaternion"], tr["omega"]):
-        np.testing.assert_allclose(quat_matrix(q), rotation([0, 0, 1], 2 * t), atol=1e-12)
+        np.testing.assert_allclose(unit_quaternion_matrix(q), rotation([0, 0, 1], 2 * t), atol=1e-12)
         np.testing.assert_allclose(w, [0, 0, 2], atol=1e-12)
 
 

@@ -12,6 +12,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from benchmarks.exact import exact_tetrahedra
 from inertia.body import CellBlock, VolumeBody
 from inertia.cells import CELL_NODES, cell_rule, shape_functions
 from inertia.mass import assembly_properties, mass_properties
@@ -146,13 +147,7 @@ def test_straight_tetra10_matches_the_exact_tetrahedron() -> None:
     mids = [(0, 1), (1, 2), (2, 0), (0, 3), (1, 3), (2, 3)]  # VTK's tetra10 edge order
     nodes = np.vstack([corners, [(corners[a] + corners[b]) / 2 for a, b in mids]])
     props = mass_properties(body_of("tetra10", nodes), density=1.0)
-    vol, m1, m2 = volref.tet_moments_exact(corners)
-    c = [v / vol for v in m1]
-    cov = [[m2[i][j] - vol * c[i] * c[j] for j in range(3)] for i in range(3)]
-    exact_tensor = [
-        [(cov[(i + 1) % 3][(i + 1) % 3] + cov[(i + 2) % 3][(i + 2) % 3]) if i == j else -cov[i][j] for j in range(3)]
-        for i in range(3)
-    ]
+    vol, c, exact_tensor = exact_tetrahedra(corners, [[0, 1, 2, 3]])
     assert props.mass == pytest.approx(float(vol), rel=1e-14)
     np.testing.assert_allclose(props.center_of_mass, [float(v) for v in c], rtol=1e-14)
     np.testing.assert_allclose(props.inertia.matrix, np.array(exact_tensor, dtype=float), rtol=1e-13)

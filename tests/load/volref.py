@@ -12,7 +12,6 @@ any of these integrands needs.
 from __future__ import annotations
 
 import itertools
-from fractions import Fraction
 from typing import Any
 
 import numpy as np
@@ -114,19 +113,3 @@ def inertia_about_centre(m0: float, m1: np.ndarray, m2: np.ndarray, density: flo
     cov = m2 - m0 * np.outer(c, c)
     tensor = np.trace(cov) * np.eye(3) - cov
     return m0 * density, c, tensor * density
-
-
-def tet_moments_exact(p: np.ndarray) -> tuple[Fraction, list[Fraction], list[list[Fraction]]]:
-    """Exact integrals of a linear tetrahedron (Tonon 2004, eqs. 7-8) in fractions."""
-    q = [[Fraction(float(v)) for v in row] for row in p]
-    e = [[q[k][i] - q[0][i] for i in range(3)] for k in (1, 2, 3)]
-    det = (
-        e[0][0] * (e[1][1] * e[2][2] - e[1][2] * e[2][1])
-        - e[0][1] * (e[1][0] * e[2][2] - e[1][2] * e[2][0])
-        + e[0][2] * (e[1][0] * e[2][1] - e[1][1] * e[2][0])
-    )
-    vol = abs(det) / 6
-    s = [sum(q[k][i] for k in range(4)) for i in range(3)]
-    m1 = [vol * s[i] / 4 for i in range(3)]
-    m2 = [[vol / 20 * (sum(q[k][i] * q[k][j] for k in range(4)) + s[i] * s[j]) for j in range(3)] for i in range(3)]
-    return vol, m1, m2

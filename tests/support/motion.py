@@ -8,12 +8,14 @@
 
 from __future__ import annotations
 
-from typing import Any
+import math
+from typing import Any, cast
 
 import mpmath as mp
 import numpy as np
 from scipy.integrate import solve_ivp
 
+from benchmarks.exact import elliptic_omega
 from inertia.classification import Classification, classify
 from inertia.motion.result import FreeMotion, Trajectory
 from inertia.principal import PrincipalFrame
@@ -67,6 +69,24 @@ def ll_period(moments: Any, omega_body: Any) -> float:
         return float(4 * mp.ellipk(k2) / rate)
 
 
+def hat(w: Any) -> np.ndarray:
+    """The cross-product matrix [w]x: hat(w) @ v = w x v."""
+    return np.array([[0, -w[2], w[1]], [w[2], 0, -w[0]], [-w[1], w[0], 0]], dtype=float)
+
+
+def rotation(axis: Any, angle: float) -> np.ndarray:
+    """The rotation by ``angle`` about ``axis`` (Rodrigues' formula)."""
+    u = np.asarray(axis, float)
+    u = u / np.linalg.norm(u)
+    K = hat(u)
+    return cast("np.ndarray", np.eye(3) + math.sin(angle) * K + (1 - math.cos(angle)) * K @ K)
+
+
+def unit_quaternion_matrix(q: Any) -> np.ndarray:
+    """The rotation matrix of one quaternion [w, x, y, z], normalised first."""
+    return cast("np.ndarray", quaternion_matrix(np.asarray(q, float) / np.linalg.norm(q)))
+
+
 def quaternion_matrix(q: Any) -> Any:
     """Rotation matrices of quaternions [w, x, y, z] (written out, independent of the service)."""
     w, x, y, z = np.moveaxis(np.asarray(q, dtype=float), -1, 0)
@@ -81,56 +101,8 @@ def quaternion_matrix(q: Any) -> Any:
 
 
 def elliptic_reference(moments: Any, omega_body: Any, t: Any, dps: int = 50) -> Any:
-    """Omega(t) (N, 3) in the body frame of an asymmetric top (I1 < I2 < I3), from the
-    closed form of L&L §37 (eqs. 37.10-37.12) evaluated with mpmath's Jacobi
-    functions at ``dps`` digits, for the moments exactly as given.
-
-    Written from the textbook without the service's conventions: the
-    circulation axis c is x3 when M^2 > 2 E I2, else x1; with a the other
-    extreme axis and b = 2 the intermediate one,
-    Omega_a = rho A_a cn u, Omega_b = rho s A_b sn u, Omega_c = s A_c dn u,
-    u = lambda t + u0; the sign of lambda is fixed by Euler's equations at t = 0
-    (the relabelling 1 <-> 3 reverses the sense of rotation).
-    """
-    with mp.workdps(dps):
-        I = [mp.mpf(float(x)) for x in moments]
-        W = [mp.mpf(float(x)) for x in omega_body]
-        E2 = sum(I[i] * W[i] ** 2 for i in range(3))
-        M2 = sum((I[i] * W[i]) ** 2 for i in range(3))
-        c, a = (2, 0) if E2 * I[1] < M2 else (0, 2)
-        b = 1
-        Ia, Ib, Ic = I[a], I[b], I[c]
-        Aa = mp.sqrt((E2 * Ic - M2) / (Ia * (Ic - Ia)))
-        Ab = mp.sqrt((E2 * Ic - M2) / (Ib * (Ic - Ib)))
-        Ac = mp.sqrt((M2 - E2 * Ia) / (Ic * (Ic - Ia)))
-        lam = mp.sqrt((Ic - Ib) * (M2 - E2 * Ia) / (Ia * Ib * Ic))
-        m = (Ib - Ia) * (E2 * Ic - M2) / ((Ic - Ib) * (M2 - E2 * Ia))
-        rho = -1 if W[a] < 0 else 1
-        s = -1 if W[c] < 0 else 1
-        sn0 = max(-1, min(1, W[b] / (rho * s * Ab)))
-        u0 = mp.ellipf(mp.asin(sn0), m)
-
-        def euler(w: Any) -> Any:
-            return [(I[1] - I[2]) / I[0] * w[1] * w[2], (I[2] - I[0]) / I[1] * w[2] * w[0], (I[0] - I[1]) / I[2] * w[0] * w[1]]
-
-        rhs = euler(W)
-        # d/du of the formula at u0, component by component; the sign of lambda matches Euler
-        dformula = [mp.mpf(0)] * 3
-        sn, cn, dn = (mp.ellipfun(kind, u0, m=m) for kind in ("sn", "cn", "dn"))
-        dformula[a] = -rho * Aa * sn * dn
-        dformula[b] = rho * s * Ab * cn * dn
-        dformula[c] = -s * Ac * m * sn * cn
-        k = max(range(3), key=lambda i: abs(rhs[i]))
-        if rhs[k] * dformula[k] < 0:
-            lam = -lam
-        out = np.empty((len(t), 3))
-        for n, tn in enumerate(t):
-            u = lam * mp.mpf(float(tn)) + u0
-            sn, cn, dn = (mp.ellipfun(kind, u, m=m) for kind in ("sn", "cn", "dn"))
-            w = [mp.mpf(0)] * 3
-            w[a], w[b], w[c] = rho * Aa * cn, rho * s * Ab * sn, s * Ac * dn
-            out[n] = [float(x) for x in w]
-        return out
+    """Omega(t) of an asymmetric top from L&L §37's closed form (``benchmarks.exact.elliptic_omega``)."""
+    return elliptic_omega(moments, omega_body, t, dps)
 
 
 def euler_taylor_reference(moments: Any, omega_body: Any, t: Any, dps: int = 30) -> Any:

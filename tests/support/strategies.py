@@ -7,7 +7,7 @@ from hypothesis import strategies as st
 from scipy.spatial import ConvexHull
 from scipy.spatial.transform import Rotation
 
-from benchmarks.cases import box  # sample_meshes/generate.py, on sys.path via conftest
+from benchmarks.cases import box
 
 
 def convex_mesh(points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

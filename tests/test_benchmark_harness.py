@@ -1,0 +1,124 @@
+"""The benchmarks' harness (``benchmarks.harness``): what its figures mean is what they measure."""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import pytest
+
+from benchmarks import harness
+
+
+def test_best_of_keeps_the_fastest_run_and_its_result() -> None:
+    waits = iter([0.2, 0.0, 0.1])
+    calls: list[float] = []
+
+    def call() -> float:
+        wait = next(waits)
+        clock = harness.Stopwatch()
+        while clock.wall_s < wait:
+            pass
+        calls.append(wait)
+        return wait
+
+    result, timing = harness.best_of(call, repeat=3)
+    assert calls == [0.2, 0.0, 0.1] and result == 0.0
+    assert timing.wall_s < 0.1 and timing.peak_rss_bytes > 0  # the others waited at least 0.1 s
+
+
+def test_best_of_stops_once_its_budget_is_spent() -> None:
+    calls: list[int] = []
+    harness.best_of(lambda: calls.append(1), repeat=10, budget_s=-1.0)
+    assert calls == [1]
+
+
+def test_timed_counts_cpu_time_of_busy_work() -> None:
+    def spin() -> None:
+        clock = harness.Stopwatch()
+        while clock.wall_s < 0.05:
+            pass
+
+    _, timing = harness.timed(spin)
+    assert timing.wall_s >= 0.05 and timing.cpu_s > 0
+
+
+def test_interleaved_rotates_the_order_and_keeps_each_contenders_best() -> None:
+    order: list[str] = []
+    walls = {"a": iter([3.0, 1.0, 2.0]), "b": iter([5.0, 6.0, 4.0])}
+
+    def run(name: str) -> float:
+        order.append(name)
+        return next(walls[name])
+
+    rounds: list[int] = []
+    out = harness.interleaved(
+        [("a", lambda: run("a")), ("b", lambda: run("b"))],
+        3,
+        lambda _name, wall: wall,
+        before_round=rounds.append,
+    )
+    assert order == ["a", "b", "b", "a", "a", "b"] and rounds == [0, 1, 2]
+    assert out.best == {"a": 1.0, "b": 4.0}
+    assert out.runs == {"a": [3.0, 1.0, 2.0], "b": [5.0, 6.0, 4.0]}
+
+
+def test_run_process_reports_output_cpu_and_peak_memory() -> None:
+    code = "import time\nb = bytearray(64 * 2**20)\nt = time.process_time()\nwhile time.process_time() - t < 0.3: pass\nprint(1)"
+    run = harness.run_process([sys.executable, "-c", code])
+    assert run.returncode == 0 and run.stdout.strip() == "1"
+    # CPU is sampled every SAMPLE_S: the last sample may miss the child's last moments
+    assert run.wall_s >= 0.3 and run.cpu_s >= 0.1 and run.own_cpu_s == run.cpu_s
+    assert run.peak_rss_bytes >= 64 * 2**20
+
+
+def test_run_process_failure_names_the_command_and_its_error() -> None:
+    with pytest.raises(RuntimeError, match="exit 3") as err:
+        harness.run_process([sys.executable, "-c", "import sys; sys.exit('bad input' and 3)"])
+    assert "python" in str(err.value)
+    assert harness.run_process([sys.executable, "-c", "raise SystemExit(3)"], check=False).returncode == 3
+
+
+def test_report_writes_the_title_the_command_and_replaces_only_its_section(tmp_path: Path) -> None:
+    report = harness.Report("Speed", "python -m benchmarks.x --quick")
+    report.add("| a | b |", "", report.regenerate_line("needs the `batch` extra"))
+    regenerate = "Regenerate: `python -m benchmarks.x --quick` (from the repository root; needs the `batch` extra)."
+    assert report.text() == f"# Speed\n\n| a | b |\n\n{regenerate}\n"
+    doc = tmp_path / "doc.md"
+    doc.write_text(f"intro\n{harness.START}\nold\n{harness.END}\noutro\n", encoding="utf-8")
+    report.write(doc, section=True)
+    text = doc.read_text(encoding="utf-8")
+    assert text.startswith("intro\n") and text.endswith("\noutro\n") and "old" not in text and "# Speed" in text
+    fresh = tmp_path / "fresh.md"
+    report.write(fresh)
+    assert fresh.read_text(encoding="utf-8") == report.text()
+
+
+def test_machine_names_the_cpu_cores_and_package_versions() -> None:
+    m = harness.machine(("numpy", "no-such-package-here"))
+    assert m["cpu"] and int(m["cores"]) >= int(m["usable"]) >= 1
+    assert m["numpy"][0].isdigit() and m["no-such-package-here"] == "not installed"
+
+
+def test_run_tool_reports_the_tools_own_peak_memory_and_its_output() -> None:
+    code = "b = bytearray(96 * 2**20)\nfor i in range(0, len(b), 4096): b[i] = 1\nprint(len(b))"
+    run = harness.run_tool([sys.executable, "-c", code])
+    assert run.stdout.strip() == str(96 * 2**20) and run.cpu_s > 0 and run.wall_s > 0
+    assert 96 * 2**20 <= run.peak_rss_bytes < 96 * 2**20 + 2**30
+    with pytest.raises(RuntimeError, match="failed"):
+        harness.run_tool([sys.executable, "-c", "raise SystemExit(2)"])
+
+
+def test_proc_stat_and_descendants_see_live_processes() -> None:
+    import os
+    import subprocess
+
+    me = harness.proc_stat(os.getpid())
+    assert me is not None and me.rss_bytes > 0 and me.peak_rss_bytes >= me.rss_bytes and "python" in me.command
+    child = subprocess.Popen([sys.executable, "-c", "import time; time.sleep(30)"])
+    try:
+        assert child.pid in harness.descendants(os.getpid())
+    finally:
+        child.kill()
+        child.wait()
+    assert harness.proc_stat(child.pid) is None
