@@ -7,6 +7,7 @@ not to the coordinates, so a unit conversion never perturbs the polyhedron.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -164,13 +165,14 @@ class PointBody:
             raise InvalidParameterError("each point needs a mass and a 3-component position")
         if len(m) == 0:
             raise EmptyGeometryError("no points were given; send at least one point mass")
-        _check_finite("masses", m)
-        _check_finite("positions", x)
-        if np.any(m <= 0):
-            raise InvalidParameterError(
-                f"masses must be positive; {int(np.count_nonzero(m <= 0))} are zero or negative", field="mass"
-            )
-        _check_span(m, x, self.length_scale)
+        if not (len(m) <= _FEW_POINTS and _few_points_valid(m, x, self.length_scale)):
+            _check_finite("masses", m)
+            _check_finite("positions", x)
+            if np.any(m <= 0):
+                raise InvalidParameterError(
+                    f"masses must be positive; {int(np.count_nonzero(m <= 0))} are zero or negative", field="mass"
+                )
+            _check_span(m, x, self.length_scale)
         object.__setattr__(self, "masses", m)
         object.__setattr__(self, "positions", x)
 
@@ -178,6 +180,22 @@ class PointBody:
 # Moments of a point set are ~ mass x span^2 [kg m^2]; below float64's smallest normal number over eps they
 # lose digits to underflow (subnormals, then 0), so no number with the promised precision can come back.
 _MIN_MOMENT_SCALE = float(np.finfo(np.float64).tiny) / float(np.finfo(np.float64).eps)
+
+
+_FEW_POINTS = 64  # up to this many points the checks run on Python floats (numpy's per-call cost dominates)
+
+
+def _few_points_valid(masses: NDArray[np.float64], positions: NDArray[np.float64], length_scale: float) -> bool:
+    """True when the checks below would all pass; False sends the body through them (to raise their errors).
+
+    The same comparisons on the same floats: max, min and their difference are exact in both, and the
+    mass sum is numpy's, as in ``_check_span``."""
+    ms = masses.tolist()
+    xs = positions.tolist()
+    if not all(math.isfinite(v) and v > 0 for v in ms) or not all(math.isfinite(c) for p in xs for c in p):
+        return False
+    span = max(max(column) - min(column) for column in zip(*xs)) * length_scale
+    return not (span > 0.0 and float(masses.sum()) * span * span < _MIN_MOMENT_SCALE)
 
 
 def _check_span(masses: NDArray[np.float64], positions: NDArray[np.float64], length_scale: float) -> None:

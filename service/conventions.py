@@ -15,6 +15,8 @@
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 from numpy.typing import NDArray
 
@@ -53,15 +55,27 @@ def length_scale(unit: str) -> float:
 
 def orient_axes(axes: NDArray[np.float64]) -> NDArray[np.float64]:
     """Apply the sign rule to unit axes given as rows; returns a new array."""
-    out = np.array(axes, dtype=np.float64)
+    # Python floats for the 3x3 steps (numpy's per-call cost is most of the time on arrays this small); a
+    # negation and the cross product's products and differences round as numpy's do, the norm stays numpy's
+    rows = np.asarray(axes, dtype=np.float64).tolist()
     for i in (0, 1):
-        k = int(np.argmax(np.abs(out[i])))  # argmax returns the first maximum
-        if out[i, k] < 0:
-            out[i] = -out[i]
-    (a0, a1, a2), (b0, b1, b2) = out[0].tolist(), out[1].tolist()
-    out[2] = (a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0)  # a x b (np.cross costs 40 us here)
+        row = rows[i]
+        if not all(math.isfinite(x) for x in row):  # numpy's argmax takes the first NaN: keep its rule
+            k = int(np.argmax(np.abs(row)))
+        else:
+            magnitudes = [abs(x) for x in row]
+            k = magnitudes.index(max(magnitudes))  # the first maximum, as argmax
+        if row[k] < 0:
+            rows[i] = [-x for x in row]
+    (a0, a1, a2), (b0, b1, b2) = rows[0], rows[1]
+    out = np.array([rows[0], rows[1], [a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0]])  # a x b
     out[2] /= np.linalg.norm(out[2])
     return out + 0.0  # -0.0 becomes 0.0: the same axis prints the same way
+
+
+def _sqrt(x: float) -> float:
+    """math.sqrt where it is defined; numpy's (NaN, with its warning) elsewhere, as before."""
+    return math.sqrt(x) if x >= 0.0 else float(np.sqrt(x))
 
 
 def quaternion_from_matrix(matrix: NDArray[np.float64]) -> NDArray[np.float64]:
@@ -70,22 +84,23 @@ def quaternion_from_matrix(matrix: NDArray[np.float64]) -> NDArray[np.float64]:
     Shepperd's method (J. Guidance and Control 1, 1978): pick the largest of
     the four squared components to divide by, so no step loses precision.
     """
-    m = np.asarray(matrix, dtype=np.float64)
-    trace = m[0, 0] + m[1, 1] + m[2, 2]
-    candidates = (trace, m[0, 0], m[1, 1], m[2, 2])
-    k = int(np.argmax(candidates))
+    # Python floats (bit for bit numpy's scalar arithmetic: +, -, *, / and sqrt are correctly rounded in both)
+    (m00, m01, m02), (m10, m11, m12), (m20, m21, m22) = np.asarray(matrix, dtype=np.float64).tolist()
+    trace = m00 + m11 + m22
+    candidates = (trace, m00, m11, m22)
+    k = int(np.argmax(candidates)) if not all(math.isfinite(c) for c in candidates) else candidates.index(max(candidates))
     if k == 0:
-        s = 2.0 * np.sqrt(1.0 + trace)
-        q = [0.25 * s, (m[2, 1] - m[1, 2]) / s, (m[0, 2] - m[2, 0]) / s, (m[1, 0] - m[0, 1]) / s]
+        s = 2.0 * _sqrt(1.0 + trace)
+        q = [0.25 * s, (m21 - m12) / s, (m02 - m20) / s, (m10 - m01) / s]
     elif k == 1:
-        s = 2.0 * np.sqrt(1.0 + m[0, 0] - m[1, 1] - m[2, 2])
-        q = [(m[2, 1] - m[1, 2]) / s, 0.25 * s, (m[0, 1] + m[1, 0]) / s, (m[0, 2] + m[2, 0]) / s]
+        s = 2.0 * _sqrt(1.0 + m00 - m11 - m22)
+        q = [(m21 - m12) / s, 0.25 * s, (m01 + m10) / s, (m02 + m20) / s]
     elif k == 2:
-        s = 2.0 * np.sqrt(1.0 - m[0, 0] + m[1, 1] - m[2, 2])
-        q = [(m[0, 2] - m[2, 0]) / s, (m[0, 1] + m[1, 0]) / s, 0.25 * s, (m[1, 2] + m[2, 1]) / s]
+        s = 2.0 * _sqrt(1.0 - m00 + m11 - m22)
+        q = [(m02 - m20) / s, (m01 + m10) / s, 0.25 * s, (m12 + m21) / s]
     else:
-        s = 2.0 * np.sqrt(1.0 - m[0, 0] - m[1, 1] + m[2, 2])
-        q = [(m[1, 0] - m[0, 1]) / s, (m[0, 2] + m[2, 0]) / s, (m[1, 2] + m[2, 1]) / s, 0.25 * s]
+        s = 2.0 * _sqrt(1.0 - m00 - m11 + m22)
+        q = [(m10 - m01) / s, (m02 + m20) / s, (m12 + m21) / s, 0.25 * s]
     quat = np.array(q, dtype=np.float64)
     quat /= np.linalg.norm(quat)
     if quat[0] < 0:
