@@ -14,8 +14,8 @@ Cases: the sample meshes (solid, and the STL ones as shells), and closed tori
 grid order and shuffled, corners rotated within faces, inverted, mixed
 winding, a few faces removed (open), float32 coordinates offset far from the
 origin (100 to 1e7: exact, warned, refused), two disjoint tori, a torus with a
-cavity (a smaller torus inside, wound the same way: its orientation is
-repaired by nesting), a shell analysis, and at the smallest size also ASCII STL,
+cavity (a thinner torus inside its tube, wound the same way: its orientation
+is repaired by nesting), a shell analysis, and at the smallest size also ASCII STL,
 OBJ (float64 text) and unwelded float64 arrays.  Meshes are written once into
 ``--cache`` and reused.
 """
@@ -113,10 +113,10 @@ def _variants(cache: Path, label: str) -> Iterator[tuple[str, Path, dict[str, An
         return np.concatenate([base, other])
 
     def cavity() -> np.ndarray:
-        inner = base.copy()
-        inner["vertices"] *= np.float32(0.5)
-        inner["vertices"][..., 2] *= np.float32(0.5)
-        return np.concatenate([base, inner])
+        inner = cache / f"torus_{label}_minor05.stl"  # the same ring, half the tube: inside the material
+        if not inner.exists():
+            torus_stl(inner, *SIZES[label], minor=0.5)
+        return np.concatenate([base, _records(inner)])
 
     yield "ordered", make("ordered", lambda: base), {}
     yield "shuffled", make("shuffled", shuffled), {}

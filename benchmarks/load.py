@@ -23,21 +23,21 @@ from __future__ import annotations
 
 import argparse
 import asyncio
-import contextlib
 import os
-import socket
 import statistics
-import subprocess
 import sys
 import tempfile
 import threading
 import time
-from collections.abc import Awaitable, Callable, Iterator
+from collections.abc import Awaitable, Callable
 from dataclasses import dataclass, field
+from functools import partial
 from pathlib import Path
 
 import httpx
-import numpy as np
+
+from benchmarks.cases import stl_bytes, torus
+from benchmarks.harness import Report, Server, Stopwatch, descendants, interleaved, load_average, proc_stat
 
 ROOT = Path(__file__).resolve().parents[1]
 HOST = "127.0.0.1"  # loopback only
@@ -80,69 +80,24 @@ class Phase:
         return ordered[min(len(ordered) - 1, int(q * len(ordered)))] * 1e3
 
 
-def _free_port() -> int:
-    with socket.socket() as s:
-        s.bind((HOST, 0))
-        return int(s.getsockname()[1])
+def _server_command(host: str, port: int) -> list[str]:
+    return [sys.executable, "-c", SERVER, host, str(port)]
 
 
-@contextlib.contextmanager
-def running_server() -> Iterator[tuple[str, subprocess.Popen[bytes]]]:
-    port = _free_port()
-    env = {k: v for k, v in os.environ.items() if not k.startswith("INERTIA_")}
-    proc = subprocess.Popen(
-        [sys.executable, "-c", SERVER, HOST, str(port)], cwd=ROOT, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL
-    )
-    url = f"http://{HOST}:{port}"
-    try:
-        deadline = time.monotonic() + 60
-        while time.monotonic() < deadline:
-            try:
-                if httpx.get(f"{url}/healthz", timeout=1).status_code == 200:
-                    break
-            except httpx.TransportError:
-                time.sleep(0.2)
-        else:
-            raise RuntimeError("the server did not start")
-        yield url, proc
-    finally:
-        proc.terminate()
-        try:
-            proc.wait(15)
-        except subprocess.TimeoutExpired:
-            proc.kill()
+def running_server() -> Server:
+    """The server (``SERVER``) on a free loopback port, ready; stop it with ``with``."""
+    return Server(startup_s=60.0, command=_server_command, host=HOST)
 
 
 def _rss_mib(pid: int) -> float:
-    try:
-        for line in Path(f"/proc/{pid}/status").read_text().splitlines():
-            if line.startswith("VmRSS"):
-                return int(line.split()[1]) / 1024
-    except OSError:
-        pass
-    return 0.0
+    stat = proc_stat(pid)
+    return stat.rss_bytes / 2**20 if stat else 0.0
 
 
 def _cpu_s(pid: int) -> float:
     """User + system CPU time of one process [s]."""
-    try:
-        fields = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
-    except OSError:
-        return 0.0
-    return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
-
-
-def _descendants(pid: int) -> list[int]:
-    parents = {}
-    for entry in Path("/proc").iterdir():
-        if entry.name.isdigit():
-            with contextlib.suppress(OSError, IndexError, ValueError):
-                parents[int(entry.name)] = int((entry / "stat").read_text().rsplit(")", 1)[1].split()[1])
-    found, frontier = [], [pid]
-    while frontier:
-        frontier = [p for p, parent in parents.items() if parent in frontier]
-        found += frontier
-    return found
+    stat = proc_stat(pid)
+    return stat.cpu_s if stat else 0.0
 
 
 class MemorySampler(threading.Thread):
@@ -150,13 +105,14 @@ class MemorySampler(threading.Thread):
 
     def __init__(self, pid: int) -> None:
         super().__init__(daemon=True)
-        self.pid, self.phase, self.samples = pid, "start", []
+        self.pid, self.phase = pid, "start"
+        self.samples: list[tuple[float, str, float, float]] = []
         self.done = threading.Event()
         self.start_time = time.monotonic()
 
     def run(self) -> None:
         while not self.done.wait(0.5):
-            workers = sum(_rss_mib(p) for p in _descendants(self.pid))
+            workers = sum(_rss_mib(p) for p in descendants(self.pid))
             self.samples.append((time.monotonic() - self.start_time, self.phase, _rss_mib(self.pid), workers))
 
 
@@ -202,31 +158,18 @@ async def _box(c: httpx.AsyncClient) -> bool:
     return r.status_code == 200 and "mass" in r.json()
 
 
-def _torus_stl(n: int, m: int) -> bytes:
-    u = np.linspace(0, 2 * np.pi, n, endpoint=False)[:, None]
-    v = np.linspace(0, 2 * np.pi, m, endpoint=False)[None, :]
-    ring = 2.0 + 0.5 * np.cos(v)
-    pts = np.stack([ring * np.cos(u), ring * np.sin(u), 0.5 * np.sin(v) + 0 * u], axis=-1).reshape(-1, 3)
-    i, j = np.meshgrid(np.arange(n), np.arange(m), indexing="ij")
-    a, b = i * m + j, ((i + 1) % n) * m + j
-    c, d = ((i + 1) % n) * m + (j + 1) % m, i * m + (j + 1) % m
-    faces = np.concatenate([np.stack([a, b, c], -1).reshape(-1, 3), np.stack([a, c, d], -1).reshape(-1, 3)])
-    records = np.zeros(len(faces), dtype=[("normal", "<f4", 3), ("v", "<f4", (3, 3)), ("attr", "<u2")])
-    records["v"] = pts[faces]
-    return b"\0" * 80 + len(faces).to_bytes(4, "little") + records.tobytes()
-
-
 def _cpu_us(fns: dict[str, Callable[[], object]], number: int = 200, repeat: int = 7) -> dict[str, float]:
     """CPU microseconds of one call of each function: the best of ``repeat`` batches, taken in turn (so
     that a busy moment of the shared machine hits every function alike, not one of them)."""
-    best = dict.fromkeys(fns, float("inf"))
-    for _ in range(repeat):
-        for name, fn in fns.items():
-            start = time.process_time()
-            for _ in range(number):
-                fn()
-            best[name] = min(best[name], (time.process_time() - start) / number)
-    return {name: 1e6 * t for name, t in best.items()}
+
+    def batch(fn: Callable[[], object]) -> float:
+        clock = Stopwatch()
+        for _ in range(number):
+            fn()
+        return clock.cpu_s / number
+
+    rounds = interleaved([(name, partial(batch, fn)) for name, fn in fns.items()], repeat, lambda _name, t: t, rotate=0)
+    return {name: 1e6 * t for name, t in rounds.best.items()}
 
 
 def in_process_breakdown() -> list[tuple[str, float]]:
@@ -330,6 +273,11 @@ def _load(values: tuple[float, float, float]) -> str:
     return ", ".join(f"{v:.1f}" for v in values) + f" on {os.cpu_count()} cores"
 
 
+def _torus_stl(n: int, m: int) -> bytes:
+    """Binary STL of a closed torus (R = 2, r = 0.5) of 2 n m triangles (``benchmarks.cases.torus``)."""
+    return stl_bytes(*torus(n, m, 2.0, 0.5))
+
+
 def _row(p: Phase) -> str:
     return f"| {p.name} | {len(p.latencies)} | {p.rate:.0f} | {p.quantile(0.5):.1f} | {p.quantile(0.99):.1f} | {p.errors} |"
 
@@ -386,18 +334,19 @@ async def measure(url: str, sampler: MemorySampler, seconds: float, rounds: int,
     return {"pairs": pairs, "small": small, "mix": [mix_points, mix_small, mix_big, health]}
 
 
-def report(result: dict[str, object], sampler: MemorySampler, args: argparse.Namespace, wall: float) -> str:
+def report(result: dict[str, object], sampler: MemorySampler, args: argparse.Namespace, wall: float) -> Report:
     pairs = result["pairs"]
     assert isinstance(pairs, list)
     ratios = [p.rate / b.rate for b, p in pairs]
     cpu_ratios = [b.cpu_ms_per_request / p.cpu_ms_per_request for b, p in pairs]
-    lines = [
-        "# Load on the HTTP server",
-        "",
-        "Generated by `python -m benchmarks.load"
+    command = (
+        "python -m benchmarks.load"
         + (f" --seconds {args.seconds:g}" if args.seconds != 8 else "")
         + (f" --rounds {args.rounds}" if args.rounds != 3 else "")
-        + "` "
+    )
+    out = Report("Load on the HTTP server", command)
+    lines = [
+        f"Generated by `{command}` "
         f"({time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}, {wall:.0f} s). One server on 127.0.0.1 with "
         f"default settings ({os.cpu_count()} cores, two compute processes) and an extra `POST /bench/bare` route "
         f"(an `async def` returning a constant, behind the same middleware): the peer in the same run. "
@@ -481,8 +430,9 @@ def report(result: dict[str, object], sampler: MemorySampler, args: argparse.Nam
             last = t
     peak_server = max((s[2] for s in sampler.samples), default=0.0)
     peak_workers = max((s[3] for s in sampler.samples), default=0.0)
-    lines += ["", f"Peaks: server {peak_server:.0f} MiB, compute processes together {peak_workers:.0f} MiB.", ""]
-    return "\n".join(lines)
+    lines += ["", f"Peaks: server {peak_server:.0f} MiB, compute processes together {peak_workers:.0f} MiB."]
+    out.add(*lines)
+    return out
 
 
 def main() -> None:
@@ -497,11 +447,11 @@ def main() -> None:
     args = parser.parse_args()
     args.clients = max(1, min(64, args.clients))
     if args.small_only:
-        with running_server() as (url, proc):
-            sampler = MemorySampler(proc.pid)
+        with running_server() as server:
+            sampler = MemorySampler(server.process.pid)
             sampler.start()
             try:
-                pairs = asyncio.run(measure_pairs(url, sampler, args.seconds, args.rounds, args.clients))
+                pairs = asyncio.run(measure_pairs(server.url, sampler, args.seconds, args.rounds, args.clients))
             finally:
                 sampler.done.set()
                 sampler.join()
@@ -509,24 +459,24 @@ def main() -> None:
             print(_row(b) + f" {b.cpu_ms_per_request:.2f} |\n" + _row(p) + f" {p.cpu_ms_per_request:.2f} |")
         print("throughput ratios", [round(p.rate / b.rate, 2) for b, p in pairs])
         print("CPU ratios", [round(b.cpu_ms_per_request / p.cpu_ms_per_request, 2) for b, p in pairs])
-        print("load average", os.getloadavg())
+        print("load average", load_average())
         return
     args.load_before = os.getloadavg()
     big = _torus_stl(707, 707)  # 999,698 triangles
-    start = time.monotonic()
-    with running_server() as (url, proc):
-        sampler = MemorySampler(proc.pid)
+    clock = Stopwatch()
+    with running_server() as server:
+        sampler = MemorySampler(server.process.pid)
         sampler.start()
         try:
-            result = asyncio.run(measure(url, sampler, args.seconds, args.rounds, args.clients, big))
+            result = asyncio.run(measure(server.url, sampler, args.seconds, args.rounds, args.clients, big))
         finally:
             sampler.done.set()
             sampler.join()
     args.load_after = os.getloadavg()
     result["breakdown"] = in_process_breakdown()
-    text = report(result, sampler, args, time.monotonic() - start)
-    args.doc.write_text(text)
-    print(text)
+    doc = report(result, sampler, args, clock.wall_s)
+    doc.write(args.doc)
+    print(doc.text())
 
 
 if __name__ == "__main__":

@@ -34,16 +34,17 @@ import importlib.metadata
 import json
 import os
 import platform
-import subprocess
 import sys
 import tempfile
-import time
 from collections import defaultdict
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
 import numpy as np
+
+from benchmarks.cases import torus, triangles_stl_bytes
+from benchmarks.harness import Report, Stopwatch, available_memory, cpu_model, run_tool
 
 SIZES = {"1e4": (100, 50), "1e5": (250, 200), "1e6": (1000, 500), "5e6": (2500, 1000), "2e7": (5000, 2000)}
 QUICK = ("1e4", "1e5")
@@ -70,64 +71,9 @@ print(json.dumps({"volume": float(volume), "inertia": inertia.tolist()}))
 
 def torus_stl(path: Path, nu: int, nv: int, major: float = 3.0, minor: float = 1.0) -> int:
     """Write a closed torus of 2 nu nv triangles as binary STL; returns the triangle count."""
-    u = 2 * np.pi * np.arange(nu) / nu
-    v = 2 * np.pi * np.arange(nv) / nv
-    uu, vv = np.meshgrid(u, v, indexing="ij")
-    ring = major + minor * np.cos(vv)
-    pts = np.stack([ring * np.cos(uu), ring * np.sin(uu), minor * np.sin(vv)], -1).reshape(-1, 3).astype("<f4")
-    i, j = np.meshgrid(np.arange(nu), np.arange(nv), indexing="ij")
-    a, b = i * nv + j, (i + 1) % nu * nv + j
-    c, d = (i + 1) % nu * nv + (j + 1) % nv, i * nv + (j + 1) % nv
-    faces = np.concatenate([np.stack([a, b, c], -1).reshape(-1, 3), np.stack([a, c, d], -1).reshape(-1, 3)])
-    rec = np.zeros(len(faces), dtype=[("normal", "<f4", (3,)), ("vertices", "<f4", (3, 3)), ("attr", "<u2")])
-    rec["vertices"] = pts[faces]
-    with open(path, "wb") as fh:
-        fh.write(b"benchmarks.mass torus".ljust(80, b" "))
-        fh.write(np.uint32(len(faces)).tobytes())
-        fh.write(rec.tobytes())
+    v, faces = torus(nu, nv, major, minor)
+    path.write_bytes(triangles_stl_bytes(v.astype("<f4")[faces], b"benchmarks.mass torus".ljust(80, b" ")))
     return len(faces)
-
-
-GNU_TIME = "/usr/bin/time"
-
-
-def available_memory() -> int:
-    """MemAvailable of /proc/meminfo in bytes (0 where unknown)."""
-    try:
-        for line in Path("/proc/meminfo").read_text().splitlines():
-            if line.startswith("MemAvailable:"):
-                return int(line.split()[1]) * 1024
-    except (OSError, ValueError, IndexError):
-        pass
-    return 0
-
-
-def run_process(cmd: list[str]) -> tuple[float, int, str, float]:
-    """Wall time [s], peak RSS [bytes], stdout and CPU time [s] of one child process.
-
-    Linux carries a process's high-water RSS across fork and exec into the
-    child's ``ru_maxrss``, so a child of this (large) benchmark process would
-    report at least this process's own peak.  GNU time, itself tiny, forks the
-    tool and reports the tool's own peak; without it we fall back to wait4.
-    """
-    wrapped = os.path.exists(GNU_TIME)
-    with tempfile.TemporaryFile() as out, tempfile.NamedTemporaryFile("r") as rss_file:
-        full = [GNU_TIME, "-f", "%M %U %S", "-o", rss_file.name, *cmd] if wrapped else cmd
-        start = time.perf_counter()
-        proc = subprocess.Popen(full, stdout=out, stderr=subprocess.PIPE)
-        _, status, usage = os.wait4(proc.pid, 0)
-        wall = time.perf_counter() - start
-        proc.returncode = os.waitstatus_to_exitcode(status)
-        err = proc.stderr.read().decode() if proc.stderr else ""
-        if proc.returncode != 0:
-            raise RuntimeError(f"{cmd[:3]} failed ({proc.returncode}): {err[-2000:]}")
-        if wrapped:
-            fields = rss_file.read().split()[-3:]
-            peak_kb, cpu = int(fields[0]), float(fields[1]) + float(fields[2])
-        else:
-            peak_kb, cpu = usage.ru_maxrss, usage.ru_utime + usage.ru_stime
-        out.seek(0)
-        return wall, peak_kb * 1024, out.read().decode(), cpu
 
 
 def tool_commands(path: Path) -> dict[str, list[str]]:
@@ -168,18 +114,19 @@ def measure_processes(path: Path, triangles: int, repeat: int) -> dict[str, dict
         for tool in order if r % 2 == 0 else order[::-1]:
             if tool == "numpy-stl" and triangles >= SLOW_NUMPY_STL and out[tool]["walls"]:
                 continue
-            wall, peak, stdout, cpu = run_process(commands[tool])
+            run = run_tool(commands[tool])
+            wall, peak, stdout, cpu = run.wall_s, run.peak_rss_bytes, run.stdout, run.cpu_s
             out[tool]["walls"].append(wall)
             out[tool]["rss"].append(peak)
             out[tool]["cpu"].append(cpu)
             out[tool]["stdout"] = stdout
-    for r in out.values():
-        if "skipped" in r:
+    for res in out.values():
+        if "skipped" in res:
             continue
-        r["wall"], r["rss"], r["cpu_s"], r["runs"] = min(r["walls"]), min(r["rss"]), min(r["cpu"]), len(r["walls"])
-    for tool, r in out.items():
-        if "skipped" not in r:
-            r["moments"], r["estimate"] = principal_per_density(tool, r.pop("stdout"))
+        res["wall"], res["rss"], res["cpu_s"], res["runs"] = min(res["walls"]), min(res["rss"]), min(res["cpu"]), len(res["walls"])
+    for tool, res in out.items():
+        if "skipped" not in res:
+            res["moments"], res["estimate"] = principal_per_density(tool, res.pop("stdout"))
     return out
 
 
@@ -195,11 +142,11 @@ def stage_breakdown(path: Path, warmup: Path) -> dict[str, float]:
 
     def timed(name: str | Callable[[], str], fn: Callable[..., Any]) -> Callable[..., Any]:
         def wrapper(*args: Any, **kwargs: Any) -> Any:
-            start = time.perf_counter()
+            clock = Stopwatch()
             try:
                 return fn(*args, **kwargs)
             finally:
-                times[name() if callable(name) else name] += time.perf_counter() - start
+                times[name() if callable(name) else name] += clock.wall_s
 
         return wrapper
 
@@ -207,7 +154,7 @@ def stage_breakdown(path: Path, warmup: Path) -> dict[str, float]:
         passes[0] += 1
         return f"integration pass {passes[0]}"
 
-    patches = [
+    patches: list[tuple[Any, str, str | Callable[[], str]]] = [
         (stl, "read_stl_file", "read STL + float32 weld"),
         (solid, "surface_topology", "edge topology (watertight check)"),
         (solid, "_orient_outward", "outward orientation"),
@@ -220,9 +167,9 @@ def stage_breakdown(path: Path, warmup: Path) -> dict[str, float]:
         pipeline.analyze(str(warmup))  # warm-up: lazy imports
         times.clear()
         passes[0] = 0
-        start = time.perf_counter()
+        clock = Stopwatch()
         pipeline.analyze(str(path))
-        total = time.perf_counter() - start
+        total = clock.wall_s
     finally:
         for obj, attr, fn in saved:
             setattr(obj, attr, fn)
@@ -233,14 +180,7 @@ def stage_breakdown(path: Path, warmup: Path) -> dict[str, float]:
 
 
 def machine_info() -> dict[str, str]:
-    cpu = "unknown"
-    try:
-        for line in Path("/proc/cpuinfo").read_text().splitlines():
-            if line.startswith("model name"):
-                cpu = line.split(":", 1)[1].strip()
-                break
-    except OSError:
-        pass
+    cpu = cpu_model()
     mem = ""
     try:
         kb = int(Path("/proc/meminfo").read_text().split()[1])
@@ -268,12 +208,11 @@ def _cell(r: dict[str, Any], key: str, fmt: str, scale: float = 1.0) -> str:
     return "skipped" if "skipped" in r else format(r[key] / scale, fmt)
 
 
-def report(results: dict[str, dict[str, Any]], stages: dict[str, dict[str, float]], command: str) -> str:
+def report(results: dict[str, dict[str, Any]], stages: dict[str, dict[str, float]], command: str) -> Report:
     mb = 1e6
     tools = ("inertia", "trimesh", "numpy-stl")
+    out = Report("Performance: load + mass properties of binary STL", command)
     lines = [
-        "# Performance: load + mass properties of binary STL",
-        "",
         f"Regenerate with `{command}` from the repository root (written by `benchmarks/mass.py`).",
         "",
         "Bodies: closed tori (R = 3, r = 1) as binary STL, two triangles per grid quad.  Whole processes:",
@@ -353,9 +292,9 @@ def report(results: dict[str, dict[str, Any]], stages: dict[str, dict[str, float
         "other work shared the CPUs, which slows every tool (peak memory is unaffected).",
         "",
         *[f"- {k}: {v}" for k, v in machine_info().items()],
-        "",
     ]
-    return "\n".join(lines)
+    out.add(*lines)
+    return out
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -383,7 +322,7 @@ def main(argv: list[str] | None = None) -> int:
             path = Path(tmp) / f"torus_{label}.stl"
             triangles = torus_stl(path, *SIZES[label])
             print(f"{label}: {triangles:,} triangles, {path.stat().st_size / 1e6:.1f} MB", file=sys.stderr, flush=True)
-            r = measure_processes(path, triangles, args.repeat)
+            r: dict[str, Any] = dict(measure_processes(path, triangles, args.repeat))
             r["triangles"], r["file_bytes"] = triangles, path.stat().st_size
             results[label] = r
             if "skipped" not in r["inertia"]:
@@ -406,12 +345,11 @@ def main(argv: list[str] | None = None) -> int:
         + (f" --out {args.out}" if args.out not in ("docs/performance.md", "-") else "")
         + (f" --memory-margin {args.memory_margin:g}" if args.memory_margin != 8 else "")
     )
-    text = report(results, stages, command)
+    doc = report(results, stages, command)
     if args.out == "-":
-        print(text)
+        print(doc.text())
     else:
-        Path(args.out).parent.mkdir(parents=True, exist_ok=True)
-        Path(args.out).write_text(text)
+        doc.write(Path(args.out))
         print(f"wrote {args.out}", file=sys.stderr)
     return 0
 

@@ -426,3 +426,58 @@ def test_a_bad_samples_limit_stops_the_server_with_a_sentence() -> None:
         timeout=300,
     )
     assert out.returncode != 0 and "INERTIA_MAX_SAMPLES must be a whole number" in out.stderr
+
+
+def _sections() -> list[type]:
+    from inertia import sections
+
+    found = [getattr(sections, name) for name in sections.__all__]
+    return [c for c in found if isinstance(c, type) and issubclass(c, sections.Section) and c is not sections.Section]
+
+
+@pytest.mark.parametrize("section", _sections(), ids=lambda c: c.__name__)
+def test_response_schemas_are_the_result_model_sections(spec: dict[str, Any], section: type) -> None:
+    """Each section of the result model is a response schema with exactly its keys, in its order, required
+    where the dataclass requires them: a field added to a section is in the schema without a second edit."""
+    from dataclasses import MISSING, fields
+
+    from inertia.api.schemas import response_model
+
+    schema = spec["components"]["schemas"][response_model(section).__name__]
+    keys = [f.metadata.get("key") or f.name for f in fields(section)]
+    required = [k for f, k in zip(fields(section), keys, strict=True) if f.default is MISSING and f.default_factory is MISSING]
+    assert list(schema["properties"]) == keys
+    assert schema.get("required", []) == required
+    assert schema["additionalProperties"] is False
+
+
+def test_closed_sets_and_defaults_in_the_schema_are_the_vocabulary_and_the_options(spec: dict[str, Any]) -> None:
+    from inertia.options import DEFAULT_OPTIONS
+    from inertia.tolerances import DEFAULT_TOLERANCES
+    from inertia.vocabulary import (
+        Geometry,
+        Isotopes,
+        MassUnit,
+        Model,
+        MotionMethod,
+        Regime,
+        RotorKind,
+        SourceKind,
+        UnitsFrom,
+        values,
+    )
+
+    schemas = spec["components"]["schemas"]
+    query = {p["name"]: p["schema"] for p in spec["paths"]["/v1/analyze/mesh"]["post"]["parameters"]}
+    body = schemas["PointsRequest"]["properties"]
+    for where in (query, body, schemas["PrecessionRequest"]["properties"]):
+        assert (where["method"]["enum"], where["method"]["default"]) == (list(values(MotionMethod)), "exact")
+        assert where["tolerance"]["default"] == DEFAULT_TOLERANCES.moment_rel == DEFAULT_OPTIONS.tolerance == 1e-6
+    assert (query["model"]["enum"], query["model"]["default"]) == (list(values(Model)), "solid")
+    assert (query["geometry"]["enum"], query["geometry"]["default"]) == (list(values(Geometry)), "brep")
+    assert query["isotopes"]["enum"] == body["isotopes"]["enum"] == list(values(Isotopes))
+    assert (body["mass_unit"]["enum"], body["mass_unit"]["default"]) == (list(values(MassUnit)), "kg")
+    assert schemas["SourceOut"]["properties"]["kind"]["enum"] == list(values(SourceKind))
+    assert schemas["SourceOut"]["properties"]["units_from"]["enum"] == list(values(UnitsFrom))
+    assert schemas["ClassificationOut"]["properties"]["kind"]["enum"] == list(values(RotorKind))
+    assert schemas["PrecessionOut"]["properties"]["regime"]["enum"] == list(values(Regime))
