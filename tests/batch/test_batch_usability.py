@@ -20,8 +20,11 @@ from typing import Any
 import numpy as np
 import pytest
 
+from benchmarks.cases import torus, write_stl
+
 ROOT = Path(__file__).resolve().parents[2]
 BOX = ROOT / "sample_meshes" / "box.stl"
+N_PARTS = 64
 
 
 def inertia(*args: str, **kwargs: Any) -> subprocess.CompletedProcess[str]:
@@ -67,10 +70,14 @@ def test_flat_rows_carry_the_principal_axes_and_quaternion(tmp_path: Path) -> No
 
 @pytest.mark.skipif(os.name != "posix", reason="Ctrl-C is a SIGINT to the foreground process group")
 def test_ctrl_c_keeps_the_rows_and_says_how_to_resume(tmp_path: Path) -> None:
+    # 64 tori of 1 MB: the batch groups them into several tasks, so rows reach the output well before the
+    # end and the interrupt lands mid-run (400 boxes were one task: their rows came at the very end, and the
+    # interrupt raced the command's exit)
     folder = tmp_path / "parts"
     folder.mkdir()
-    for i in range(400):
-        shutil.copy(BOX, folder / f"part{i:04d}.stl")
+    write_stl(folder / "part00.stl", *torus(100, 100))
+    for i in range(1, N_PARTS):
+        shutil.copy(folder / "part00.stl", folder / f"part{i:02d}.stl")
     out = tmp_path / "rows.jsonl"
     proc = subprocess.Popen(
         [sys.executable, "-m", "inertia", "batch", str(folder), "--out", str(out), "--workers", "2", "--no-progress"],
@@ -90,8 +97,8 @@ def test_ctrl_c_keeps_the_rows_and_says_how_to_resume(tmp_path: Path) -> None:
     assert "Traceback" not in err
     assert "--resume" in err and str(out) in err
     kept = [json.loads(line) for line in out.read_text().splitlines()]
-    assert 0 < len(kept) < 400
+    assert 0 < len(kept) < N_PARTS
     resumed = inertia(str(folder), "--out", str(out), "--workers", "2", "--no-progress", "--resume")
     assert resumed.returncode == 0, resumed.stderr
     names = [json.loads(line)["source"]["filename"] for line in out.read_text().splitlines()]
-    assert len(names) == len(set(names)) == 400
+    assert len(names) == len(set(names)) == N_PARTS
