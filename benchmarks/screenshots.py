@@ -26,7 +26,9 @@ if TYPE_CHECKING:
 ROOT = Path(__file__).resolve().parents[1]
 SAMPLES = ROOT / "sample_meshes"
 OUT = ROOT / "docs" / "screenshots"
-ARGS = [
+# headless without a GPU: WebGL through SwiftShader (software), nothing fetched from the network;
+# the end-to-end tests launch Chromium with the same flags
+CHROMIUM_ARGS = [
     "--headless",
     "--no-sandbox",
     "--disable-gpu",
@@ -82,7 +84,7 @@ def main() -> None:
     args.out.mkdir(parents=True, exist_ok=True)
     with Server({"INERTIA_COMPUTE_PROCESSES": "1"}, startup_s=60.0) as server, sync_playwright() as p:
         url = server.url
-        browser = p.chromium.launch(executable_path=args.chromium, args=ARGS)
+        browser = p.chromium.launch(executable_path=args.chromium, args=CHROMIUM_ARGS)
         desktop = browser.new_page(viewport={"width": 1280, "height": 1400})
         _analyze(desktop, url, "l_bracket.stl")
         desktop.screenshot(path=args.out / "asymmetric.png", clip={"x": 0, "y": 0, "width": 1280, "height": 790})

@@ -15,25 +15,12 @@ from typing import Any
 
 import pytest
 
+from benchmarks.screenshots import CHROMIUM_ARGS
 from tests.support.server import LiveServer
 
 ROOT = Path(__file__).resolve().parents[2]
 STARTUP_S = 60.0
 HTTP_ERROR = re.compile(r"^Failed to load resource: the server responded with a status of 4\d\d")
-# headless without a GPU: WebGL through SwiftShader (software), nothing fetched from the network
-CHROMIUM_ARGS = [
-    "--headless",
-    "--no-sandbox",
-    "--disable-gpu",
-    "--disable-quic",
-    "--no-first-run",
-    "--disable-background-networking",
-    "--disable-component-update",
-    "--disable-sync",
-    "--use-gl=angle",
-    "--use-angle=swiftshader",
-    "--enable-unsafe-swiftshader",
-]
 
 
 def chromium_path() -> str | None:
