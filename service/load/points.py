@@ -20,10 +20,11 @@ import numpy as np
 
 from ..body import PointBody
 from ..errors import EmptyGeometryError, InvalidParameterError, UnreadableFileError
+from ..vocabulary import Isotopes, MassUnit, values
 
 __all__ = ["MASS_UNITS", "names_elements", "points_from_records", "read_points", "read_points_file"]
 
-MASS_UNITS = ("kg", "u")
+MASS_UNITS = values(MassUnit)
 
 
 def names_elements(records: Iterable[Mapping[str, Any]]) -> bool:
@@ -46,7 +47,11 @@ def _mass(rec: Mapping[str, Any], k: int, isotopes: str, dalton: float | None) -
 
 
 def points_from_records(
-    records: Iterable[Mapping[str, Any]], length_scale: float = 1.0, *, isotopes: str = "standard", mass_unit: str = "kg"
+    records: Iterable[Mapping[str, Any]],
+    length_scale: float = 1.0,
+    *,
+    isotopes: str = Isotopes.STANDARD,
+    mass_unit: str = MassUnit.KG,
 ) -> PointBody:
     """``[{"mass": m, "position": [x, y, z]}, ...]`` (or ``"element"`` for ``mass``) as a ``PointBody``.
 
@@ -55,7 +60,7 @@ def points_from_records(
     if mass_unit not in MASS_UNITS:
         raise InvalidParameterError(f"mass_unit must be 'kg' or 'u', got {mass_unit!r}", parameter="mass_unit")
     dalton = None
-    if mass_unit == "u":
+    if mass_unit == MassUnit.U:
         from ..elements import dalton_kg
 
         dalton = dalton_kg()
@@ -76,13 +81,13 @@ def points_from_records(
     return PointBody(np.array(masses), np.array(positions).reshape(-1, 3), length_scale)
 
 
-def read_points_file(data: bytes, fmt: str, length_scale: float = 1.0, *, isotopes: str = "standard") -> PointBody:
+def read_points_file(data: bytes, fmt: str, length_scale: float = 1.0, *, isotopes: str = Isotopes.STANDARD) -> PointBody:
     """A JSON list of records (or ``{"points": [...]}``), a CSV with columns mass,x,y,z
     (or element,x,y,z), or an XYZ file."""
     return read_points(data, fmt, length_scale, isotopes=isotopes)[0]
 
 
-def read_points(data: bytes, fmt: str, length_scale: float = 1.0, *, isotopes: str = "standard") -> tuple[PointBody, bool]:
+def read_points(data: bytes, fmt: str, length_scale: float = 1.0, *, isotopes: str = Isotopes.STANDARD) -> tuple[PointBody, bool]:
     """The points of a file, and whether it names elements (a molecule: XYZ always does)."""
     records, warnings = _file_records(data.decode("utf-8-sig", errors="replace"), fmt)
     body = points_from_records(records, length_scale, isotopes=isotopes)
