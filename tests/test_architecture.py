@@ -213,8 +213,13 @@ def test_layer_lookup_prefers_the_most_specific_prefix() -> None:
 
 
 def test_every_module_is_placed_in_a_layer() -> None:
+    unplaced = []
     for name in modules():
-        layer_of(name)
+        try:
+            layer_of(name)
+        except LookupError:
+            unplaced.append(name)
+    assert unplaced == [], f"modules in no layer of LAYERS: {unplaced}"
 
 
 def test_no_import_cycle() -> None:
