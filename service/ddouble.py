@@ -8,12 +8,17 @@ into compensated dot products (Ogita, Rump & Oishi, SIAM J. Sci. Comput. 26,
 
 from __future__ import annotations
 
+from typing import TypeVar
+
 import numpy as np
 from numpy.typing import NDArray
 
 __all__ = ["two_sum", "two_prod", "rotated"]
 
 _SPLIT = 134217729.0  # 2^27 + 1, Dekker's splitting constant for float64
+
+# The same operations on Python floats (the small point-set path) or on arrays
+Real = TypeVar("Real", float, NDArray[np.float64])
 
 
 def two_sum(a: NDArray[np.float64], b: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
@@ -22,7 +27,7 @@ def two_sum(a: NDArray[np.float64], b: NDArray[np.float64]) -> tuple[NDArray[np.
     return s, (a - (s - bb)) + (b - bb)  # Knuth, TAOCP vol. 2, 4.2.2
 
 
-def two_prod(a: NDArray[np.float64] | float, b: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+def two_prod(a: Real | float, b: Real) -> tuple[Real, Real]:
     p = a * b
     ca = _SPLIT * a
     ah = ca - (ca - a)

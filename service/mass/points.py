@@ -24,6 +24,7 @@ import math
 import numpy as np
 from numpy.typing import NDArray
 
+from ..ddouble import two_prod
 from ..integrals import Sums
 
 __all__ = ["SMALL_POINTS", "small_point_sums"]
@@ -31,7 +32,6 @@ __all__ = ["SMALL_POINTS", "small_point_sums"]
 SMALL_POINTS = 16
 """Point sets up to this size are summed here (numpy wins above a few dozen points)."""
 
-_SPLIT = 134217729.0  # 2^27 + 1, Dekker's splitting constant (as in ``ddouble``)
 _IJ = ((0, 0), (1, 1), (2, 2), (0, 1), (0, 2), (1, 2))  # as in ``integrals``
 
 
@@ -60,17 +60,6 @@ def _pairwise(a: list[float]) -> float:
     return 0.0 + res
 
 
-def _two_prod(a: float, b: float) -> tuple[float, float]:
-    p = a * b
-    ca = _SPLIT * a
-    ah = ca - (ca - a)
-    al = a - ah
-    cb = _SPLIT * b
-    bh = cb - (cb - b)
-    bl = b - bh
-    return p, ((ah * bh - p) + ah * bl + al * bh) + al * bl
-
-
 def _shifted(points: list[list[float]], origin: list[float]) -> list[list[float]]:
     """``points - origin``."""
     return [[p[0] - origin[0], p[1] - origin[1], p[2] - origin[2]] for p in points]
@@ -91,10 +80,10 @@ def _rotated(points: list[list[float]], origin: list[float], rotation: list[list
             d_lo[i] = (a - (s - bb)) + (b - bb)
         row = []
         for j in range(3):
-            hi, lo = _two_prod(rotation[0][j], d_hi[0])
+            hi, lo = two_prod(rotation[0][j], d_hi[0])
             lo = lo + rotation[0][j] * d_lo[0]
             for i in (1, 2):
-                q, e = _two_prod(rotation[i][j], d_hi[i])
+                q, e = two_prod(rotation[i][j], d_hi[i])
                 s = hi + q
                 bb = s - hi
                 e2 = (hi - (s - bb)) + (q - bb)
