@@ -238,10 +238,15 @@ def truncated_stl() -> bytes:
     return data[:80] + struct.pack("<I", 1000) + data[84 : 84 + 100]
 
 
-def post_points(client: TestClient, body: dict[str, Any] | str) -> Any:
+def post_json(client: TestClient, path: str, body: Any) -> Any:
+    """POST a JSON body: an object, or a string sent as it is (for malformed JSON)."""
     if isinstance(body, str):
-        return client.post("/v1/analyze/points", content=body, headers={"content-type": "application/json"})
-    return client.post("/v1/analyze/points", json=body)
+        return client.post(path, content=body, headers={"content-type": "application/json"})
+    return client.post(path, json=body)
+
+
+def post_points(client: TestClient, body: dict[str, Any] | str) -> Any:
+    return post_json(client, "/v1/analyze/points", body)
 
 
 def points_ok(client: TestClient, body: Any) -> dict[str, Any]:
@@ -256,9 +261,7 @@ TRIATOMIC = json.loads((SAMPLES / "triatomic.json").read_text())
 
 
 def post_precession(client: TestClient, body: Any) -> Any:
-    if isinstance(body, str):
-        return client.post("/v1/precession", content=body, headers={"content-type": "application/json"})
-    return client.post("/v1/precession", json=body)
+    return post_json(client, "/v1/precession", body)
 
 
 def precession_ok(client: TestClient, body: Any) -> dict[str, Any]:
