@@ -9,6 +9,7 @@ are stated in the package's docstring.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -42,15 +43,20 @@ class Setup:
     initial: RigidProblem | None = None  # the state as given: reported M, E and omega_body come from it
 
 
-def decide_regime(frame: PrincipalFrame, classification: Classification, omega: Array, tol: Tolerances) -> Setup:
-    """The regime, and the ideal problem that is solved; the state as given is kept beside it."""
-    decided = _decide(frame, classification, omega, tol)
+def decide_regime(
+    frame: PrincipalFrame, classification: Classification, omega: Array, tol: Tolerances, omega_exponent: int = 0
+) -> Setup:
+    """The regime, and the ideal problem that is solved; the state as given is kept beside it.
+
+    ``omega`` is in units of 2^omega_exponent rad/s (``scaling.Units``); warnings quote rad/s.
+    """
+    decided = _decide(frame, classification, omega, tol, omega_exponent)
     axes = np.asarray(frame.axes, dtype=np.float64)
     given = RigidProblem(np.asarray(frame.moments, dtype=np.float64), axes @ omega, axes, frame.quaternion)
     return replace(decided, initial=given)
 
 
-def _decide(frame: PrincipalFrame, classification: Classification, omega: Array, tol: Tolerances) -> Setup:
+def _decide(frame: PrincipalFrame, classification: Classification, omega: Array, tol: Tolerances, omega_exponent: int) -> Setup:
     axes = np.asarray(frame.axes, dtype=np.float64)
     omega_body = axes @ omega
     rotor = motion_rotor(frame, classification)
@@ -59,8 +65,9 @@ def _decide(frame: PrincipalFrame, classification: Classification, omega: Array,
     if rotor is RotorClass.LINEAR and omega_body[0] != 0.0:
         along = abs(float(omega_body[0]))
         if along > tol.permanent_rotation_rel * float(np.linalg.norm(omega_body)):
+            in_rad_s = math.ldexp(along, omega_exponent)
             warnings.append(
-                f"the component of omega along the rotator axis ({along:.3g} rad/s) has no physical effect "
+                f"the component of omega along the rotator axis ({in_rad_s:.3g} rad/s) has no physical effect "
                 "on a linear rotator and was dropped"
             )
         omega_body = omega_body.copy()
