@@ -46,8 +46,18 @@ Modelling decisions (stated once, here):
   meaningless; it is dropped (with a warning when it is not negligible) and
   the rotator turns uniformly about M, perpendicular to its axis.
 - Omega is along a principal axis (permanent rotation) when its other
-  principal components are within rounding (``Tolerances.permanent_rotation_rel``);
-  a larger tilt, even 1e-9, is predicted as the motion it is (a flip, say).
+  principal components are within the rounding of ``axes @ Omega``
+  (``Tolerances.permanent_rotation_rel``); a larger tilt, even 1e-9, is
+  predicted as the motion it is (a flip, say).  Where the axes are an exact
+  signed permutation (principal moments given, a diagonal tensor) there is no
+  such rounding: only exact zeros are permanent rotation, and a tilt of 1e-17
+  about the intermediate axis grows into the flip it is.
+- Separatrix: the distance 2E I2 - M^2 is computed exactly.  Within
+  ``Tolerances.separatrix_rel`` of zero the state is reported as on the
+  separatrix (no period, a warning; API.md), but its trajectory is the
+  motion of the numbers given; only an exact zero moves along the
+  separatrix's hyperbolic limit (which the true motion leaves after its first
+  approach to the intermediate axis).
 - ``stable`` follows the contract: an asymmetric top is unstable when Omega
   starts nearest its intermediate axis; permanent rotation about the
   intermediate axis is unstable; every other regime is stable (a symmetric
