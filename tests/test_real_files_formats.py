@@ -53,3 +53,24 @@ def test_abaqus_inp_is_not_taken_for_avs_ucd() -> None:
     assert not is_avs_ucd(b"*HEADING\n** comment\n*NODE\n1, 0.0, 0.0, 0.0\n")
     assert is_avs_ucd((REAL / "inp" / "cellsnd.bin.inp").read_bytes())
     assert is_avs_ucd((REAL / "inp" / "cellsnd.ascii.inp").read_bytes())
+
+
+def test_rooms_sharing_a_wall_are_not_rewound_as_cavities() -> None:
+    """trimesh's no_indices_3storybuilding.glb: each floor is two rooms that share a wall (four faces on its edges).
+
+    The components joined across manifold edges were two open rooms and the wall's two
+    sides; the nesting test re-wound one side of the wall as a "cavity" and the volume came
+    out 0.36 % high.  Expected: trimesh's own reading of the file integrated exactly.
+    """
+    from benchmarks.real_files import reference
+    from inertia.pipeline import AnalysisOptions, analyze_loaded
+
+    rel = "trimesh_models/no_indices_3storybuilding.glb"
+    volume, tensor = reference(REAL / rel, rel, ())
+    loaded = load_body((REAL / rel).read_bytes(), filename="no_indices_3storybuilding.glb", units="m")
+    doc = analyze_loaded(loaded, AnalysisOptions(units="m", density=1.0)).as_dict()
+    assert doc["mass"] == pytest.approx(volume, rel=1e-12)
+    assert max(abs(a - b) for ra, rb in zip(doc["inertia_tensor"], tensor, strict=True) for a, b in zip(ra, rb, strict=True)) <= (
+        1e-12 * float(abs(tensor).max())
+    )
+    assert not any("winding corrected" in w for w in doc["warnings"])
