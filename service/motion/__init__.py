@@ -37,6 +37,10 @@ Modelling decisions (stated once, here):
   forms of those tops are used only where the moments agree to rounding
   (``MOTION_ROUNDING`` x the largest moment, ``motion_rotor``), and then the
   moments that agree are replaced by their mean (a change at rounding level).
+  Where the axes are an exact signed permutation (principal moments given,
+  a diagonal tensor) the moments carry no rounding, so only exactly equal
+  moments (an exactly zero smallest one for a linear rotator) get a closed
+  form of a degenerate top.
   Moments that differ by more, even if the classification calls them equal,
   move by the exact asymmetric (Jacobi elliptic) solution: a nearly
   symmetric top is not replaced by an ideal one whose motion departs from

@@ -83,8 +83,7 @@ def _decide(frame: PrincipalFrame, classification: Classification, omega: Array,
     # Omega_body = axes @ Omega carries rounding (and the axes their own error) unless the axes are an
     # exact signed permutation (principal moments given, a diagonal tensor): then a tilt is real, even
     # 1e-17, and moves as it does (about the intermediate axis it grows to a flip after ~40 / rate)
-    exact_axes = bool(np.all((axes == 0.0) | (np.abs(axes) == 1.0)))
-    noise = 0.0 if exact_axes else tol.permanent_rotation_rel
+    noise = 0.0 if exact_axes(axes) else tol.permanent_rotation_rel
     along_axis = _principal_axis_of(omega_body, noise)
     if rotor.is_symmetric:
         unique = 0 if rotor is RotorClass.SYMMETRIC_PROLATE else 2
@@ -124,16 +123,29 @@ def motion_rotor(frame: PrincipalFrame, classification: Classification) -> Rotor
 
     The classification labels the body with its own ``tolerance``; the motion
     uses a closed form (symmetric, spherical, linear) only for moments equal
-    within ``MOTION_ROUNDING`` (or the classification's tolerance, if smaller).
+    within ``MOTION_ROUNDING`` (or the classification's tolerance, if smaller),
+    and for moments given exactly (``exact_axes``) only for equal ones (a
+    smallest moment of exactly 0 for a linear rotator).
     Otherwise the class is decided again at that level, so a nearly symmetric
     top moves as the asymmetric top it is.
     """
     from ..classification import classify
 
-    level = min(MOTION_ROUNDING, classification.tolerance)
+    # exact (permutation) axes: the moments are the numbers given, with no rounding to forgive
+    level = 0.0 if exact_axes(frame.axes) else min(MOTION_ROUNDING, classification.tolerance)
     if classification.tolerance <= level:
         return classification.rotor
     return classify(frame, level).rotor
+
+
+def exact_axes(axes: ArrayLike) -> bool:
+    """Whether the principal axes are a signed permutation of the input axes, exactly.
+
+    Then the moments and ``axes @ Omega`` are the numbers given (principal moments, a diagonal
+    tensor) with no rounding of a rotation in them.
+    """
+    a = np.asarray(axes, dtype=np.float64)
+    return bool(np.all((a == 0.0) | (np.abs(a) == 1.0)))
 
 
 def _principal_axis_of(omega_body: Array, rel: float) -> int | None:
