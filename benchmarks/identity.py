@@ -28,6 +28,7 @@ import json
 import sys
 import tempfile
 from collections.abc import Callable, Iterator
+from functools import partial
 from pathlib import Path
 from typing import Any
 
@@ -186,18 +187,18 @@ def cases(cache: Path, sizes: list[str]) -> Iterator[tuple[str, Callable[[], Any
     for path in sorted(samples.iterdir()):
         if path.suffix in (".py", ".md"):
             continue
-        yield f"sample {path.name}", lambda p=path: analyze(str(p))
+        yield f"sample {path.name}", partial(analyze, str(path))
         if path.suffix == ".stl":
             shell = AnalysisOptions(model="shell", thickness=0.001)
-            yield f"sample {path.name} shell", lambda p=path, o=shell: analyze(str(p), options=o)
+            yield f"sample {path.name} shell", partial(analyze, str(path), options=shell)
     for label in sizes:
         for name, path, opts in _variants(cache, label):
-            yield f"{label} {name}", lambda p=path, o=opts: analyze(str(p), options=AnalysisOptions(**o))
+            yield f"{label} {name}", partial(analyze, str(path), options=AnalysisOptions(**opts))
         if SIZES[label][0] * SIZES[label][1] * 2 <= 300_000:
             rec = _torus_records(cache, label)
             corners = rec["vertices"].astype(np.float64).reshape(-1, 3)
             faces = np.arange(len(corners)).reshape(-1, 3)
-            yield f"{label} unwelded arrays", lambda v=corners, f=faces: analyze((v, f))
+            yield f"{label} unwelded arrays", partial(analyze, (corners, faces))
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -186,6 +186,7 @@ def in_process_breakdown() -> list[tuple[str, float]]:
     from inertia.api import Settings, create_app
     from inertia.api.jobs import PointsJob, run_job
     from inertia.api.schemas import PointsRequest
+    from inertia.body import PointBody
     from inertia.load import load_points
     from inertia.mass import mass_properties
 
@@ -235,6 +236,7 @@ def in_process_breakdown() -> list[tuple[str, float]]:
     job = PointsJob(records, options)
     doc = run_job(job)
     point_body = load_points(records, None).parts[0].body
+    assert isinstance(point_body, PointBody)
     access = logging.getLogger("inertia.api.access")
     disabled, access.disabled = access.disabled, True
     loop = asyncio.new_event_loop()

@@ -20,7 +20,10 @@ show.  VTK is the optional extra ``vtk``; without it these two formats are
 refused (415 ``unsupported_format``) with a message naming the extra, rather
 than read by a reader that can get them wrong.  Other formats (Gmsh, Abaqus,
 Medit, TetGen, ...) go through meshio, which converts their node orders to
-VTK's.
+VTK's.  An ``.inp`` file is Abaqus unless its content is AVS UCD (the other
+format with that extension, binary or ASCII, see ``is_avs_ucd``), which
+VTK's ``vtkAVSucdReader`` reads: meshio took it for Abaqus and answered "no
+points" or a UTF-8 decoding error.
 
 Every reader call is fenced: anything it raises (``SystemExit`` from meshio's
 ``sys.exit(1)`` included; never ``KeyboardInterrupt``) becomes an
@@ -129,6 +132,7 @@ _FORMAT_NAMES = {
     "dat": "Tecplot",
     "ugrid": "UGRID",
     "ele": "TetGen",
+    "ucd": "AVS UCD (.inp)",
 }
 
 
@@ -159,9 +163,33 @@ def read_volume_parts(
     companions : other files of the same upload by name (a TetGen ``.node``
         beside its ``.ele``, an XDMF's HDF5 file), written beside it for the reader.
     """
-    label = _label(filename, fmt)
-    mesh = _read_vtk(data, fmt, label) if fmt in VTK_FORMATS else _read_meshio(data, fmt, label, filename, companions)
+    if fmt == "inp" and is_avs_ucd(data):  # the other format named .inp: VTK reads it, meshio would take it for Abaqus
+        label = _label(filename, "ucd")
+        mesh = _read_vtk(data, "ucd", label)
+    else:
+        label = _label(filename, fmt)
+        mesh = _read_vtk(data, fmt, label) if fmt in VTK_FORMATS else _read_meshio(data, fmt, label, filename, companions)
     return _parts(mesh, label, length_scale)
+
+
+def is_avs_ucd(data: bytes) -> bool:
+    """Whether an ``.inp`` file is AVS UCD rather than Abaqus.
+
+    Binary UCD starts with the byte 7 (AVS's magic number); ASCII UCD, after
+    ``#`` comment lines, with one line of five integers (numbers of nodes,
+    cells, node data, cell data and model data).  An Abaqus input file's
+    lines are ``*KEYWORD`` lines, ``**`` comments and data under a keyword,
+    so its first line that is not a comment starts with ``*``.
+    """
+    if data[:1] == b"\x07":
+        return True
+    for raw in data[:4096].splitlines():
+        line = raw.strip()
+        if not line or line.startswith(b"#"):
+            continue
+        fields = line.split()
+        return len(fields) == 5 and all(f.isdigit() for f in fields)
+    return False
 
 
 def _label(filename: str | None, fmt: str) -> str:
@@ -244,11 +272,13 @@ def _read_vtk(data: bytes, fmt: str, label: str) -> _Mesh:
         from vtkmodules.util.numpy_support import vtk_to_numpy
         from vtkmodules.vtkCommonCore import vtkLogger, vtkOutputWindow, vtkStringOutputWindow
         from vtkmodules.vtkFiltersCore import vtkAppendFilter
+        from vtkmodules.vtkIOGeometry import vtkAVSucdReader
         from vtkmodules.vtkIOLegacy import vtkDataSetReader
         from vtkmodules.vtkIOXML import vtkXMLUnstructuredGridReader
     except ImportError as exc:
         raise _vtk_missing(label, fmt) from exc
 
+    kind, fmt = ("AVS UCD", "inp") if fmt == "ucd" else ("VTK", fmt)  # the file's own format, as the client named it
     window = vtkStringOutputWindow()
     with _VTK_LOCK, _upload_dir(data, fmt, None, None) as path:  # the output window is process-wide
         previous = vtkOutputWindow.GetInstance()
@@ -257,7 +287,8 @@ def _read_vtk(data: bytes, fmt: str, label: str) -> _Mesh:
             # VTK's logger writes errors to stderr beside the output window; it stays off for the process
             vtkLogger.SetStderrVerbosity(vtkLogger.VERBOSITY_OFF)
             with _quiet():
-                reader: Any = vtkXMLUnstructuredGridReader() if fmt == "vtu" else vtkDataSetReader()
+                readers: dict[str, Any] = {"vtu": vtkXMLUnstructuredGridReader, "inp": vtkAVSucdReader}
+                reader: Any = readers.get(fmt, vtkDataSetReader)()
                 reader.SetFileName(path)
                 if fmt == "vtk":
                     reader.ReadAllScalarsOn()
@@ -272,7 +303,8 @@ def _read_vtk(data: bytes, fmt: str, label: str) -> _Mesh:
             raise
         except BaseException as exc:  # VTK's wrappers raise whatever the C++ side threw
             raise UnreadableFileError(
-                f"could not read {label}: {_reason(exc, _text(window.GetOutput()), (path,))}; check that it is a complete VTK file",
+                f"could not read {label}: {_reason(exc, _text(window.GetOutput()), (path,))}; "
+                f"check that it is a complete {kind} file",
                 format=fmt,
             ) from exc
         finally:
@@ -280,7 +312,7 @@ def _read_vtk(data: bytes, fmt: str, label: str) -> _Mesh:
         log = _vtk_errors(_text(window.GetOutput()), path)
     if grid is None or (log and grid.GetNumberOfCells() == 0):
         raise UnreadableFileError(
-            f"could not read {label}: {log or 'VTK found no data set in it'}; check that it is a complete, uncorrupted VTK file",
+            f"could not read {label}: {log or 'VTK found no data set in it'}; check that it is a complete, uncorrupted {kind} file",
             format=fmt,
         )
     if log:

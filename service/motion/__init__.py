@@ -8,6 +8,9 @@ the body (``CAPABILITIES``), and joins the stages, one module each:
     methods.py     Setup + times -> Omega(t), attitude: one class per method, with its capabilities
     integrators.py the numerical integrators (scipy imported only when one runs)
     symmetric.py, jacobi.py, elliptic.py  the closed forms
+    scaling.py     the units of the computation: moments and Omega scaled by exact powers of two
+                   so that nothing overflows at any scale, and the results taken back (or refused
+                   when a reported number would leave float64's normal range)
 
 and, given a duration and a number of samples, returns the trajectory with its
 invariant drifts.
@@ -34,6 +37,10 @@ Modelling decisions (stated once, here):
   forms of those tops are used only where the moments agree to rounding
   (``MOTION_ROUNDING`` x the largest moment, ``motion_rotor``), and then the
   moments that agree are replaced by their mean (a change at rounding level).
+  Where the axes are an exact signed permutation (principal moments given,
+  a diagonal tensor) the moments carry no rounding, so only exactly equal
+  moments (an exactly zero smallest one for a linear rotator) get a closed
+  form of a degenerate top.
   Moments that differ by more, even if the classification calls them equal,
   move by the exact asymmetric (Jacobi elliptic) solution: a nearly
   symmetric top is not replaced by an ideal one whose motion departs from
@@ -43,8 +50,18 @@ Modelling decisions (stated once, here):
   meaningless; it is dropped (with a warning when it is not negligible) and
   the rotator turns uniformly about M, perpendicular to its axis.
 - Omega is along a principal axis (permanent rotation) when its other
-  principal components are within rounding (``Tolerances.permanent_rotation_rel``);
-  a larger tilt, even 1e-9, is predicted as the motion it is (a flip, say).
+  principal components are within the rounding of ``axes @ Omega``
+  (``Tolerances.permanent_rotation_rel``); a larger tilt, even 1e-9, is
+  predicted as the motion it is (a flip, say).  Where the axes are an exact
+  signed permutation (principal moments given, a diagonal tensor) there is no
+  such rounding: only exact zeros are permanent rotation, and a tilt of 1e-17
+  about the intermediate axis grows into the flip it is.
+- Separatrix: the distance 2E I2 - M^2 is computed exactly.  Within
+  ``Tolerances.separatrix_rel`` of zero the state is reported as on the
+  separatrix (no period, a warning; API.md), but its trajectory is the
+  motion of the numbers given; only an exact zero moves along the
+  separatrix's hyperbolic limit (which the true motion leaves after its first
+  approach to the intermediate axis).
 - ``stable`` follows the contract: an asymmetric top is unstable when Omega
   starts nearest its intermediate axis; permanent rotation about the
   intermediate axis is unstable; every other regime is stable (a symmetric
@@ -73,6 +90,7 @@ from .methods import CAPABILITIES, EXACT_REST, method_for
 from .quantities import precession_quantities
 from .regime import MOTION_ROUNDING, decide_regime, ideal_moments, motion_rotor
 from .result import FreeMotion, MotionDiagnostics, MotionMethod, Regime, Trajectory
+from .scaling import Units
 
 __all__ = [
     "predict_motion",
@@ -88,7 +106,6 @@ __all__ = [
     "MAX_SAMPLES",
 ]
 
-MAX_MOMENTUM = 1e150  # bound on I3 |omega| and I3 |omega|^2: their squares (1e300) stay finite
 MAX_SAMPLES = 1_000_000
 """Largest ``samples``: 1e6 samples are ~100 MB of JSON, beyond any client's use."""
 
@@ -119,21 +136,26 @@ def predict_motion(
     started = time.perf_counter()
     chosen = method_for(_parse_method(method))
     omega = _parse_omega(angular_velocity)
-    _check_scale(frame, omega)
-    times = _parse_times(duration, samples)
+    _check_inertia(frame)
+    given_times = _parse_times(duration, samples)
+    # the motion is computed in units where the largest moment and |Omega_i| are ~1 (exact powers of two)
+    units = Units.of(np.asarray(frame.moments, dtype=np.float64), omega)
+    frame = units.frame(frame)
+    times = None if given_times is None else units.times(given_times)
     chosen.check(motion_rotor(frame, classification))
-    setup = decide_regime(frame, classification, omega, tolerances)
+    setup = decide_regime(frame, classification, units.angular_velocity(omega), tolerances, units.omega)
     motion = precession_quantities(setup, chosen.name, tolerances)
     if times is None:
-        diagnostics = MotionDiagnostics(elapsed_s=time.perf_counter() - started)
-        return replace(motion, diagnostics=diagnostics)
+        motion = units.restore(motion, None)
+        return replace(motion, diagnostics=MotionDiagnostics(elapsed_s=time.perf_counter() - started))
     # a body at rest stays at rest: no method needs to integrate that
     propagator = EXACT_REST if setup.regime is Regime.REST else chosen
     omega_body, attitude = propagator.propagate(setup, times, tolerances)
     trajectory = _trajectory(setup.problem, times, omega_body, attitude)
     energy_drift, momentum_drift = invariant_drifts(setup.problem, trajectory.omega_body, trajectory.quaternion)
+    motion = units.restore(replace(motion, trajectory=trajectory), given_times)
     diagnostics = MotionDiagnostics(time.perf_counter() - started, energy_drift, momentum_drift)
-    return replace(motion, trajectory=trajectory, diagnostics=diagnostics)
+    return replace(motion, diagnostics=diagnostics)
 
 
 # -- input validation ---------------------------------------------------------------
@@ -161,20 +183,12 @@ def _parse_omega(angular_velocity: ArrayLike) -> Array:
     return omega
 
 
-def _check_scale(frame: PrincipalFrame, omega: Array) -> None:
-    """The body must have inertia, and |M| and E must stay well inside float64."""
+def _check_inertia(frame: PrincipalFrame) -> None:
+    """The body must have inertia (the scale of the motion is otherwise free: see ``scaling``)."""
     largest = float(frame.moments[-1])
-    if not largest > 0:
+    if not (largest > 0 and np.isfinite(largest)):
         raise InvalidParameterError(
             "the body has no rotational inertia (all its mass is at one point), so its free rotation is undefined; leave out omega",
-            parameter="omega",
-        )
-    # |M| <= I3 |omega| and 2E <= I3 |omega|^2; the motion squares and multiplies these
-    speed2 = float(omega @ omega)
-    if not (largest * np.sqrt(speed2) <= MAX_MOMENTUM and largest * speed2 <= MAX_MOMENTUM):
-        raise InvalidParameterError(
-            "omega and the moments of inertia are so large that the angular momentum "
-            "or energy would overflow float64; rescale them (other units)",
             parameter="omega",
         )
 

@@ -66,7 +66,11 @@ class Exact(PropagationMethod):
             assert setup.unique is not None
             return SymmetricTop(problem.moments, problem.omega_body, setup.unique).propagate(t)
         if setup.regime is Regime.ASYMMETRIC:
-            return AsymmetricTop.from_initial(problem.moments, problem.omega_body, tol.separatrix_rel).propagate(t)
+            # the motion of the state as given: only an exactly zero distance to the separatrix (computed
+            # exactly) is the separatrix's own motion; within tol.separatrix_rel the quantities call it
+            # separatrix (no period), but the hyperbolic limit would part from the true motion by O(1)
+            # after ~ln(1/gap)/rate (the first approach to the intermediate axis)
+            return AsymmetricTop.from_initial(problem.moments, problem.omega_body, 0.0).propagate(t)
         return uniform_rotation(problem.omega_body, t)
 
 

@@ -55,10 +55,17 @@ def precession_quantities(setup: Setup, method: MotionMethod, tol: Tolerances) -
 
 
 def _asymmetric_quantities(base: FreeMotion, top: AsymmetricTop) -> FreeMotion:
+    if top.separatrix and AsymmetricTop.from_initial(top.moments, top.omega_body, 0.0).separatrix:
+        warning = (
+            "Omega starts on the separatrix (2 E I2 = |M|^2 exactly): the motion approaches "
+            "rotation about the intermediate axis forever, so it has no period"
+        )
+        return replace(base, warnings=(*base.warnings, warning))
     if top.separatrix:
         warning = (
-            "Omega starts on the separatrix (2 E I2 = |M|^2 within rounding): the motion approaches "
-            "rotation about the intermediate axis forever, so it has no period"
+            "Omega starts within rounding of the separatrix (2 E I2 = |M|^2 to ~1e-15 relative), so no "
+            "period is reported: it is finite, but it and the distance to the separatrix are set by the "
+            "last digits of the input; the trajectory is the motion of the numbers as given"
         )
         return replace(base, warnings=(*base.warnings, warning))
     period = top.period

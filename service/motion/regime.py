@@ -9,6 +9,7 @@ are stated in the package's docstring.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -42,15 +43,20 @@ class Setup:
     initial: RigidProblem | None = None  # the state as given: reported M, E and omega_body come from it
 
 
-def decide_regime(frame: PrincipalFrame, classification: Classification, omega: Array, tol: Tolerances) -> Setup:
-    """The regime, and the ideal problem that is solved; the state as given is kept beside it."""
-    decided = _decide(frame, classification, omega, tol)
+def decide_regime(
+    frame: PrincipalFrame, classification: Classification, omega: Array, tol: Tolerances, omega_exponent: int = 0
+) -> Setup:
+    """The regime, and the ideal problem that is solved; the state as given is kept beside it.
+
+    ``omega`` is in units of 2^omega_exponent rad/s (``scaling.Units``); warnings quote rad/s.
+    """
+    decided = _decide(frame, classification, omega, tol, omega_exponent)
     axes = np.asarray(frame.axes, dtype=np.float64)
     given = RigidProblem(np.asarray(frame.moments, dtype=np.float64), axes @ omega, axes, frame.quaternion)
     return replace(decided, initial=given)
 
 
-def _decide(frame: PrincipalFrame, classification: Classification, omega: Array, tol: Tolerances) -> Setup:
+def _decide(frame: PrincipalFrame, classification: Classification, omega: Array, tol: Tolerances, omega_exponent: int) -> Setup:
     axes = np.asarray(frame.axes, dtype=np.float64)
     omega_body = axes @ omega
     rotor = motion_rotor(frame, classification)
@@ -59,8 +65,9 @@ def _decide(frame: PrincipalFrame, classification: Classification, omega: Array,
     if rotor is RotorClass.LINEAR and omega_body[0] != 0.0:
         along = abs(float(omega_body[0]))
         if along > tol.permanent_rotation_rel * float(np.linalg.norm(omega_body)):
+            in_rad_s = math.ldexp(along, omega_exponent)
             warnings.append(
-                f"the component of omega along the rotator axis ({along:.3g} rad/s) has no physical effect "
+                f"the component of omega along the rotator axis ({in_rad_s:.3g} rad/s) has no physical effect "
                 "on a linear rotator and was dropped"
             )
         omega_body = omega_body.copy()
@@ -73,10 +80,14 @@ def _decide(frame: PrincipalFrame, classification: Classification, omega: Array,
         return Setup(problem, Regime.SPHERICAL, True, tuple(warnings))
     if rotor is RotorClass.LINEAR:
         return Setup(problem, Regime.ROTATOR, True, tuple(warnings))
-    along_axis = _principal_axis_of(omega_body, tol.permanent_rotation_rel)
+    # Omega_body = axes @ Omega carries rounding (and the axes their own error) unless the axes are an
+    # exact signed permutation (principal moments given, a diagonal tensor): then a tilt is real, even
+    # 1e-17, and moves as it does (about the intermediate axis it grows to a flip after ~40 / rate)
+    noise = 0.0 if exact_axes(axes) else tol.permanent_rotation_rel
+    along_axis = _principal_axis_of(omega_body, noise)
     if rotor.is_symmetric:
         unique = 0 if rotor is RotorClass.SYMMETRIC_PROLATE else 2
-        perpendicular = abs(omega_body[unique]) <= tol.permanent_rotation_rel * rate
+        perpendicular = abs(omega_body[unique]) <= noise * rate
         if along_axis is not None or perpendicular:
             snapped = _snap(problem, along_axis, unique if perpendicular else None)
             return Setup(snapped, Regime.PERMANENT_ROTATION, True, tuple(warnings))
@@ -112,16 +123,29 @@ def motion_rotor(frame: PrincipalFrame, classification: Classification) -> Rotor
 
     The classification labels the body with its own ``tolerance``; the motion
     uses a closed form (symmetric, spherical, linear) only for moments equal
-    within ``MOTION_ROUNDING`` (or the classification's tolerance, if smaller).
+    within ``MOTION_ROUNDING`` (or the classification's tolerance, if smaller),
+    and for moments given exactly (``exact_axes``) only for equal ones (a
+    smallest moment of exactly 0 for a linear rotator).
     Otherwise the class is decided again at that level, so a nearly symmetric
     top moves as the asymmetric top it is.
     """
     from ..classification import classify
 
-    level = min(MOTION_ROUNDING, classification.tolerance)
+    # exact (permutation) axes: the moments are the numbers given, with no rounding to forgive
+    level = 0.0 if exact_axes(frame.axes) else min(MOTION_ROUNDING, classification.tolerance)
     if classification.tolerance <= level:
         return classification.rotor
     return classify(frame, level).rotor
+
+
+def exact_axes(axes: ArrayLike) -> bool:
+    """Whether the principal axes are a signed permutation of the input axes, exactly.
+
+    Then the moments and ``axes @ Omega`` are the numbers given (principal moments, a diagonal
+    tensor) with no rounding of a rotation in them.
+    """
+    a = np.asarray(axes, dtype=np.float64)
+    return bool(np.all((a == 0.0) | (np.abs(a) == 1.0)))
 
 
 def _principal_axis_of(omega_body: Array, rel: float) -> int | None:

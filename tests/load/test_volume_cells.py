@@ -39,7 +39,7 @@ def curved(name: str, seed: int, amplitude: float = 0.08) -> np.ndarray:
     return cast("np.ndarray", base @ a.T + amplitude * rng.uniform(-1, 1, base.shape) + np.array([0.3, -0.2, 0.5]))
 
 
-def compare(props: Any, m0: float, m1: np.ndarray, m2: np.ndarray, rel: float) -> None:
+def assert_matches_reference(props: Any, m0: float, m1: np.ndarray, m2: np.ndarray, rel: float) -> None:
     mass, com, tensor = volref.inertia_about_centre(m0, m1, m2, density=1000.0)
     scale = np.abs(tensor).max()
     size = np.sqrt(scale / mass)  # radius of gyration: the length scale of the centre's error
@@ -193,7 +193,7 @@ def test_curved_cell_matches_vtk_map_integrated_independently(name: str, seed: i
     nodes = curved(name, seed)
     props = mass_properties(body_of(name, nodes))
     m0, m1, m2 = volref.reference_integrals(name, nodes)
-    compare(props, m0, m1, m2, rel=1e-12)
+    assert_matches_reference(props, m0, m1, m2, rel=1e-12)
 
 
 def test_warped_hexahedron_is_the_trilinear_cell_not_a_tetrahedral_split() -> None:
@@ -202,7 +202,7 @@ def test_warped_hexahedron_is_the_trilinear_cell_not_a_tetrahedral_split() -> No
     points[6] += (0.0, 0.0, 0.6)  # top face no longer planar
     props = mass_properties(body_of("hexahedron", points), density=1.0)
     m0, m1, m2 = volref.reference_integrals("hexahedron", points)
-    compare(mass_properties(body_of("hexahedron", points)), m0, m1, m2, rel=1e-13)
+    assert_matches_reference(mass_properties(body_of("hexahedron", points)), m0, m1, m2, rel=1e-13)
     around_06 = [[0, 1, 2, 6], [0, 2, 3, 6], [0, 3, 7, 6], [0, 7, 4, 6], [0, 4, 5, 6], [0, 5, 1, 6]]
     around_17 = [[1, 2, 3, 7], [1, 3, 0, 7], [1, 0, 4, 7], [1, 4, 5, 7], [1, 5, 6, 7], [1, 6, 2, 7]]
     split_a = mass_properties(VolumeBody(points, np.array(around_06)), density=1.0).mass

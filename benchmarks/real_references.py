@@ -1,0 +1,238 @@
+"""References for the real volume and CAD files, computed by the files' own tools (not by this project).
+
+    python -m benchmarks.real_references     # rewrites tests/data/real/{vtk,vtu,inp}/vtk_reference.json
+                                             # and tests/data/real/step/gmsh_reference.json
+
+VTK files (legacy ``.vtk``, XML ``.vtu``, AVS UCD ``.inp``): read by VTK's own
+readers (``vtkDataSetReader``, ``vtkXMLUnstructuredGridReader``,
+``vtkAVSucdReader``; other data sets merged to an unstructured grid by
+``vtkAppendFilter``), then every 3-D cell integrated with VTK's own element
+definition: its interpolation functions and their derivatives
+(``InterpolateFunctions``, ``InterpolateDerivs``) at the points of a
+Gauss-Legendre product rule on the cell's parametric domain (the unit cube;
+for tetrahedra and wedges the collapsed cube, Duffy's map), so that volume,
+first and second moments are sum(w det J), sum(w det J x), sum(w det J x x^T).
+With ``ORDER`` points per direction the rule is exact for every polynomial
+element VTK defines up to the triquadratic hexahedron.  A cell whose
+Jacobian keeps one sign counts with its absolute volume (VTK's own cell
+sizes are signed: an inverted cell is the same solid); a cell whose Jacobian
+changes sign is integrated with its sign, as ``vtkCellSizeFilter`` does.
+Polyhedra and pentagonal or hexagonal prisms are not integrated (the files
+holding them are expected to be refused).
+
+STEP files: imported by Gmsh's OpenCASCADE kernel (``gmsh.model.occ``) in
+millimetres, each volume's ``getMass``, ``getCenterOfMass`` and
+``getMatrixOfInertia`` combined (parallel axes) and converted back to the
+file's own unit (``STEP_UNITS`` below, read from the file's ``LENGTH_UNIT``).
+``getMass`` integrates each face with a fixed Gauss order, which is not
+converged on some NURBS faces: so the volume is checked against Gmsh's own
+surface mesh (``Mesh.MeshSizeFromCurvature`` 80 and 160 elements per 2 pi,
+closed triangles summed as signed tetrahedra to the origin, extrapolated as
+h^2; its precision ``mesh_rtol`` is the extrapolation's own step).  Where the
+two disagree by more than three times that (and more than ``STEP_CHECK``)
+the file's reference is the extrapolated volume alone, to the precision the
+two meshes support (``rtol``), without a tensor.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+REAL = ROOT / "tests" / "data" / "real"
+ORDER = 8
+_SIMPLEX = {10, 24}  # tetrahedra: r + s + t <= 1
+_WEDGE = {13, 26, 32}  # wedges: r + s <= 1, 0 <= t <= 1
+_NOT_INTEGRATED = {15, 16, 42}
+# STEP files and the length unit their solids are written in (mm per unit): the reference is in file units
+STEP_UNITS = {
+    "featuretype.STEP": 25.4,
+    "base_interface_AP214.STEP": 25.4,
+    "base_interface_AP203.STEP": 25.4,
+    "red_cube_blue_cylinder.step": 1000.0,
+}
+
+
+def read_vtk(path: Path) -> Any:
+    from vtkmodules.vtkFiltersCore import vtkAppendFilter
+    from vtkmodules.vtkIOGeometry import vtkAVSucdReader
+    from vtkmodules.vtkIOLegacy import vtkDataSetReader
+    from vtkmodules.vtkIOXML import vtkXMLUnstructuredGridReader
+
+    suffix = path.suffix.lower()
+    reader: Any = {".vtu": vtkXMLUnstructuredGridReader, ".inp": vtkAVSucdReader}.get(suffix, vtkDataSetReader)()
+    reader.SetFileName(str(path))
+    reader.Update()
+    grid = reader.GetOutput()
+    if grid.GetClassName() != "vtkUnstructuredGrid":
+        merge = vtkAppendFilter()
+        merge.SetInputData(grid)
+        merge.Update()
+        grid = merge.GetOutput()
+    return grid
+
+
+def _rule(cell_type: int) -> tuple[np.ndarray, np.ndarray]:
+    x, w = np.polynomial.legendre.leggauss(ORDER)
+    x, w = (x + 1) / 2, w / 2
+    u, v, t = (a.ravel() for a in np.meshgrid(x, x, x, indexing="ij"))
+    weights = np.einsum("i,j,k->ijk", w, w, w).ravel()
+    if cell_type in _SIMPLEX:
+        return np.c_[u, v * (1 - u), t * (1 - u) * (1 - v)], weights * (1 - u) ** 2 * (1 - v)
+    if cell_type in _WEDGE:
+        return np.c_[u, v * (1 - u), t], weights * (1 - u)
+    return np.c_[u, v, t], weights
+
+
+def vtk_moments(grid: Any) -> tuple[float, np.ndarray, np.ndarray, dict[int, int]]:
+    """Volume, first and second moments (unit density) of the 3-D cells; counts of the cells left out by type."""
+    from vtkmodules.util.numpy_support import vtk_to_numpy
+
+    to_numpy: Any = vtk_to_numpy  # untyped in VTK's wheel
+    points = np.asarray(to_numpy(grid.GetPoints().GetData()), dtype=np.float64)
+    by_type: dict[int, list[int]] = {}
+    for i in range(grid.GetNumberOfCells()):
+        by_type.setdefault(grid.GetCellType(i), []).append(i)
+    m0, m1, m2 = 0.0, np.zeros(3), np.zeros((3, 3))
+    skipped: dict[int, int] = {}
+    for cell_type, ids in sorted(by_type.items()):
+        cell = grid.GetCell(ids[0])
+        if cell.GetCellDimension() != 3 or cell_type in _NOT_INTEGRATED:
+            skipped[cell_type] = len(ids)
+            continue
+        n = cell.GetNumberOfPoints()
+        pcoords, weights = _rule(cell_type)
+        shape = np.zeros((len(pcoords), n))
+        derivs = np.zeros((len(pcoords), 3, n))
+        for q, p in enumerate(pcoords):
+            f, d = [0.0] * n, [0.0] * (3 * n)
+            cell.InterpolateFunctions(list(p), f)
+            cell.InterpolateDerivs(list(p), d)
+            shape[q], derivs[q] = f, np.reshape(d, (3, n))
+        conn = np.array([[grid.GetCell(i).GetPointId(k) for k in range(n)] for i in ids])
+        x = points[conn]
+        xq = np.einsum("qn,cnd->cqd", shape, x)
+        det = np.linalg.det(np.einsum("qjn,cnd->cqjd", derivs, x))
+        wdet = det * weights[None, :]
+        sign = np.where(wdet.sum(axis=1) < 0, -1.0, 1.0)[:, None]  # an inverted cell is the same solid
+        wdet = wdet * sign
+        m0 += float(wdet.sum())
+        m1 += np.einsum("cq,cqd->d", wdet, xq)
+        m2 += np.einsum("cq,cqd,cqe->de", wdet, xq, xq)
+    return m0, m1, m2, skipped
+
+
+def _about_centre(m0: float, m1: np.ndarray, m2: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    c = m1 / m0
+    s = m2 - m0 * np.outer(c, c)
+    return c, np.trace(s) * np.eye(3) - s
+
+
+def vtk_references(folder: Path) -> dict[str, Any]:
+    out: dict[str, Any] = {}
+    for path in sorted(folder.iterdir()):
+        if path.suffix.lower() not in (".vtk", ".vtu", ".inp"):
+            continue
+        m0, m1, m2, skipped = vtk_moments(read_vtk(path))
+        if m0 <= 0 or any(t in _NOT_INTEGRATED for t in skipped):
+            continue  # no 3-D cells, or cells the service refuses: no number to compare
+        c, inertia = _about_centre(m0, m1, m2)
+        out[path.name] = {
+            "volume": m0,
+            "center": c.tolist(),
+            "inertia_unit_density": inertia.tolist(),
+            "reader": f"VTK {_vtk_version()}, Gauss-Legendre {ORDER}^3 on each cell's own interpolation",
+        }
+    return out
+
+
+def _vtk_version() -> str:
+    from vtkmodules.vtkCommonCore import vtkVersion
+
+    return str(vtkVersion.GetVTKVersion())
+
+
+STEP_CHECK = 1e-6
+
+
+def _gmsh_mesh_volume(curvature: int) -> float:
+    """The volume enclosed by Gmsh's surface mesh of the current model (model units)."""
+    import gmsh
+
+    gmsh.model.mesh.clear()
+    gmsh.option.setNumber("Mesh.MeshSizeFromCurvature", curvature)
+    gmsh.model.mesh.generate(2)
+    tags, coords, _ = gmsh.model.mesh.getNodes()
+    x = np.zeros((int(tags.max()) + 1, 3))
+    x[tags.astype(int)] = np.reshape(coords, (-1, 3))
+    volume = 0.0
+    for _, tag in gmsh.model.getEntities(2):
+        _, _, nodes = gmsh.model.mesh.getElements(2, tag)
+        for nn in nodes:
+            t = x[np.asarray(nn, dtype=int).reshape(-1, 3)]
+            volume += float(np.einsum("ij,ij->", t[:, 0], np.cross(t[:, 1], t[:, 2]))) / 6
+    return abs(volume)
+
+
+def gmsh_references(folder: Path) -> dict[str, Any]:
+    import gmsh
+
+    out: dict[str, Any] = {}
+    gmsh.initialize()
+    try:
+        gmsh.option.setNumber("General.Terminal", 0)
+        for name, mm in STEP_UNITS.items():
+            gmsh.clear()
+            gmsh.model.occ.importShapes(str(folder / name))
+            gmsh.model.occ.synchronize()
+            m0, m1, m2 = 0.0, np.zeros(3), np.zeros((3, 3))
+            for _, tag in gmsh.model.getEntities(3):
+                v = gmsh.model.occ.getMass(3, tag) / mm**3
+                c = np.array(gmsh.model.occ.getCenterOfMass(3, tag)) / mm
+                j = np.reshape(gmsh.model.occ.getMatrixOfInertia(3, tag), (3, 3)) / mm**5  # about the volume's centre
+                s = np.trace(j) / 2 * np.eye(3) - j + v * np.outer(c, c)  # second moment about the origin
+                m0, m1, m2 = m0 + v, m1 + v * c, m2 + s
+            c, inertia = _about_centre(m0, m1, m2)
+            coarse, fine = (_gmsh_mesh_volume(n) / mm**3 for n in (80, 160))
+            meshed = fine - (coarse - fine) / 3  # h^2 extrapolation
+            entry: dict[str, Any] = {
+                "volume": m0,
+                "center": c.tolist(),
+                "inertia_unit_density": inertia.tolist(),
+                "reader": f"Gmsh {gmsh.__version__} OpenCASCADE getMass/getCenterOfMass/getMatrixOfInertia",
+                "unit_mm": mm,
+                "mesh_volume": meshed,
+            }
+            mesh_rtol = abs(fine - coarse) / 3 / meshed  # the extrapolation's own step: its precision
+            entry["mesh_rtol"] = mesh_rtol
+            if abs(meshed - m0) > max(STEP_CHECK, 3 * mesh_rtol) * m0:
+                entry.update(
+                    volume=meshed,
+                    rtol=max(mesh_rtol, 1e-9),
+                    inertia_unit_density=None,
+                    reader=f"Gmsh {gmsh.__version__} surface mesh, extrapolated (getMass gave {m0!r}, not converged)",
+                )
+            out[name] = entry
+    finally:
+        gmsh.finalize()
+    return out
+
+
+def main() -> int:
+    for sub in ("vtk", "vtu", "inp"):
+        refs = vtk_references(REAL / sub)
+        if refs:
+            (REAL / sub / "vtk_reference.json").write_text(json.dumps(refs, indent=1) + "\n")
+        print(f"{sub}: {len(refs)} references")
+    refs = gmsh_references(REAL / "step")
+    (REAL / "step" / "gmsh_reference.json").write_text(json.dumps(refs, indent=1) + "\n")
+    print(f"step: {len(refs)} references")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -1,0 +1,76 @@
+"""Real PLY, OFF, VTK, VTU, AVS UCD, STEP and IGES files (tests/data/real/<format>/): what their readers got wrong.
+
+Every file of those folders is also run by ``tests/test_real_files.py`` against
+its independent reference (``benchmarks/real_files.py``); these tests pin the
+bugs the files found, with expectations read from the files themselves.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from inertia.errors import EmptyGeometryError
+from inertia.load import load_body
+
+REAL = Path(__file__).resolve().parent / "data" / "real"
+
+
+@pytest.mark.parametrize("name", ["cellsnd.ascii.inp", "cellsnd.bin.inp"])
+def test_avs_ucd_inp_is_read_as_avs_ucd_not_taken_for_abaqus(name: str) -> None:
+    """VTK's test data: an AVS UCD file of 8 triangles and 4 quads (13 nodes), ASCII and binary.
+
+    Read as Abaqus, the ASCII file was said to hold "no points" and the binary one
+    failed on UTF-8 decoding; the file's own reader (VTK's vtkAVSucdReader) finds
+    its 12 surface cells, so the refusal must say there is no 3-D cell among them.
+    """
+    pytest.importorskip("vtkmodules")
+    ascii_text = (REAL / "inp" / "cellsnd.ascii.inp").read_text()
+    cell_lines = [ln.split() for ln in ascii_text.splitlines() if len(ln.split()) > 2 and ln.split()[2] in ("tri", "quad")]
+    assert sum(f[2] == "tri" for f in cell_lines) == 8 and sum(f[2] == "quad" for f in cell_lines) == 4
+    with pytest.raises(EmptyGeometryError) as info:
+        load_body((REAL / "inp" / name).read_bytes(), filename=name)
+    message = info.value.message
+    assert "AVS UCD" in message and "4 quad, 8 triangle" in message and "no 3-D cells" in message
+    assert "Abaqus" not in message and "utf-8" not in message.lower()
+
+
+def test_avs_ucd_tetrahedron_is_weighed() -> None:
+    """A 3-D UCD cell is read, not only refused: one unit right-corner tetrahedron, V = 1/6."""
+    pytest.importorskip("vtkmodules")
+    text = b"# AVS UCD\n4 1 0 0 0\n0 0 0 0\n1 1 0 0\n2 0 1 0\n3 0 0 1\n0 1 tet 0 1 2 3\n"
+    loaded = load_body(text, filename="tet.inp")
+    from inertia.pipeline import AnalysisOptions, analyze_loaded
+
+    doc = analyze_loaded(loaded, AnalysisOptions(density=1.0)).as_dict()
+    assert doc["mass"] == pytest.approx(1 / 6, rel=1e-14)
+
+
+def test_abaqus_inp_is_not_taken_for_avs_ucd() -> None:
+    from inertia.load.volume import is_avs_ucd
+
+    assert not is_avs_ucd(b"*HEADING\n** comment\n*NODE\n1, 0.0, 0.0, 0.0\n")
+    assert is_avs_ucd((REAL / "inp" / "cellsnd.bin.inp").read_bytes())
+    assert is_avs_ucd((REAL / "inp" / "cellsnd.ascii.inp").read_bytes())
+
+
+def test_rooms_sharing_a_wall_are_not_rewound_as_cavities() -> None:
+    """trimesh's no_indices_3storybuilding.glb: each floor is two rooms that share a wall (four faces on its edges).
+
+    The components joined across manifold edges were two open rooms and the wall's two
+    sides; the nesting test re-wound one side of the wall as a "cavity" and the volume came
+    out 0.36 % high.  Expected: trimesh's own reading of the file integrated exactly.
+    """
+    from benchmarks.real_files import reference
+    from inertia.pipeline import AnalysisOptions, analyze_loaded
+
+    rel = "trimesh_models/no_indices_3storybuilding.glb"
+    volume, tensor = reference(REAL / rel, rel, ())
+    loaded = load_body((REAL / rel).read_bytes(), filename="no_indices_3storybuilding.glb", units="m")
+    doc = analyze_loaded(loaded, AnalysisOptions(units="m", density=1.0)).as_dict()
+    assert doc["mass"] == pytest.approx(volume, rel=1e-12)
+    assert max(abs(a - b) for ra, rb in zip(doc["inertia_tensor"], tensor, strict=True) for a, b in zip(ra, rb, strict=True)) <= (
+        1e-12 * float(abs(tensor).max())
+    )
+    assert not any("winding corrected" in w for w in doc["warnings"])
