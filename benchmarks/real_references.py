@@ -92,7 +92,8 @@ def vtk_moments(grid: Any) -> tuple[float, np.ndarray, np.ndarray, dict[int, int
     """Volume, first and second moments (unit density) of the 3-D cells; counts of the cells left out by type."""
     from vtkmodules.util.numpy_support import vtk_to_numpy
 
-    points = vtk_to_numpy(grid.GetPoints().GetData()).astype(np.float64)
+    to_numpy: Any = vtk_to_numpy  # untyped in VTK's wheel
+    points = np.asarray(to_numpy(grid.GetPoints().GetData()), dtype=np.float64)
     by_type: dict[int, list[int]] = {}
     for i in range(grid.GetNumberOfCells()):
         by_type.setdefault(grid.GetCellType(i), []).append(i)

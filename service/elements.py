@@ -1,11 +1,16 @@
 """Atomic masses by element symbol, for molecules given as atoms.
 
 Masses come from the ``periodictable`` package (imported here only), whose
-tables are, for elements, the IUPAC abridged standard atomic weights
-(Prohaska et al., "Standard atomic weights of the elements 2021",
-Pure Appl. Chem. 94, 2022, as published by CIAAW), and for isotopes the
-AME2020 atomic masses (Wang et al., Chinese Phys. C 45, 030003, 2021) with
-the CIAAW 2021 isotopic abundances.
+tables are, for elements, the IUPAC standard atomic weights (Prohaska et
+al., "Standard atomic weights of the elements 2021", Pure Appl. Chem. 94,
+2022, as published by CIAAW; conventional values for the elements whose
+weight is an interval), and for isotopes the AME2020 atomic masses (Wang et
+al., Chinese Phys. C 45, 030003, 2021) with the CIAAW 2021 isotopic
+abundances.  A bare symbol weighs the abridged value (API.md: "abridged
+conventional values"): the standard atomic weight rounded to five
+significant figures, as CIAAW abridges its table (sodium 22.990, not
+22.98976928; fluorine 18.998), with halves rounded up as CIAAW writes
+them (vanadium 50.9415 -> 50.942).
 
 A symbol may carry a mass number in front (``13C``, ``2H``); ``D`` is ``2H``
 and ``T`` is ``3H``.  With ``isotopes="abundant"`` a bare symbol means the
@@ -22,9 +27,12 @@ from typing import Any
 from .errors import InvalidParameterError
 from .vocabulary import Isotopes, values
 
-__all__ = ["ISOTOPE_CHOICES", "atomic_mass", "dalton_kg", "element_symbol"]
+__all__ = ["ABRIDGED_DIGITS", "ISOTOPE_CHOICES", "abridged", "atomic_mass", "dalton_kg", "element_symbol"]
 
 ISOTOPE_CHOICES = values(Isotopes)
+
+# the abridged table's precision: five significant figures (CIAAW, "Abridged standard atomic weights")
+ABRIDGED_DIGITS = 5
 
 _SPEC = re.compile(r"^\s*(\d*)\s*([A-Za-z]{1,3})\s*$")
 _HYDROGEN_ALIASES = {"D": 2, "T": 3}  # deuterium and tritium, IUPAC-recognised symbols
@@ -75,7 +83,8 @@ def atomic_mass(spec: str, isotopes: str = Isotopes.STANDARD) -> float:
         raise InvalidParameterError(f"element {spec!r} is not a symbol such as 'O', '13C' or 'D'", parameter="element")
     number_text, symbol = match.groups()
     mass_number = int(number_text) if number_text else None
-    if symbol in _HYDROGEN_ALIASES:
+    if symbol.upper() in _HYDROGEN_ALIASES:  # "d" as "D", as "o" is "O"
+        symbol = symbol.upper()
         if mass_number is not None:
             raise InvalidParameterError(f"element {spec!r}: {symbol} already names an isotope of hydrogen", parameter="element")
         mass_number, symbol = _HYDROGEN_ALIASES[symbol], "H"
@@ -110,7 +119,20 @@ def _standard_weight(element: Any, spec: str) -> float:
             f"'{int(element.mass)}{element.symbol}' or the mass",
             parameter="element",
         )
-    return float(element.mass)
+    return abridged(float(element.mass))
+
+
+def abridged(weight: float) -> float:
+    """A standard atomic weight abridged to ``ABRIDGED_DIGITS`` significant figures, halves up as CIAAW rounds.
+
+    A weight already written with fewer digits (a conventional value such as 1.008 or 6.94) is unchanged.
+    """
+    from decimal import ROUND_HALF_UP, Decimal
+
+    exact = Decimal(repr(weight))  # the decimal digits as tabulated, not the binary float's expansion
+    step = Decimal(1).scaleb(exact.adjusted() - ABRIDGED_DIGITS + 1)
+    rounded = exact.quantize(step, rounding=ROUND_HALF_UP)  # 1.008 -> 1.0080: the same number
+    return weight if rounded == exact else float(rounded)
 
 
 def _abundant_mass(element: Any, spec: str) -> float:

@@ -14,7 +14,12 @@ the first (the solid angle it subtends, van Oosterom & Strackee, IEEE Trans.
 Biomed. Eng. 30(2), 1983), which is exact for closed shells and does not
 depend on bounding boxes.  A shell of zero volume is never flipped, and
 shells that touch or coincide (a test point on the other shell) keep the
-file's orientation: flipping shells must not manufacture volume.
+file's orientation: flipping shells must not manufacture volume.  Shells are
+the components of faces joined across manifold edges, unless one of those is
+not closed by itself (two rooms sharing a wall: the wall's edges are
+non-manifold, and the wall's two sides come apart from their rooms); then the
+shells are the components joined across every edge, each closed, so a piece
+of a shell is never re-wound on its own.
 """
 
 from __future__ import annotations
@@ -27,7 +32,7 @@ from .errors import NotWatertightError, ZeroVolumeError
 from .integrals import CHUNK, gather_corners, local_origin, point_records
 from .seams import merge_seams
 from .tolerances import EPS
-from .topology import SurfaceTopology, face_components, orient_consistently, surface_topology, weld
+from .topology import SurfaceTopology, _components, face_components, orient_consistently, surface_topology, weld
 
 __all__ = ["closed_surface"]
 
@@ -102,6 +107,11 @@ def _orient_outward(
     total = float(det.sum())
     count, label = face_components(faces, topo)
     vol = np.bincount(label, weights=det, minlength=count)
+    if count > 1 and np.any(vol < 0) and not _each_closed(faces, label):
+        # components split at non-manifold edges (two rooms sharing a wall) are not shells by themselves:
+        # re-winding one of them would make volume; the shells are the components joined across every edge
+        count, label = _edge_connected(faces)
+        vol = np.bincount(label, weights=det, minlength=count)
     noise = np.bincount(label, weights=np.abs(det), minlength=count)
     flat = np.abs(vol) <= 64 * EPS * noise  # a shell of zero volume: no orientation makes it a body
     if count == 1:
@@ -129,6 +139,34 @@ def _orient_outward(
         f"winding corrected on {int(flip_shell.sum())} of {count} shells by their nesting "
         "(a shell inside an odd number of others is a cavity)"
     ]
+
+
+def _undirected_edges(
+    faces: NDArray[np.int64],
+) -> tuple[NDArray[np.int64], NDArray[np.int64], NDArray[np.int64], NDArray[np.int64]]:
+    """Every face's three edges: lower vertex, higher vertex, +1/-1 for the face's direction, face number."""
+    a = faces.ravel()
+    b = faces[:, [1, 2, 0]].ravel()
+    return np.minimum(a, b), np.maximum(a, b), np.where(a < b, 1, -1), np.repeat(np.arange(len(faces)), 3)
+
+
+def _each_closed(faces: NDArray[np.int64], label: NDArray[np.int64]) -> bool:
+    """Whether every component is closed by itself: each of its edges crossed as often one way as the other."""
+    lo, hi, sign, face = _undirected_edges(faces)
+    comp = label[face]
+    order = np.lexsort((hi, lo, comp))
+    lo, hi, comp, sign = lo[order], hi[order], comp[order], sign[order]
+    starts = np.flatnonzero(np.r_[True, (lo[1:] != lo[:-1]) | (hi[1:] != hi[:-1]) | (comp[1:] != comp[:-1])])
+    return bool(np.all(np.add.reduceat(sign, starts) == 0))
+
+
+def _edge_connected(faces: NDArray[np.int64]) -> tuple[int, NDArray[np.int64]]:
+    """Components of faces joined across every shared edge, manifold or not (each is closed when the surface is)."""
+    lo, hi, _, face = _undirected_edges(faces)
+    order = np.lexsort((hi, lo))
+    lo, hi, face = lo[order], hi[order], face[order]
+    same = (lo[1:] == lo[:-1]) & (hi[1:] == hi[:-1])
+    return _components(len(faces), face[:-1][same], face[1:][same])
 
 
 def winding_numbers(x: NDArray[np.float64], faces: NDArray[np.int64], points: NDArray[np.float64]) -> NDArray[np.float64]:

@@ -7,6 +7,7 @@ bugs the files found, with expectations read from the files themselves.
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 import pytest
@@ -53,3 +54,61 @@ def test_abaqus_inp_is_not_taken_for_avs_ucd() -> None:
     assert not is_avs_ucd(b"*HEADING\n** comment\n*NODE\n1, 0.0, 0.0, 0.0\n")
     assert is_avs_ucd((REAL / "inp" / "cellsnd.bin.inp").read_bytes())
     assert is_avs_ucd((REAL / "inp" / "cellsnd.ascii.inp").read_bytes())
+
+
+def test_rooms_sharing_a_wall_are_not_rewound_as_cavities() -> None:
+    """trimesh's no_indices_3storybuilding.glb: each floor is two rooms that share a wall (four faces on its edges).
+
+    The components joined across manifold edges were two open rooms and the wall's two
+    sides; the nesting test re-wound one side of the wall as a "cavity" and the volume came
+    out 0.36 % high.  Expected: trimesh's own reading of the file integrated exactly.
+    """
+    from benchmarks.real_files import reference
+    from inertia.pipeline import AnalysisOptions, analyze_loaded
+
+    rel = "trimesh_models/no_indices_3storybuilding.glb"
+    volume, tensor = reference(REAL / rel, rel, ())
+    loaded = load_body((REAL / rel).read_bytes(), filename="no_indices_3storybuilding.glb", units="m")
+    doc = analyze_loaded(loaded, AnalysisOptions(units="m", density=1.0)).as_dict()
+    assert doc["mass"] == pytest.approx(volume, rel=1e-12)
+    assert max(abs(a - b) for ra, rb in zip(doc["inertia_tensor"], tensor, strict=True) for a, b in zip(ra, rb, strict=True)) <= (
+        1e-12 * float(abs(tensor).max())
+    )
+    assert not any("winding corrected" in w for w in doc["warnings"])
+
+
+@pytest.mark.parametrize(("name", "types"), [("MS.inp", ["DASHPOTA", "SPRINGA"]), ("MSM.inp", ["DASHPOTA", "MASS", "SPRINGA"])])
+def test_abaqus_deck_of_springs_and_masses_is_refused_by_element_name(name: str, types: list[str]) -> None:
+    """CalculiX's mass-spring examples: their element types (read from the deck) are named, not "is the file complete?"."""
+    from inertia.errors import UnsupportedFormatError
+
+    text = (REAL / "calculix" / name).read_text()
+    declared = re.findall(r"^\*ELEMENT, *TYPE=(\w+)", text, re.IGNORECASE | re.MULTILINE)
+    assert set(types) <= set(declared)
+    with pytest.raises(UnsupportedFormatError) as info:
+        load_body((REAL / "calculix" / name).read_bytes(), filename=name)
+    assert all(t in info.value.message for t in types)
+    assert "complete" not in info.value.message
+
+
+@pytest.mark.parametrize("spelling", ["c3d4", "C3D4T", "c3d4h", "DC3D4"])
+def test_abaqus_solid_variants_in_any_case_are_weighed(spelling: str) -> None:
+    """Abaqus reads names in any case and has many variants of one node layout; V of the unit corner tetrahedron is 1/6."""
+    from inertia.pipeline import AnalysisOptions, analyze_loaded
+
+    deck = (
+        f"*node, nset=nall\n1, 0, 0, 0\n2, 1, 0, 0\n3, 0, 1, 0\n4, 0, 0, 1\n*element, type={spelling}, elset=eall\n1, 1, 2, 3, 4\n"
+    )
+    deck += "*element output, elset=eall\nS\n"  # a keyword that starts like *ELEMENT and is not one
+    doc = analyze_loaded(load_body(deck.encode(), filename="t.inp"), AnalysisOptions(density=1.0)).as_dict()
+    assert doc["mass"] == pytest.approx(1 / 6, rel=1e-14)
+
+
+def test_abaqus_shells_beside_solids_are_said_not_weighed() -> None:
+    from inertia.pipeline import AnalysisOptions, analyze_loaded
+
+    deck = b"*NODE\n1, 0, 0, 0\n2, 1, 0, 0\n3, 0, 1, 0\n4, 0, 0, 1\n*ELEMENT, TYPE=C3D4\n1, 1, 2, 3, 4\n"
+    deck += b"*ELEMENT, TYPE=S3\n2, 1, 2, 3\n"  # a shell: its mass needs a thickness, so it is said to be left out
+    doc = analyze_loaded(load_body(deck, filename="t.inp"), AnalysisOptions(density=1.0)).as_dict()
+    assert doc["mass"] == pytest.approx(1 / 6, rel=1e-14)
+    assert any("1 triangle elements" in w and "not weighed" in w for w in doc["warnings"])

@@ -83,7 +83,21 @@ def _where(loc: tuple[Any, ...]) -> str:
     return f"{loc[0]} field {path!r}" if loc[0] in ("body", "query") else path
 
 
-def invalid_request(exc: RequestValidationError) -> InvalidParameterError:
+def _body_message(error: dict[str, Any], content_type: str | None) -> str | None:
+    """What to send instead, when FastAPI could not take the body as JSON: malformed JSON, or a body sent
+    without ``Content-Type: application/json`` (FastAPI then hands the raw bytes on) or not an object."""
+    loc = error["loc"]
+    if len(loc) == 2 and loc[0] == "body" and isinstance(loc[1], int) and error.get("type") == "json_invalid":
+        return f"the request body is not valid JSON (at character {loc[1]}); send the JSON document of API.md"
+    if loc == ["body"] and error.get("type") == "model_attributes_type":
+        if content_type is None or "json" not in content_type.lower():
+            sent = f"was sent as {content_type}" if content_type else "came without a Content-Type header"
+            return f"the request body {sent}; send the JSON document of API.md with the header Content-Type: application/json"
+        return "the request body must be a JSON object (the document of API.md), not an array or a single value"
+    return None
+
+
+def invalid_request(exc: RequestValidationError, content_type: str | None = None) -> InvalidParameterError:
     """A schema failure as ``invalid_parameter``, naming the first bad field."""
     errors = [
         {
@@ -95,7 +109,10 @@ def invalid_request(exc: RequestValidationError) -> InvalidParameterError:
     ]
     first = errors[0] if errors else {"loc": [], "msg": "invalid request"}
     message = f"{_where(tuple(first['loc']))}: {first['msg']}; fix it and send the request again"
-    parameter = str(first["loc"][-1]) if first["loc"] else None
+    # the field's name, not a list index: 'omega' for body.omega.0, 'position' for body.points.2.position.1
+    names = [p for p in first["loc"] if isinstance(p, str)]
+    parameter = names[-1] if names else None
+    message = _body_message(first, content_type) or message
     return InvalidParameterError(message, parameter=parameter, errors=errors)
 
 
@@ -108,7 +125,7 @@ async def _service_error(request: Request, exc: Exception) -> JSONResponse:
 
 async def _validation_error(request: Request, exc: Exception) -> JSONResponse:
     assert isinstance(exc, RequestValidationError)
-    return error_response(invalid_request(exc))
+    return error_response(invalid_request(exc, request.headers.get("content-type")))
 
 
 async def _http_error(request: Request, exc: Exception) -> JSONResponse:

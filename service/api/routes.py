@@ -77,6 +77,12 @@ async def healthz() -> dict[str, str]:
     return {"status": "ok"}
 
 
+@health.head("/healthz", response_model=HealthOut, tags=["service"], responses=error_responses(500))
+async def healthz_head() -> dict[str, str]:
+    """Liveness for probes that send HEAD: the status of GET /healthz, without the body."""
+    return {"status": "ok"}
+
+
 @v1.get("/formats", response_model=FormatsOut, tags=["service"], responses=error_responses(500))
 async def formats() -> FormatsOut:
     """The formats this installation can read, and which hold surfaces, volume cells, or scenes of several parts.

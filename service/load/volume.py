@@ -23,7 +23,12 @@ Medit, TetGen, ...) go through meshio, which converts their node orders to
 VTK's.  An ``.inp`` file is Abaqus unless its content is AVS UCD (the other
 format with that extension, binary or ASCII, see ``is_avs_ucd``), which
 VTK's ``vtkAVSucdReader`` reads: meshio took it for Abaqus and answered "no
-points" or a UTF-8 decoding error.
+points" or a UTF-8 decoding error.  Abaqus decks are scanned for their
+element types first (``_admit_abaqus_types``): solid variants meshio does not
+name (lower case, C3D8T, C3D4H, DC3D10, ...) are taken as the solid of their
+node count, other elements (springs, masses, user elements) refuse the file
+by name, and shells, beams or trusses beside the solids are said to be left
+out (their mass needs their sections).
 
 Every reader call is fenced: anything it raises (``SystemExit`` from meshio's
 ``sys.exit(1)`` included; never ``KeyboardInterrupt``) becomes an
@@ -438,6 +443,9 @@ def _read_meshio(data: bytes, fmt: str, label: str, filename: str | None, compan
         for key, dim in _MESHIO_MISSING_DIMENSIONS.items():
             table.setdefault(key, dim)
 
+    if fmt == "inp":
+        _admit_abaqus_types([data, *(companions or {}).values()], label)
+
     with _upload_dir(data, fmt, filename, companions) as path, _quiet() as printed:
         try:
             mesh = meshio.read(path, file_format=VOLUME_FORMATS[fmt])
@@ -445,7 +453,78 @@ def _read_meshio(data: bytes, fmt: str, label: str, filename: str | None, compan
             raise
         except BaseException as exc:  # meshio calls sys.exit(1) and raises KeyError, ValueError, ...
             raise UnreadableFileError(_meshio_failure(exc, printed.getvalue(), path, fmt, label, companions), format=fmt) from exc
-    return _mesh_from_meshio(mesh, label)
+    out = _mesh_from_meshio(mesh, label)
+    if fmt == "inp" and out.blocks and out.other:  # Abaqus shells, beams, trusses have mass through their sections
+        listed = ", ".join(f"{n} {t}" for t, n in sorted(out.other.items()))
+        out.warnings.append(
+            f"{label} also holds {listed} elements (shells, membranes, beams or trusses), whose mass depends on "
+            "section properties; they were not weighed: the result is the solid elements alone"
+        )
+    return out
+
+
+# Abaqus solid elements by node count: C3D<n> with any suffix (R reduced, H hybrid, I incompatible modes,
+# M modified, T coupled temperature, P pore pressure, ...), DC3D<n> heat transfer, SC6R/SC8R continuum
+# shells; the node layout depends on <n> alone.  Variable-node elements (C3D15V, C3D27) are not among them.
+_ABAQUS_SOLID = re.compile(r"^(?:D?C3D(?P<n>4|6|8|10|15|20)[A-UW-Z]*|SC(?P<sc>6|8)R[A-Z]*)$")
+_ABAQUS_SOLID_TYPE = {"4": "tetra", "6": "wedge", "8": "hexahedron", "10": "tetra10", "15": "wedge15", "20": "hexahedron20"}
+_ABAQUS_ELEMENT = re.compile(rb"^[ \t]*\*[ \t]*ELEMENT[ \t]*(?:,(?P<params>[^\r\n]*))?$", re.IGNORECASE | re.MULTILINE)
+_ABAQUS_TYPE = re.compile(rb"(?:^|,)[ \t]*TYPE[ \t]*=[ \t]*(?P<type>[^,\s]+)", re.IGNORECASE)
+
+
+def abaqus_element_types(texts: list[bytes]) -> list[str]:
+    """The element types an Abaqus input deck declares (``*ELEMENT, TYPE=...``), as written."""
+    found: set[str] = set()
+    for text in texts:
+        for m in _ABAQUS_ELEMENT.finditer(text):
+            t = _ABAQUS_TYPE.search(m.group("params") or b"")
+            if t:
+                found.add(t.group("type").decode("latin-1"))
+    return sorted(found)
+
+
+def _admit_abaqus_types(texts: list[bytes], label: str) -> None:
+    """Teach meshio the deck's solid element names it lacks; refuse, by name, the elements it cannot read.
+
+    Abaqus reads keywords and element names in any case and has many solid
+    variants (C3D8T, C3D10HS, DC3D4, ...) of the few node layouts meshio
+    knows by a handful of names (its table has C3D8R but not c3d8r or
+    C3D8T); meshio refused every other spelling with "Element type not
+    available".  Each such solid is added to meshio's table under the name
+    as written (entries are only added, never changed).  Springs, dashpots,
+    point masses, connectors, user elements and the like are not solids and
+    some of them carry mass (MASS, ROTARYI): the file is refused, naming them.
+    """
+    from meshio import _common, _mesh
+    from meshio.abaqus import _abaqus
+
+    table = getattr(_abaqus, "abaqus_to_meshio_type", None)
+    if not isinstance(table, dict):
+        return
+    # meshio 5.3.5 names C3D4H's cells "tetra4" but knows neither their node count nor their dimension
+    # (KeyError on every C3D4H deck): the two entries are added
+    for nodes_or_dim, value in (
+        (getattr(_common, "num_nodes_per_cell", None), 4),
+        (getattr(_mesh, "topological_dimension", None), 3),
+    ):
+        if isinstance(nodes_or_dim, dict):
+            nodes_or_dim.setdefault("tetra4", value)
+    unknown = []
+    for name in abaqus_element_types(texts):
+        known = table.get(name) or table.get(name.upper())
+        m = _ABAQUS_SOLID.match(name.upper())
+        target = known or (_ABAQUS_SOLID_TYPE[m.group("n") or m.group("sc")] if m else None)
+        if target is None:
+            unknown.append(name)
+        else:
+            table.setdefault(name, target)
+    if unknown:
+        raise UnsupportedFormatError(
+            f"{label} holds elements this service does not read ({', '.join(unknown)}): it weighs continuum "
+            "solids (C3D4 ... C3D20 and their variants), and springs, dashpots, point masses (MASS, ROTARYI), "
+            "connectors or user elements would be left out although some carry mass; export the solid mesh alone",
+            element_types=unknown,
+        )
 
 
 def _meshio_failure(

@@ -15,6 +15,12 @@ def test_healthz_reports_ok(client: TestClient) -> None:
     assert r.json() == {"status": "ok"}
 
 
+def test_healthz_answers_a_head_probe(client: TestClient) -> None:
+    # load balancers and container health checks may probe with HEAD: the same status, no body
+    r = client.head("/healthz")
+    assert r.status_code == 200 and r.content == b""
+
+
 def test_formats_lists_readable_formats_and_their_capabilities(client: TestClient) -> None:
     r = client.get("/v1/formats")
     assert r.status_code == 200
