@@ -36,12 +36,12 @@ def test_box_mass_centre_and_tensor_match_closed_form(client: TestClient) -> Non
     r = upload(client, box_stl(1, 2, 3))
     assert r.status_code == 200, r.text
     doc = r.json()
-    assert doc["mass"] == pytest.approx(6000, rel=REL) and doc["volume"] == pytest.approx(6, rel=REL)
+    assert doc["mass"] == pytest.approx(6000, rel=REL, abs=0) and doc["volume"] == pytest.approx(6, rel=REL, abs=0)
     assert doc["density"] == 1000
     assert close(doc["center_of_mass"], [0.5, 1, 1.5])
     assert close(doc["inertia_tensor"], box_inertia(6000, 1, 2, 3))
     assert close(doc["principal"]["moments"], [2500, 5000, 6500])
-    assert np.linalg.det(np.array(doc["principal"]["axes"])) == pytest.approx(1, rel=1e-12)
+    assert np.linalg.det(np.array(doc["principal"]["axes"])) == pytest.approx(1, rel=1e-12, abs=0)
     assert doc["classification"]["kind"] == "asymmetric_top"
     assert doc["source"] == {
         **doc["source"],
@@ -75,10 +75,10 @@ def test_reference_tensor_follows_parallel_axis_theorem(client: TestClient) -> N
 def test_units_density_and_mass_options_scale_as_expected(client: TestClient) -> None:
     mm = upload(client, box_stl(10, 20, 30), units="mm", density=7850).json()
     m = 7850 * 6e-6
-    assert mm["source"]["units"] == "mm" and mm["mass"] == pytest.approx(m, rel=1e-12)
+    assert mm["source"]["units"] == "mm" and mm["mass"] == pytest.approx(m, rel=1e-12, abs=0)
     assert close(mm["inertia_tensor"], box_inertia(m, 0.01, 0.02, 0.03), rel=1e-6)
     by_mass = upload(client, box_stl(1, 2, 3), mass=12).json()
-    assert by_mass["mass"] == pytest.approx(12, rel=REL) and by_mass["density"] == pytest.approx(2, rel=REL)
+    assert by_mass["mass"] == pytest.approx(12, rel=REL, abs=0) and by_mass["density"] == pytest.approx(2, rel=REL, abs=0)
 
 
 def test_format_parameter_overrides_the_file_name(client: TestClient) -> None:
@@ -94,7 +94,7 @@ def test_client_paths_are_never_followed(client: TestClient) -> None:
 def test_omega_with_duration_and_samples_adds_a_trajectory(client: TestClient) -> None:
     doc = upload(client, box_stl(1, 2, 3), omega="0.01,1,0.01", duration=2, samples=5, method="dop853").json()
     traj = doc["precession"]["trajectory"]
-    assert len(traj["t"]) == 5 and traj["t"][0] == 0 and traj["t"][-1] == pytest.approx(2)
+    assert len(traj["t"]) == 5 and traj["t"][0] == 0 and traj["t"][-1] == pytest.approx(2, abs=0)
     assert close(traj["quaternion"][0], [1, 0, 0, 0])
 
 
@@ -138,11 +138,11 @@ def test_precession_of_symmetric_top_matches_landau_lifshitz(client: TestClient)
     M = math.hypot(I1 * w[0], I3 * w[2])
     # L&L §33: Omega_pr = M / I1; body rate Omega3 (I3 - I1) / I1; cos theta = I3 Omega3 / M
     assert p["regime"] == "regular_precession"
-    assert p["space_precession_rate"] == pytest.approx(M / I1, rel=1e-12)
-    assert p["body_precession_rate"] == pytest.approx(w[2] * (I3 - I1) / I1, rel=1e-12)
-    assert p["nutation_angle"] == pytest.approx(math.acos(I3 * w[2] / M), rel=1e-12)
-    assert p["spin_rate"] == pytest.approx(M * (I3 * w[2] / M) * (1 / I3 - 1 / I1), rel=1e-12)
-    assert p["period"] == pytest.approx(2 * math.pi, rel=1e-12)
+    assert p["space_precession_rate"] == pytest.approx(M / I1, rel=1e-12, abs=0)
+    assert p["body_precession_rate"] == pytest.approx(w[2] * (I3 - I1) / I1, rel=1e-12, abs=0)
+    assert p["nutation_angle"] == pytest.approx(math.acos(I3 * w[2] / M), rel=1e-12, abs=0)
+    assert p["spin_rate"] == pytest.approx(M * (I3 * w[2] / M) * (1 / I3 - 1 / I1), rel=1e-12, abs=0)
+    assert p["period"] == pytest.approx(2 * math.pi, rel=1e-12, abs=0)
     assert doc["classification"]["kind"] == "symmetric_top" and doc["classification"]["shape"] == "oblate"
     assert set(doc) == {"principal", "classification", "precession", "warnings", "diagnostics"}
 
@@ -182,7 +182,7 @@ def test_batch_streams_one_line_per_file_in_upload_order(client: TestClient) -> 
     ]
     lines = _lines(client.post("/v1/batch", files=files, params={"density": 500}))
     assert [line["source"]["filename"] for line in lines] == ["a.stl", "notes.txt", "empty.stl", "b.stl"]
-    assert lines[0]["mass"] == pytest.approx(3000) and lines[3]["mass"] == pytest.approx(4000)
+    assert lines[0]["mass"] == pytest.approx(3000, abs=0) and lines[3]["mass"] == pytest.approx(4000, abs=0)
     assert lines[1]["error"]["code"] == "unsupported_format"
     assert lines[2]["error"]["code"] == "empty_geometry"
 
@@ -198,7 +198,7 @@ def test_batch_of_a_zip_expands_members_in_archive_order(client: TestClient) -> 
     files = [("files", ("parts.zip", buf.getvalue())), ("files", ("broken.zip", b"PK not really"))]
     lines = _lines(client.post("/v1/batch", files=files))
     assert [line["source"]["filename"] for line in lines] == ["parts/one.stl", "readme.md", "parts/two.stl", "broken.zip"]
-    assert lines[0]["mass"] == pytest.approx(1000) and lines[2]["mass"] == pytest.approx(2000)
+    assert lines[0]["mass"] == pytest.approx(1000, abs=0) and lines[2]["mass"] == pytest.approx(2000, abs=0)
     assert lines[1]["error"]["code"] == "unsupported_format"
     assert lines[3]["error"]["code"] == "unreadable_file"
 

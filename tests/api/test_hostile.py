@@ -140,7 +140,7 @@ def test_corrupt_zip_member_is_one_error_line_of_a_complete_batch(client: Any) -
     lines = [json.loads(line) for line in response.text.splitlines()]
     assert [("error" in line) for line in lines] == [False, True, False]
     assert lines[1]["source"]["filename"] == "b.stl" and lines[1]["error"]["code"] == "unreadable_file"
-    assert lines[2]["mass"] == pytest.approx(1000.0, rel=1e-12)
+    assert lines[2]["mass"] == pytest.approx(1000.0, rel=1e-12, abs=0)
 
 
 def test_zip_bomb_member_is_an_error_line_and_the_batch_goes_on(client: Any) -> None:
@@ -167,7 +167,7 @@ def test_job_past_its_memory_allowance_is_413_and_the_worker_serves_on() -> None
         error = error_of(post_mesh(c, "torus.stl", torus_stl(500, 500)), 413, "payload_too_large")
         assert "memory" in error["message"]
         ok = post_mesh(c, "box.stl", BOX)
-    assert ok.status_code == 200 and ok.json()["mass"] == pytest.approx(6000, rel=1e-12)
+    assert ok.status_code == 200 and ok.json()["mass"] == pytest.approx(6000, rel=1e-12, abs=0)
 
 
 def test_queue_beyond_its_bound_is_503_with_retry_after() -> None:
@@ -367,7 +367,7 @@ def test_gltf_with_its_buffer_as_a_second_file_part_is_read(client: Any) -> None
     files = [("file", ("tet.gltf", json.dumps(doc).encode())), ("file", ("tet.bin", buffer))]
     response = client.post("/v1/analyze/mesh", files=files)
     assert response.status_code == 200, response.text
-    assert response.json()["mass"] == pytest.approx(1000 / 6, rel=1e-6)  # unit right tetrahedron, float32 corners
+    assert response.json()["mass"] == pytest.approx(1000 / 6, rel=1e-6, abs=0)  # unit right tetrahedron, float32 corners
     alone = client.post("/v1/analyze/mesh", files=[files[0]])
     error_of(alone, 422, "external_reference")
 
@@ -378,5 +378,5 @@ def test_abaqus_include_that_comes_in_the_same_upload_is_followed(client: Any) -
     files = [("file", ("deck.inp", main)), ("file", ("part.inc", part))]
     response = client.post("/v1/analyze/mesh", files=files)
     assert response.status_code == 200, response.text
-    assert response.json()["mass"] == pytest.approx(1000 / 6, rel=1e-12)  # the unit right tetrahedron
+    assert response.json()["mass"] == pytest.approx(1000 / 6, rel=1e-12, abs=0)  # the unit right tetrahedron
     error_of(client.post("/v1/analyze/mesh", files=[files[0]]), 422, "external_reference")

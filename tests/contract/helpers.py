@@ -295,11 +295,11 @@ def check_symmetric_rates(pre: dict[str, Any], I_perp: float, I_sym: float, n: A
     body = W3 * (I_sym - I_perp) / I_perp
     cos_theta = I_sym * W3 / M
     assert pre["regime"] == "regular_precession"
-    assert pre["body_precession_rate"] == pytest.approx(body, rel=1e-12)
-    assert pre["space_precession_rate"] == pytest.approx(M / I_perp, rel=1e-12)
-    assert pre["spin_rate"] == pytest.approx(M * cos_theta * (1 / I_sym - 1 / I_perp), rel=1e-12)
-    assert pre["nutation_angle"] == pytest.approx(math.acos(cos_theta), rel=1e-12)
-    assert pre["period"] == pytest.approx(2 * math.pi / abs(body), rel=1e-12)
+    assert pre["body_precession_rate"] == pytest.approx(body, rel=1e-12, abs=0)
+    assert pre["space_precession_rate"] == pytest.approx(M / I_perp, rel=1e-12, abs=0)
+    assert pre["spin_rate"] == pytest.approx(M * cos_theta * (1 / I_sym - 1 / I_perp), rel=1e-12, abs=0)
+    assert pre["nutation_angle"] == pytest.approx(math.acos(cos_theta), rel=1e-12, abs=0)
+    assert pre["period"] == pytest.approx(2 * math.pi / abs(body), rel=1e-12, abs=0)
 
 
 def check_trajectory(
@@ -309,7 +309,7 @@ def check_trajectory(
     t = np.asarray(tr["t"], float)
     assert len(t) == samples
     np.testing.assert_allclose(t, np.linspace(0, duration, samples), rtol=1e-14, atol=1e-14 * duration)
-    assert t[0] == 0 and t[-1] == pytest.approx(duration, rel=1e-15)
+    assert t[0] == 0 and t[-1] == pytest.approx(duration, rel=1e-15, abs=0)
     W = np.asarray(tr["omega_body"], float)
     w = np.asarray(tr["omega"], float)
     Q = np.asarray(tr["quaternion"], float)

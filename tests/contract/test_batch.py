@@ -47,7 +47,7 @@ def test_batch_streams_one_line_per_file_in_upload_order(client: TestClient) -> 
     r = client.post("/v1/batch", files=files, params={"density": "2000", "reference": "0,0,0"})
     lines = ndjson_lines(r)
     assert len(lines) == 4
-    assert lines[0]["mass"] == pytest.approx(12000, rel=1e-14)
+    assert lines[0]["mass"] == pytest.approx(12000, rel=1e-14, abs=0)
     check_batch_lines(client, lines, {"density": "2000", "reference": "0,0,0"})
 
 
@@ -60,7 +60,7 @@ def test_batch_accepts_one_zip_of_files(client: TestClient) -> None:
     r = client.post("/v1/batch", files=[("files", ("meshes.zip", buf.getvalue(), "application/zip"))], params=params)
     lines = ndjson_lines(r)
     assert len(lines) == 4
-    assert lines[0]["mass"] == pytest.approx(6e-6, rel=1e-13)
+    assert lines[0]["mass"] == pytest.approx(6e-6, rel=1e-13, abs=0)
     assert len(lines[0]["precession"]["trajectory"]["t"]) == 3
     check_batch_lines(client, lines, params)
 
@@ -75,7 +75,7 @@ def test_batch_unsupported_and_unreadable_files_are_error_lines(client: TestClie
     assert [line["source"]["filename"] for line in lines] == ["a.xyz123", "b.stl", "c.stl"]
     assert lines[0]["error"]["code"] == "unsupported_format"
     assert lines[1]["error"]["code"] == "unreadable_file"
-    assert lines[2]["mass"] == pytest.approx(6000, rel=1e-14)
+    assert lines[2]["mass"] == pytest.approx(6000, rel=1e-14, abs=0)
 
 
 def test_batch_with_an_invalid_parameter_is_rejected_with_the_envelope(client: TestClient) -> None:
@@ -101,6 +101,6 @@ def test_batch_keeps_upload_order_with_files_of_very_different_cost(client: Test
     assert [line["source"]["filename"] for line in lines] == names
     for nm, line in zip(names, lines):
         if "box" in nm:
-            assert line["mass"] == pytest.approx(6000, rel=1e-14)
+            assert line["mass"] == pytest.approx(6000, rel=1e-14, abs=0)
         else:
             assert line["source"]["triangles"] == 2 * n * m

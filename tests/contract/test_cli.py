@@ -78,7 +78,7 @@ def test_cli_batch_writes_one_line_per_file_and_resumes(tmp_path: Path) -> None:
     lines = [json.loads(x) for x in out.read_text().splitlines() if x.strip()]
     assert len(lines) == 2
     by_name = {Path(line["source"]["filename"]).name: line for line in lines}
-    assert by_name["box.stl"]["mass"] == pytest.approx(6000, rel=1e-14)
+    assert by_name["box.stl"]["mass"] == pytest.approx(6000, rel=1e-14, abs=0)
     assert by_name["open_box.stl"]["error"]["code"] == "not_watertight"
     (folder / "tetrahedron.stl").write_bytes((SAMPLES / "tetrahedron.stl").read_bytes())
     p = run_cli("batch", str(folder), "--out", str(out), "--resume", cwd=tmp_path)
@@ -96,7 +96,7 @@ def test_inertia_console_script_runs_analyze() -> None:
     p = subprocess.run([exe, "analyze", "tetrahedron.stl", "--json"], cwd=SAMPLES, capture_output=True, text=True, timeout=60)
     assert p.returncode == 0, p.stderr
     res = json.loads(p.stdout)
-    assert res["mass"] == pytest.approx(1000 / 6, rel=1e-14)
+    assert res["mass"] == pytest.approx(1000 / 6, rel=1e-14, abs=0)
     assert res["classification"]["kind"] == "symmetric_top"
 
 
@@ -132,7 +132,7 @@ def test_inertia_serve_starts_the_http_service(tmp_path: Path) -> None:
         r = httpx.get(f"{server.url}/healthz", timeout=1)
         assert r.json() == {"status": "ok"}
         r = httpx.post(f"{server.url}/v1/analyze/mesh", files={"file": ("box.stl", (SAMPLES / "box.stl").read_bytes())}, timeout=30)
-        assert r.status_code == 200 and r.json()["mass"] == pytest.approx(6000, rel=1e-14)
+        assert r.status_code == 200 and r.json()["mass"] == pytest.approx(6000, rel=1e-14, abs=0)
 
 
 @pytest.mark.filterwarnings("ignore:Port 8787 is already in use")  # a dashboard elsewhere on this machine
@@ -155,7 +155,7 @@ def test_cli_batch_runs_on_an_existing_dask_cluster(tmp_path: Path) -> None:
     lines = {Path(x["source"]["filename"]).name: x for x in map(json.loads, out.read_text().splitlines())}
     assert set(lines) == {"box.stl", "open_box.stl", "tetrahedron.stl"}
     assert lines["open_box.stl"]["error"]["code"] == "not_watertight"
-    assert lines["tetrahedron.stl"]["mass"] == pytest.approx(1000 / 6, rel=1e-14)
+    assert lines["tetrahedron.stl"]["mass"] == pytest.approx(1000 / 6, rel=1e-14, abs=0)
 
 
 def test_cli_batch_reads_xyz_files_from_a_folder(tmp_path: Path) -> None:

@@ -32,17 +32,17 @@ from tests.contract.helpers import (
 
 def test_format_parameter_overrides_the_file_name(client: TestClient) -> None:
     res = analyze(client, "blob.bin", (SAMPLES / "box.stl").read_bytes(), format="stl")
-    assert res["mass"] == pytest.approx(6000, rel=1e-14)
+    assert res["mass"] == pytest.approx(6000, rel=1e-14, abs=0)
     assert res["source"]["format"] == "stl"
 
 
 def test_volume_mesh_cell_density_takes_precedence_and_mass_scales_it(client: TestClient) -> None:
     base = analyze(client, "two_density.vtu", density=5)
-    assert base["mass"] == pytest.approx(9000, rel=1e-12)
+    assert base["mass"] == pytest.approx(9000, rel=1e-12, abs=0)
     np.testing.assert_allclose(base["principal"]["moments"], [1500, 21500 / 9, 21500 / 9], rtol=1e-12)
     np.testing.assert_allclose(base["center_of_mass"], [12.5 / 9, 0.5, 0.5], rtol=1e-12)
     scaled = analyze(client, "two_density.vtu", mass=18)
-    assert scaled["mass"] == pytest.approx(18, rel=1e-12)
+    assert scaled["mass"] == pytest.approx(18, rel=1e-12, abs=0)
     np.testing.assert_allclose(scaled["principal"]["moments"], np.array([1500, 21500 / 9, 21500 / 9]) * 18 / 9000, rtol=1e-12)
     np.testing.assert_allclose(scaled["center_of_mass"], [12.5 / 9, 0.5, 0.5], rtol=1e-12)
 
@@ -80,7 +80,7 @@ def test_surface_formats_give_the_same_box(client: TestClient, fmt: str) -> None
     }
     res = analyze(client, f"box.{fmt}", writers[fmt](v, BOX_FACES))
     assert res["source"]["format"] == fmt
-    assert res["mass"] == pytest.approx(6000, rel=1e-14)
+    assert res["mass"] == pytest.approx(6000, rel=1e-14, abs=0)
     np.testing.assert_allclose(res["center_of_mass"], [1.5, 0, 3.5], rtol=0, atol=1e-14 * 4)
     np.testing.assert_allclose(res["inertia_tensor"], box_inertia(6000, 1, 2, 3), rtol=0, atol=1e-12 * 6500)
     check_classification(res, "asymmetric_top")
@@ -96,12 +96,12 @@ def check_two_box_scene(res: dict[str, Any], s: float = 1.0) -> None:
     assert set(parts) == {"alpha", "beta"}, "parts are named after the scene's nodes"
     for name, m, c, I in (("alpha", ma, ca, Ia), ("beta", mb, cb, Ib)):
         p = parts[name]
-        assert p["mass"] == pytest.approx(m, rel=1e-12)
+        assert p["mass"] == pytest.approx(m, rel=1e-12, abs=0)
         np.testing.assert_allclose(p["center_of_mass"], c, rtol=0, atol=1e-12 * s)
         np.testing.assert_allclose(p["inertia_tensor"], I, rtol=0, atol=1e-12 * np.trace(I))
     M = ma + mb
     com = (ma * ca + mb * cb) / M
-    assert res["mass"] == pytest.approx(M, rel=1e-12)
+    assert res["mass"] == pytest.approx(M, rel=1e-12, abs=0)
     np.testing.assert_allclose(res["center_of_mass"], com, rtol=0, atol=1e-12 * s)
     want = parallel_axis(Ia, ma, ca - com) + parallel_axis(Ib, mb, cb - com)
     np.testing.assert_allclose(res["inertia_tensor"], want, rtol=0, atol=1e-12 * np.trace(want))
@@ -186,7 +186,7 @@ def test_volume_meshes_with_cell_density(client: TestClient, fmt: str, tmp_path:
         else:
             meshio.write(path, mesh)
     res = analyze(client, path.name, path.read_bytes(), density=1)
-    assert res["mass"] == pytest.approx(9000, rel=1e-12)
+    assert res["mass"] == pytest.approx(9000, rel=1e-12, abs=0)
     np.testing.assert_allclose(res["center_of_mass"], [12.5 / 9, 0.5, 0.5], rtol=1e-12)
     np.testing.assert_allclose(res["principal"]["moments"], TWO_CUBES_MOMENTS, rtol=1e-12)
     check_classification(res, "symmetric_top", "prolate")
@@ -200,8 +200,8 @@ def test_volume_mesh_without_density_array_uses_the_density_option(client: TestC
     path = tmp_path / "plain.vtu"
     meshio.write(path, meshio.Mesh(points, [("tetra", cells)]))
     res = analyze(client, "plain.vtu", path.read_bytes(), density=500)
-    assert res["mass"] == pytest.approx(1000, rel=1e-12)
-    assert res["volume"] == pytest.approx(2, rel=1e-12)
+    assert res["mass"] == pytest.approx(1000, rel=1e-12, abs=0)
+    assert res["volume"] == pytest.approx(2, rel=1e-12, abs=0)
     np.testing.assert_allclose(res["inertia_tensor"], box_inertia(1000, 2, 1, 1), rtol=0, atol=1e-12 * 500)
 
 
@@ -217,12 +217,12 @@ def test_volume_mesh_cell_blocks_are_parts(client: TestClient, tmp_path: Path) -
     meshio.write(path, mesh)
     res = analyze(client, "blocks.vtu", path.read_bytes())
     assert len(res["parts"]) == 2
-    assert sorted(p["mass"] for p in res["parts"]) == pytest.approx([1000, 1000], rel=1e-12)
+    assert sorted(p["mass"] for p in res["parts"]) == pytest.approx([1000, 1000], rel=1e-12, abs=0)
     coms = sorted(tuple(p["center_of_mass"]) for p in res["parts"])
     np.testing.assert_allclose(coms, [[0.5, 0.5, 0.5], [3.5, 0.5, 0.5]], rtol=1e-12)
     for p in res["parts"]:
         np.testing.assert_allclose(p["inertia_tensor"], np.eye(3) * 1000 / 6, rtol=0, atol=1e-12 * 1000)
-    assert res["mass"] == pytest.approx(2000, rel=1e-12)
+    assert res["mass"] == pytest.approx(2000, rel=1e-12, abs=0)
     np.testing.assert_allclose(res["center_of_mass"], [2, 0.5, 0.5], rtol=1e-12)
 
 
@@ -238,9 +238,23 @@ def test_obj_groups_are_parts(client: TestClient) -> None:
     )
     parts = {p["name"]: p for p in res["parts"]}
     assert set(parts) == {"left", "right"}
-    assert parts["left"]["mass"] == pytest.approx(1000, rel=1e-13)
-    assert parts["right"]["mass"] == pytest.approx(500, rel=1e-13)
-    assert res["mass"] == pytest.approx(1500, rel=1e-13)
+    assert parts["left"]["mass"] == pytest.approx(1000, rel=1e-13, abs=0)
+    assert parts["right"]["mass"] == pytest.approx(500, rel=1e-13, abs=0)
+    assert res["mass"] == pytest.approx(1500, rel=1e-13, abs=0)
+
+
+@pytest.mark.xfail(
+    strict=True,
+    reason="the OBJ reader gives every object the file's whole vertex list, so source.vertices counts "
+    "each vertex once per object (service/load, reported to its owner)",
+)
+@pytest.mark.parametrize("objects", [2, 3])
+def test_source_counts_each_vertex_of_a_multi_object_obj_once(client: TestClient, objects: int) -> None:
+    # API.md's source section counts the body's vertices (8 for a box); n cubes written as n objects hold 8 n
+    text = obj_bytes([(f"cube{i}", box_corners(1, 1, 1) + np.array([2 * i, 0, 0]), BOX_FACES) for i in range(objects)])
+    source = analyze(client, "cubes.obj", text)["source"]
+    assert source["triangles"] == 12 * objects
+    assert source["vertices"] == 8 * objects
 
 
 def test_pyramid_and_wedge_cells(client: TestClient, tmp_path: Path) -> None:
@@ -272,7 +286,7 @@ def test_pyramid_and_wedge_cells(client: TestClient, tmp_path: Path) -> None:
     path = tmp_path / "pw.vtu"
     meshio.write(path, meshio.Mesh(np.array(pts), [("pyramid", np.array(pyramids)), ("wedge", np.array(wedges))]))
     res = analyze(client, "pw.vtu", path.read_bytes())
-    assert res["mass"] == pytest.approx(2000, rel=1e-14)
+    assert res["mass"] == pytest.approx(2000, rel=1e-14, abs=0)
     np.testing.assert_allclose(res["center_of_mass"], [1, 0.5, 0.5], rtol=1e-14)
     np.testing.assert_allclose(res["inertia_tensor"], box_inertia(2000, 2, 1, 1), rtol=0, atol=1e-13 * 2000)
-    assert sorted(p["mass"] for p in res["parts"]) == pytest.approx([1000, 1000], rel=1e-14)
+    assert sorted(p["mass"] for p in res["parts"]) == pytest.approx([1000, 1000], rel=1e-14, abs=0)

@@ -61,7 +61,7 @@ def test_sample_mesh_matches_published_values(
     client: TestClient, filename: str, mass: float, com: Any, moments: Any, kind: str, shape: str | None
 ) -> None:
     res = analyze(client, filename)
-    assert res["mass"] == pytest.approx(mass, rel=1e-10)
+    assert res["mass"] == pytest.approx(mass, rel=1e-10, abs=0)
     size = max(1.0, float(np.max(np.abs(com))))
     np.testing.assert_allclose(res["center_of_mass"], com, rtol=0, atol=1e-10 * size)
     np.testing.assert_allclose(res["principal"]["moments"], moments, rtol=1e-10)
@@ -96,14 +96,14 @@ def test_box_tensor_in_input_frame_and_reference_by_parallel_axis_theorem(client
         rtol=0,
         atol=1e-12 * 26000,
     )
-    assert res["volume"] == pytest.approx(6.0, rel=1e-15)
+    assert res["volume"] == pytest.approx(6.0, rel=1e-15, abs=0)
     assert res["density"] == RHO
 
 
 def test_inverted_winding_is_corrected_with_a_warning(client: TestClient) -> None:
     good = analyze(client, "box.stl")
     bad = analyze(client, "inverted_box.stl")
-    assert bad["mass"] == pytest.approx(good["mass"], rel=1e-15)
+    assert bad["mass"] == pytest.approx(good["mass"], rel=1e-15, abs=0)
     np.testing.assert_allclose(bad["inertia_tensor"], good["inertia_tensor"], rtol=0, atol=1e-12 * 6500)
     np.testing.assert_allclose(bad["principal"]["moments"], good["principal"]["moments"], rtol=1e-14)
     assert bad["warnings"], "inverted winding must be reported in warnings"
@@ -155,7 +155,7 @@ def test_far_from_origin_binary_stl_uses_its_float32_coordinates(client: TestCli
     mass, _com, inertia, _ = exact_of("far32.stl", data)
     est = res["diagnostics"]["relative_error_estimate"]
     assert est <= 1e-12
-    assert res["mass"] == pytest.approx(float(mass), rel=1e-13)
+    assert res["mass"] == pytest.approx(float(mass), rel=1e-13, abs=0)
     for got, want in zip(res["principal"]["moments"], exact_moments(inertia)):
         assert abs(got - want) <= max(est, 2.3e-16) * want, (got, want, est)
 
@@ -192,9 +192,9 @@ def test_units_convert_file_lengths_to_si(client: TestClient, unit: str) -> None
     res = analyze(client, "box.stl", units=unit, reference="1,0,0")
     m = 6 * s**3 * RHO
     assert res["source"]["units"] == unit
-    assert res["mass"] == pytest.approx(m, rel=1e-13)
-    assert res["volume"] == pytest.approx(6 * s**3, rel=1e-13)
-    assert res["density"] == pytest.approx(RHO, rel=1e-15)
+    assert res["mass"] == pytest.approx(m, rel=1e-13, abs=0)
+    assert res["volume"] == pytest.approx(6 * s**3, rel=1e-13, abs=0)
+    assert res["density"] == pytest.approx(RHO, rel=1e-15, abs=0)
     np.testing.assert_allclose(res["center_of_mass"], np.array([0.5, 1, 1.5]) * s, rtol=1e-14)
     I_com = box_inertia(m, s, 2 * s, 3 * s)
     np.testing.assert_allclose(res["inertia_tensor"], I_com, rtol=0, atol=1e-12 * np.trace(I_com))
@@ -214,16 +214,16 @@ def test_reference_at_the_centre_of_mass_in_millimetres_gives_the_central_tensor
 
 def test_density_option_scales_mass_and_inertia(client: TestClient) -> None:
     res = analyze(client, "box.stl", density=7850)
-    assert res["mass"] == pytest.approx(6 * 7850, rel=1e-14)
+    assert res["mass"] == pytest.approx(6 * 7850, rel=1e-14, abs=0)
     assert res["density"] == 7850
     np.testing.assert_allclose(res["principal"]["moments"], np.array([2500, 5000, 6500]) * 7.85, rtol=1e-13)
 
 
 def test_mass_option_derives_the_density(client: TestClient) -> None:
     res = analyze(client, "box.stl", mass=12)
-    assert res["mass"] == pytest.approx(12, rel=1e-14)
-    assert res["density"] == pytest.approx(2.0, rel=1e-14)
-    assert res["volume"] == pytest.approx(6.0, rel=1e-14)
+    assert res["mass"] == pytest.approx(12, rel=1e-14, abs=0)
+    assert res["density"] == pytest.approx(2.0, rel=1e-14, abs=0)
+    assert res["volume"] == pytest.approx(6.0, rel=1e-14, abs=0)
     np.testing.assert_allclose(res["principal"]["moments"], np.array([2500, 5000, 6500]) * 12 / 6000, rtol=1e-13)
 
 
@@ -235,7 +235,7 @@ def test_density_and_mass_are_exclusive(client: TestClient) -> None:
 def test_shell_thickness_is_in_file_units(client: TestClient) -> None:
     res = analyze(client, "box.stl", model="shell", thickness=0.1, units="mm")
     M, _com, I = thin_box_shell_inertia(1e-3, 2e-3, 3e-3, RHO * 1e-4)
-    assert res["mass"] == pytest.approx(M, rel=1e-3)
+    assert res["mass"] == pytest.approx(M, rel=1e-3, abs=0)
     np.testing.assert_allclose(res["inertia_tensor"], I, rtol=0, atol=1e-3 * np.trace(I))
 
 
@@ -243,7 +243,7 @@ def test_shell_model_accepts_an_open_surface(client: TestClient) -> None:
     t = 1e-4
     res = analyze(client, "open_box.stl", model="shell", thickness=t)
     M, com, I = thin_box_shell_inertia(1, 2, 3, RHO * t, faces=("x0", "y0", "y1", "z0", "z1"))
-    assert res["mass"] == pytest.approx(M, rel=1e-3)
+    assert res["mass"] == pytest.approx(M, rel=1e-3, abs=0)
     np.testing.assert_allclose(res["center_of_mass"], com, atol=1e-3)
     np.testing.assert_allclose(res["inertia_tensor"], I, rtol=0, atol=1e-3 * np.trace(I))
 
@@ -258,7 +258,7 @@ def test_tolerance_decides_which_moments_are_equal(client: TestClient) -> None:
     loose = analyze(client, "hex_prism.stl")
     check_classification(loose, "symmetric_top", "prolate")
     kappa = loose["classification"]["asymmetry"]
-    assert kappa == pytest.approx(ray_kappa(loose["principal"]["moments"]), rel=1e-12)
+    assert kappa == pytest.approx(ray_kappa(loose["principal"]["moments"]), rel=1e-12, abs=0)
     assert kappa != -1.0, "asymmetry is computed from the reported moments, not rounded to -1"
     assert kappa == pytest.approx(-1, abs=1e-6)
     strict = analyze(client, "hex_prism.stl", tolerance="1e-10")
@@ -284,10 +284,10 @@ def test_parts_of_a_scene_with_densities_per_part(client: TestClient) -> None:
     assert set(parts) == {"left", "right"}
     for name, m, c in (("left", 1000, [0.5, 0.5, 0.5]), ("right", 3000, [2.5, 0.5, 0.5])):
         p = parts[name]
-        assert p["mass"] == pytest.approx(m, rel=1e-13)
+        assert p["mass"] == pytest.approx(m, rel=1e-13, abs=0)
         np.testing.assert_allclose(p["center_of_mass"], c, rtol=1e-13)
         np.testing.assert_allclose(p["inertia_tensor"], np.eye(3) * m / 6, rtol=0, atol=1e-12 * m)
-    assert res["mass"] == pytest.approx(4000, rel=1e-13)
+    assert res["mass"] == pytest.approx(4000, rel=1e-13, abs=0)
     com = np.array([2.0, 0.5, 0.5])
     np.testing.assert_allclose(res["center_of_mass"], com, rtol=1e-13)
     want = parallel_axis(np.eye(3) * 1000 / 6, 1000, np.array([0.5, 0.5, 0.5]) - com) + parallel_axis(
@@ -300,9 +300,9 @@ def test_parts_of_a_scene_with_densities_per_part(client: TestClient) -> None:
 def test_parts_without_densities_use_the_density_option(client: TestClient) -> None:
     res = analyze(client, "pair.obj", two_cube_obj(), density=2000)
     assert {p["name"] for p in res["parts"]} == {"left", "right"}
-    assert res["mass"] == pytest.approx(4000, rel=1e-13)
+    assert res["mass"] == pytest.approx(4000, rel=1e-13, abs=0)
     for p in res["parts"]:
-        assert p["mass"] == pytest.approx(2000, rel=1e-13)
+        assert p["mass"] == pytest.approx(2000, rel=1e-13, abs=0)
 
 
 def test_single_body_has_no_parts(client: TestClient) -> None:
@@ -377,7 +377,7 @@ def test_random_convex_body_far_from_the_origin_within_the_estimate(client: Test
     mass, _com, inertia, _ = exact_mass_properties(v[faces])
     est = res["diagnostics"]["relative_error_estimate"]
     assert est <= 1e-12
-    assert res["mass"] == pytest.approx(float(mass), rel=1e-13)
+    assert res["mass"] == pytest.approx(float(mass), rel=1e-13, abs=0)
     for got, want in zip(res["principal"]["moments"], exact_moments(inertia)):
         assert abs(got - want) <= max(est, 2.3e-16) * want, (got, want, est)
     check_principal(res)
@@ -403,10 +403,10 @@ def test_parts_carry_their_own_frames_consistently(client: TestClient) -> None:
 
 def test_mass_option_scales_parts_with_their_own_densities(client: TestClient) -> None:
     res = analyze(client, "pair.obj", two_cube_obj(), densities=json.dumps({"left": 1000, "right": 3000}), mass=8)
-    assert res["mass"] == pytest.approx(8, rel=1e-13)
+    assert res["mass"] == pytest.approx(8, rel=1e-13, abs=0)
     parts = {p["name"]: p for p in res["parts"]}
-    assert parts["left"]["mass"] == pytest.approx(2, rel=1e-13)
-    assert parts["right"]["mass"] == pytest.approx(6, rel=1e-13)
+    assert parts["left"]["mass"] == pytest.approx(2, rel=1e-13, abs=0)
+    assert parts["right"]["mass"] == pytest.approx(6, rel=1e-13, abs=0)
     np.testing.assert_allclose(res["center_of_mass"], [2.0, 0.5, 0.5], rtol=1e-13)
 
 
@@ -415,8 +415,8 @@ def test_cavity_is_subtracted_not_mistaken_for_inverted_winding(client: TestClie
     v = np.vstack([outer, inner])
     f = np.vstack([BOX_FACES, BOX_FACES[:, ::-1] + 8])  # the cavity's faces point into the hole
     res = analyze(client, "hollow.stl", stl_bytes(v, f))
-    assert res["mass"] == pytest.approx(RHO * (64 - 8), rel=1e-14)
-    assert res["volume"] == pytest.approx(56, rel=1e-14)
+    assert res["mass"] == pytest.approx(RHO * (64 - 8), rel=1e-14, abs=0)
+    assert res["volume"] == pytest.approx(56, rel=1e-14, abs=0)
     I = box_inertia(64000, 4, 4, 4) - box_inertia(8000, 2, 2, 2)
     np.testing.assert_allclose(res["inertia_tensor"], I, rtol=0, atol=1e-13 * np.trace(I))
     check_classification(res, "spherical_top")
@@ -426,7 +426,7 @@ def test_a_separate_inverted_shell_is_corrected_with_a_warning(client: TestClien
     v = np.vstack([box_corners(1, 1, 1), box_corners(1, 1, 1) + np.array([3, 0, 0])])
     f = np.vstack([BOX_FACES, BOX_FACES[:, ::-1] + 8])
     res = analyze(client, "two.stl", stl_bytes(v, f))
-    assert res["mass"] == pytest.approx(2000, rel=1e-14)
+    assert res["mass"] == pytest.approx(2000, rel=1e-14, abs=0)
     np.testing.assert_allclose(res["center_of_mass"], [2, 0.5, 0.5], rtol=1e-14)
     assert res["warnings"]
 
@@ -435,7 +435,7 @@ def test_inconsistent_winding_is_repaired_with_a_warning(client: TestClient) -> 
     f = BOX_FACES.copy()
     f[[0, 5, 9]] = f[[0, 5, 9]][:, ::-1]
     res = analyze(client, "mixed.stl", stl_bytes(box_corners(1, 2, 3), f))
-    assert res["mass"] == pytest.approx(6000, rel=1e-14)
+    assert res["mass"] == pytest.approx(6000, rel=1e-14, abs=0)
     np.testing.assert_allclose(res["inertia_tensor"], box_inertia(6000, 1, 2, 3), rtol=0, atol=1e-12 * 6500)
     assert res["warnings"]
 
@@ -446,6 +446,6 @@ def test_v11_sections_absent_unless_asked(client: TestClient) -> None:
     assert res.status_code == 200
     doc = res.json()
     assert not {"export", "frame", "rotational_constants"} & set(doc)
-    assert doc["surface_area"] == pytest.approx(2 * (1 * 2 + 2 * 3 + 3 * 1), rel=1e-12)  # the 1 x 2 x 3 m box
+    assert doc["surface_area"] == pytest.approx(2 * (1 * 2 + 2 * 3 + 3 * 1), rel=1e-12, abs=0)  # the 1 x 2 x 3 m box
     m, moments = doc["mass"], doc["principal"]["moments"]
-    assert doc["principal"]["radii_of_gyration"] == pytest.approx([math.sqrt(i / m) for i in moments], rel=1e-12)
+    assert doc["principal"]["radii_of_gyration"] == pytest.approx([math.sqrt(i / m) for i in moments], rel=1e-12, abs=0)

@@ -57,7 +57,7 @@ def test_shell_model_integrates_a_thin_wall_of_given_thickness(client: TestClien
     t = 1e-4  # file units (m): thin against the 1 x 2 x 3 box, so wall placement is second order
     res = analyze(client, "box.stl", model="shell", thickness=t)
     M, com, I = thin_box_shell_inertia(1, 2, 3, RHO * t)
-    assert res["mass"] == pytest.approx(M, rel=1e-3)
+    assert res["mass"] == pytest.approx(M, rel=1e-3, abs=0)
     np.testing.assert_allclose(res["center_of_mass"], com, atol=1e-3)
     np.testing.assert_allclose(res["inertia_tensor"], I, rtol=0, atol=1e-3 * np.trace(I))
     assert "volume" not in res and "density" not in res, "volume, density: solids only"
@@ -77,9 +77,9 @@ def test_precession_from_principal_moments_asymmetric_intermediate_start(client:
     A = np.asarray(res["principal"]["axes"])
     np.testing.assert_allclose(pre["omega_body"], A @ omega, atol=1e-15)
     T = ll_asymmetric_period(moments, omega)
-    assert pre["period"] == pytest.approx(T, rel=1e-10)
+    assert pre["period"] == pytest.approx(T, rel=1e-10, abs=0)
     assert pre["stable"] is False
-    assert pre["flip_interval"] == pytest.approx(T / 2, rel=1e-10)
+    assert pre["flip_interval"] == pytest.approx(T / 2, rel=1e-10, abs=0)
     check_trajectory(pre, moments, A, omega, 10.0, 41, np.diag(moments))
 
 
@@ -89,7 +89,7 @@ def test_asymmetric_period_both_branches_and_stable_starts(client: TestClient, o
     pre = precession_ok(client, {"principal_moments": moments, "omega": omega, "duration": 6, "samples": 13})["precession"]
     assert pre["regime"] == "asymmetric"
     T = ll_asymmetric_period(moments, omega)
-    assert pre["period"] == pytest.approx(T, rel=1e-10)
+    assert pre["period"] == pytest.approx(T, rel=1e-10, abs=0)
     assert pre["stable"] is True
     assert "flip_interval" not in pre
     check_trajectory(pre, moments, np.eye(3), omega, 6.0, 13, np.diag(moments))
@@ -133,7 +133,7 @@ def test_precession_from_a_rotated_inertia_tensor(client: TestClient) -> None:
     A = np.asarray(res["principal"]["axes"])
     np.testing.assert_allclose(pre["omega_body"], A @ omega, atol=1e-13)
     Wb = R.T @ omega
-    assert pre["period"] == pytest.approx(ll_asymmetric_period(moments, Wb), rel=1e-9)
+    assert pre["period"] == pytest.approx(ll_asymmetric_period(moments, Wb), rel=1e-9, abs=0)
     check_trajectory(pre, moments, A, omega, 5.0, 11, I)
 
 
@@ -163,7 +163,7 @@ def test_symmetric_mesh_regular_precession_in_the_input_frame(client: TestClient
     check_invariants(pre, I, omega)
     I_perp = res["principal"]["moments"][0]
     I_sym = res["principal"]["moments"][2]
-    assert I_perp == pytest.approx(125 / 12, rel=1e-12) and I_sym == pytest.approx(50 / 3, rel=1e-12)
+    assert I_perp == pytest.approx(125 / 12, rel=1e-12, abs=0) and I_sym == pytest.approx(50 / 3, rel=1e-12, abs=0)
     check_symmetric_rates(pre, I_perp, I_sym, n, omega)
     check_trajectory(pre, res["principal"]["moments"], res["principal"]["axes"], omega, 5.0, 6, I)
 
@@ -177,9 +177,9 @@ def test_asymmetric_mesh_precession_in_the_input_frame(client: TestClient) -> No
     assert pre["regime"] == "asymmetric"
     # principal axes are ±z, ±y, ±x: the period depends only on the squares of Ω
     T = ll_asymmetric_period([2500, 5000, 6500], [0.1, 2.0, 0.1])
-    assert pre["period"] == pytest.approx(T, rel=1e-10)
+    assert pre["period"] == pytest.approx(T, rel=1e-10, abs=0)
     assert pre["stable"] is False
-    assert pre["flip_interval"] == pytest.approx(T / 2, rel=1e-10)
+    assert pre["flip_interval"] == pytest.approx(T / 2, rel=1e-10, abs=0)
     check_trajectory(pre, [2500, 5000, 6500], res["principal"]["axes"], omega, 10.0, 21, I)
 
 
@@ -264,8 +264,8 @@ def test_linear_rotator_precession(client: TestClient) -> None:
     assert pre["regime"] == "rotator"
     I = 2 / 3
     np.testing.assert_allclose(pre["angular_momentum"], [0, 0, 2 * I], atol=1e-14)
-    assert pre["angular_momentum_magnitude"] == pytest.approx(2 * I, rel=1e-14)
-    assert pre["kinetic_energy"] == pytest.approx(0.5 * I * 4, rel=1e-14)
+    assert pre["angular_momentum_magnitude"] == pytest.approx(2 * I, rel=1e-14, abs=0)
+    assert pre["kinetic_energy"] == pytest.approx(0.5 * I * 4, rel=1e-14, abs=0)
     tr = pre["trajectory"]
     np.testing.assert_allclose(tr["t"], [0, 1, 2, 3], atol=1e-15)
     for t, q, w in zip(tr["t"], tr["quaternion"], tr["omega"]):
@@ -332,9 +332,9 @@ def test_period_near_the_separatrix(client: TestClient, eps: float) -> None:
     omega = [0.1 * math.sqrt(3) * (1 + eps), 1.0, 0.1]
     pre = precession_ok(client, {"principal_moments": moments, "omega": omega})["precession"]
     T = ll_asymmetric_period(moments, omega)
-    assert pre["period"] == pytest.approx(T, rel=1e-9)
+    assert pre["period"] == pytest.approx(T, rel=1e-9, abs=0)
     assert pre["stable"] is False
-    assert pre["flip_interval"] == pytest.approx(T / 2, rel=1e-9)
+    assert pre["flip_interval"] == pytest.approx(T / 2, rel=1e-9, abs=0)
 
 
 def test_separatrix_of_a_mesh_body(client: TestClient) -> None:
@@ -392,5 +392,5 @@ def test_moments_equal_only_within_tolerance_are_not_rounded_in_momentum_and_ene
     moments, omega = [1.0, 2.0, 2.0 + 1e-9], [0.3, 0.4, 0.5]
     res = precession_ok(client, {"principal_moments": moments, "omega": omega})
     assert res["classification"]["kind"] == "symmetric_top"
-    assert res["classification"]["asymmetry"] == pytest.approx(ray_kappa(moments), rel=1e-12)
+    assert res["classification"]["asymmetry"] == pytest.approx(ray_kappa(moments), rel=1e-12, abs=0)
     check_invariants(res["precession"], np.diag(moments), omega)
