@@ -25,7 +25,6 @@ from benchmarks.stability import (
     BOUND_INVARIANT,
     BOUND_THIN,
     DIRECTION,
-    HORIZON,
     MeshCase,
     geometry_cases,
     measure_motion,
@@ -144,5 +143,7 @@ def test_exact_motion_keeps_invariants_over_1e5_time_units(case: Any) -> None:
     assert row["energy_drift"] <= BOUND_INVARIANT, row
     assert row["momentum_drift"] <= BOUND_INVARIANT, row
     # Omega(t) against the mpmath closed form: only the phase error of a rounded frequency
-    rate_times_t = float(np.linalg.norm(case.omega)) * HORIZON
+    rate_times_t = float(np.linalg.norm(case.omega)) * case.horizon
     assert row["omega_error"] <= 1e3 * EPS * max(rate_times_t, 1.0), row
+    # where the service states a bound on Omega(t) (a long horizon), the error is within it
+    assert row["stated"] is None or row["omega_error"] <= row["stated"], row

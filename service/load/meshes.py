@@ -37,11 +37,11 @@ def read_surface_parts(
     if fmt == "obj":
         from .obj import read_obj
 
-        groups = guarded_read(lambda: read_obj(data), fmt)  # our reader; any slip still becomes a sentence
+        groups, notes = guarded_read(lambda: read_obj(data), fmt)  # our reader; any slip still becomes a sentence
         parts = [mesh_part(name or "body", v, f, length_scale, "obj") for name, v, f in groups]
         if len(parts) == 1 and not groups[0][0]:
             parts = [mesh_part("body", groups[0][1], groups[0][2], length_scale, "obj")]
-        return parts, None, []
+        return parts, None, notes
     if fmt == "3mf":
         from .threemf import read_3mf
 
@@ -119,11 +119,52 @@ def read_trimesh_parts(
     if not parts:
         what = " (only points or lines)" if skipped else ""
         raise EmptyGeometryError(f"the {fmt.upper()} file holds no triangles{what}; a solid needs a triangle mesh", format=fmt)
+    if fmt == "ply":
+        notes += _ply_split_notes(scene)
     if notes:
         first = parts[0]
         assert isinstance(first.body, MeshBody)
         parts[0] = Part(first.name, replace(first.body, warnings=(*first.body.warnings, *notes)))
     return parts, _declared_unit(scene, fmt)
+
+
+def _ply_split_notes(scene: Any) -> list[str]:
+    """``polygons.fan_split_note`` on the PLY's faces as written (trimesh keeps them as ``_ply_raw``)."""
+    from .polygons import fan_split_note
+
+    notes = []
+    for geom in scene.geometry.values():
+        raw = (getattr(geom, "metadata", None) or {}).get("_ply_raw")
+        faces = _ply_face_lists(raw)
+        if faces is None:
+            continue
+        counts = np.fromiter((len(f) for f in faces), dtype=np.int64, count=len(faces))
+        if not np.any(counts >= 4) or counts.min() < 3:
+            continue
+        corners = np.concatenate([np.asarray(f, dtype=np.int64) for f in faces])
+        if corners.min() < 0 or corners.max() >= len(geom.vertices):
+            continue  # the reader's own checks report a bad index
+        note = fan_split_note(np.asarray(geom.vertices, dtype=np.float64), corners, counts, "ply")
+        if note:
+            notes.append(note)
+    return notes
+
+
+def _ply_face_lists(raw: Any) -> list[Any] | None:
+    """Each face's vertex list from trimesh's raw PLY elements (a dict of arrays or a structured array), or None."""
+    try:
+        data = raw["face"]["data"]
+        for key in ("vertex_indices", "vertex_index"):
+            named = isinstance(data, np.ndarray) and bool(data.dtype.names) and key in (data.dtype.names or ())
+            if not ((isinstance(data, dict) and key in data) or named):
+                continue
+            array = np.asarray(data[key])
+            if array.dtype.names and "f1" in array.dtype.names:  # binary lists of one length: (count, indices)
+                array = np.asarray(array["f1"])
+            return list(array) if array.ndim in (1, 2) and not array.dtype.names else None
+        return None
+    except (KeyError, TypeError, IndexError, ValueError):
+        return None
 
 
 def _gltf_document(data: bytes, fmt: str) -> Any:

@@ -8,6 +8,9 @@ the body (``CAPABILITIES``), and joins the stages, one module each:
     methods.py     Setup + times -> Omega(t), attitude: one class per method, with its capabilities
     integrators.py the numerical integrators (scipy imported only when one runs)
     symmetric.py, jacobi.py, elliptic.py  the closed forms
+    accuracy.py    what the invariant drifts cannot show: the phase error of long horizons (warned
+                   about, or refused where float64 cannot place the phase), and how far a numerical
+                   method departs from the exact solution (warned about)
     scaling.py     the units of the computation: moments and Omega scaled by exact powers of two
                    so that nothing overflows at any scale, and the results taken back (or refused
                    when a reported number would leave float64's normal range)
@@ -85,6 +88,7 @@ from ..errors import InvalidParameterError
 from ..principal import PrincipalFrame
 from ..tolerances import DEFAULT_TOLERANCES, Tolerances
 from . import quaternions as quat
+from .accuracy import departure_warning, phase_warnings
 from .invariants import RigidProblem, invariant_drifts
 from .methods import CAPABILITIES, EXACT_REST, method_for
 from .quantities import precession_quantities
@@ -148,9 +152,15 @@ def predict_motion(
     if times is None:
         motion = units.restore(motion, None)
         return replace(motion, diagnostics=MotionDiagnostics(elapsed_s=time.perf_counter() - started))
+    notes = phase_warnings(setup, motion, float(times[-1]))  # refuses a horizon whose phase float64 cannot place
     # a body at rest stays at rest: no method needs to integrate that
     propagator = EXACT_REST if setup.regime is Regime.REST else chosen
     omega_body, attitude = propagator.propagate(setup, times, tolerances)
+    if propagator is not EXACT_REST:  # a numerical method: how far it is from the exact motion
+        exact_omega, _ = EXACT_REST.propagate(setup, times, tolerances)
+        speed = float(np.linalg.norm(setup.problem.omega_body))
+        notes += departure_warning(chosen.name.value, omega_body, exact_omega, speed)
+    motion = replace(motion, warnings=(*motion.warnings, *notes))
     trajectory = _trajectory(setup.problem, times, omega_body, attitude)
     energy_drift, momentum_drift = invariant_drifts(setup.problem, trajectory.omega_body, trajectory.quaternion)
     motion = units.restore(replace(motion, trajectory=trajectory), given_times)

@@ -1,0 +1,95 @@
+"""What the invariant drifts cannot show is said: the phase error of long horizons, a numerical method's error.
+
+A trajectory can keep E and M to 1e-16 and still be at the wrong place on its orbit.  Before, a
+horizon of 1e15 rad came back with Omega(t) off by 0.07 of |Omega| (and by 0.5 at 1e16 rad) and
+dop853 started 1 ulp off the separatrix by 0.2 (rk45 and splitting by 2.1), all with drifts of
+1e-10 or less and no word.  References: L&L §37's closed form in mpmath (``elliptic_reference``).
+"""
+
+from __future__ import annotations
+
+import re
+import warnings
+from types import SimpleNamespace
+from typing import Any
+
+import numpy as np
+import pytest
+from fastapi.testclient import TestClient
+
+from inertia import precession
+from inertia.errors import MotionError
+from inertia.motion import predict_motion
+from tests.support.motion import body, elliptic_reference
+
+MOMENTS, OMEGA = (1.0, 2.0, 3.0), (1.0, 0.01, 0.5)
+
+
+def _quoted(pattern: str, texts: Any) -> float:
+    for text in texts:
+        found = re.search(pattern, text)
+        if found:
+            return float(found.group(1))
+    raise AssertionError(f"no warning matches {pattern!r}: {texts}")
+
+
+def _tail_error(res: Any, moments: Any, omega: Any, tail: int = 3) -> float:
+    trajectory = res.motion.trajectory
+    reference = elliptic_reference(moments, omega, trajectory.t[-tail:], dps=60)
+    return float(np.max(np.abs(trajectory.omega_body[-tail:] - reference))) / float(np.linalg.norm(omega))
+
+
+@pytest.mark.parametrize("duration", [1e9, 1e12])
+def test_a_long_horizon_states_its_phase_error_and_it_holds(duration: float) -> None:
+    res = precession(OMEGA, principal_moments=MOMENTS, duration=duration, samples=11)
+    stated = _quoted(r"accurate to about ([0-9.e+-]+) of \|omega\|", res.warnings)
+    error = _tail_error(res, MOMENTS, OMEGA)
+    assert error <= stated, (error, stated)
+    assert res.motion.diagnostics.energy_drift is not None and res.motion.diagnostics.energy_drift <= 1e-15
+
+
+def test_a_needle_like_top_states_the_error_of_its_largest_component() -> None:
+    """I1 = 1e-9: Omega1 swings to 200 |Omega(0)| at ~1e3 rad/s; the error is that amplitude's."""
+    moments, omega = (1e-9, 1.0, 1.001), (0.3, 0.2, 1.0)  # a principal frame, as a mesh's could be
+    frame, classification = body(moments, tolerance=1e-12)
+    motion = predict_motion(frame, classification, np.asarray(omega), duration=1e5, samples=11)
+    stated = _quoted(r"accurate to about ([0-9.e+-]+) of \|omega\|", motion.warnings)
+    assert _tail_error(SimpleNamespace(motion=motion), moments, omega) <= stated
+
+
+def test_a_short_horizon_has_no_such_warning() -> None:
+    res = precession(OMEGA, principal_moments=MOMENTS, duration=1e3, samples=5)
+    assert not any("accurate to about" in w for w in res.warnings)
+
+
+@pytest.mark.parametrize("duration", [1e15, 1e16, 1e100])
+def test_a_horizon_whose_phase_float64_cannot_place_is_refused(duration: float) -> None:
+    with pytest.raises(MotionError, match="cannot place its phase"):
+        precession(OMEGA, principal_moments=MOMENTS, duration=duration, samples=3)
+
+
+def test_the_refusal_is_a_4xx_in_the_envelope() -> None:
+    from inertia.api import create_app
+
+    body = {"principal_moments": list(MOMENTS), "omega": list(OMEGA), "duration": 1e16, "samples": 3}
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", DeprecationWarning)
+        response = TestClient(create_app()).post("/v1/precession", json=body)
+    assert response.status_code == 422
+    assert "cannot place its phase" in response.json()["error"]["message"]
+
+
+@pytest.mark.parametrize("method", ["dop853", "rk45", "splitting"])
+def test_a_numerical_method_lost_near_the_separatrix_says_by_how_much(method: str) -> None:
+    # I = (3, 4, 6), Omega = (2, 0.3, 1) is exactly on the separatrix; one ulp of Omega1 off it
+    moments, omega = (3.0, 4.0, 6.0), (2.0 + 2 * np.finfo(float).eps, 0.3, 1.0)
+    res = precession(omega, principal_moments=moments, duration=150.0, samples=5, method=method)
+    stated = _quoted(r"departs from the exact solution by up to ([0-9.e+-]+) of \|omega\|", res.warnings)
+    error = _tail_error(res, moments, omega, tail=5)
+    assert error > 0.1  # its flip is at the wrong time
+    assert stated == pytest.approx(error, rel=0.01)  # the exact solution is exact to rounding
+
+
+def test_a_numerical_method_on_course_says_nothing() -> None:
+    res = precession(OMEGA, principal_moments=MOMENTS, duration=30.0, samples=5, method="dop853")
+    assert not any("departs" in w for w in res.warnings)
