@@ -110,7 +110,10 @@ def add_analysis_options(p: argparse.ArgumentParser) -> None:
         metavar="X,Y,Z",
         help="point (file units): also report the tensor about it; negative values as written: -1,0,0",
     )
-    p.add_argument("--densities", help="JSON file: part name -> density (kg/m^3) for files of several parts")
+    p.add_argument(
+        "--densities",
+        help="part name -> density (kg/m^3) for files of several parts: a JSON file, or the object itself '{\"A\": 500}'",
+    )
     p.add_argument(
         "--geometry", choices=values(Geometry), help="CAD files: integrate the exact B-rep (default) or a tessellation of it"
     )
@@ -135,18 +138,33 @@ def add_analysis_options(p: argparse.ArgumentParser) -> None:
     )
 
 
+def _no_constant(name: str) -> float:
+    raise ValueError(f"{name} is not a finite number")
+
+
+def _densities_arg(text: str) -> dict[str, float]:
+    """``--densities``: a JSON file, or the JSON object itself (as the API's ``densities`` takes it)."""
+    inline = text.lstrip().startswith("{")
+    try:
+        if inline:
+            value = json.loads(text, parse_constant=_no_constant)
+        else:
+            with open(text, encoding="utf-8") as fh:
+                value = json.load(fh, parse_constant=_no_constant)
+    except (OSError, ValueError, RecursionError) as exc:
+        what = "the JSON object" if inline else "the file"
+        raise InvalidParameterError(f"cannot read --densities ({what} {text!r}): {exc}", parameter="densities") from exc
+    if not isinstance(value, dict) or not all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in value.values()):
+        raise InvalidParameterError(
+            '--densities must be a JSON object {"part name": density in kg/m^3}, or a file holding one', parameter="densities"
+        )
+    return {str(k): float(v) for k, v in value.items()}
+
+
 def options_from_args(args: argparse.Namespace) -> Any:
     from .pipeline import AnalysisOptions
 
-    densities = None
-    if getattr(args, "densities", None):
-        try:
-            with open(args.densities, encoding="utf-8") as fh:
-                densities = json.load(fh)
-        except (OSError, json.JSONDecodeError) as exc:
-            raise InvalidParameterError(f"cannot read --densities {args.densities!r}: {exc}") from exc
-        if not isinstance(densities, dict):
-            raise InvalidParameterError("--densities must hold a JSON object: part name -> density")
+    densities = _densities_arg(args.densities) if getattr(args, "densities", None) else None
     return AnalysisOptions(
         format=args.format,
         units=args.units,

@@ -112,3 +112,89 @@ def test_abaqus_shells_beside_solids_are_said_not_weighed() -> None:
     doc = analyze_loaded(load_body(deck, filename="t.inp"), AnalysisOptions(density=1.0)).as_dict()
     assert doc["mass"] == pytest.approx(1 / 6, rel=1e-14)
     assert any("1 triangle elements" in w and "not weighed" in w for w in doc["warnings"])
+
+
+def _vtk_ply_volume(path: Path) -> float:
+    """The volume VTK's own PLY reader gives (its polygons cut by vtkTriangleFilter), by the divergence theorem."""
+    import numpy as np
+    from vtkmodules.util.numpy_support import vtk_to_numpy
+    from vtkmodules.vtkFiltersCore import vtkTriangleFilter
+    from vtkmodules.vtkIOPLY import vtkPLYReader
+
+    reader = vtkPLYReader()
+    reader.SetFileName(str(path))
+    split = vtkTriangleFilter()
+    split.SetInputConnection(reader.GetOutputPort())
+    split.Update()
+    grid = split.GetOutput()
+    x = np.asarray(vtk_to_numpy(grid.GetPoints().GetData()), dtype=np.float64)  # type: ignore[no-untyped-call]
+    t = x[np.asarray(vtk_to_numpy(grid.GetPolys().GetConnectivityArray())).reshape(-1, 3)]  # type: ignore[no-untyped-call]
+    return abs(float(np.einsum("ij,ij->", t[:, 0], np.cross(t[:, 1], t[:, 2])))) / 6
+
+
+def test_non_planar_polygons_say_how_they_were_split() -> None:
+    """VTK's shark.ply: 2374 polygons of 4 to 10 corners, many not planar, so the volume depends on the split.
+
+    VTK's reader cuts them otherwise than trimesh's fan and finds another volume; the number we
+    return holds for the fan, and a warning must say so with a bound at least the difference.
+    """
+    pytest.importorskip("vtkmodules")
+    import re as _re
+
+    from inertia.pipeline import AnalysisOptions, analyze_loaded
+
+    path = REAL / "ply" / "shark.ply"
+    doc = analyze_loaded(load_body(path.read_bytes(), filename="shark.ply"), AnalysisOptions(density=1.0)).as_dict()
+    vtk_volume = _vtk_ply_volume(path)
+    differs = abs(doc["mass"] - vtk_volume) / vtk_volume
+    assert differs > 1e-6  # the two readers' splits really disagree
+    notes = [w for w in doc["warnings"] if "not planar" in w and "fan" in w]
+    assert len(notes) == 1
+    bound = float(_re.search(r"up to about ([0-9.e+-]+) of it", notes[0]).group(1))  # type: ignore[union-attr]
+    assert bound >= differs
+
+
+@pytest.mark.parametrize(
+    "rel", ["ply/cube_blender_uv.ply", "ply/cube_blender_uv_meshlab.ply", "trimesh_models/cube_compressed.obj"]
+)
+def test_planar_polygons_are_split_without_a_word(rel: str) -> None:
+    from inertia.pipeline import AnalysisOptions, analyze_loaded
+
+    doc = analyze_loaded(load_body((REAL / rel).read_bytes(), filename=rel.split("/")[-1]), AnalysisOptions(density=1.0)).as_dict()
+    assert not any("not planar" in w for w in doc["warnings"])
+
+
+def test_binary_ply_quads_are_checked_too() -> None:
+    """A unit cube whose top corner (1, 1, 1) is raised to z = 1.3: its top quad is bent.
+
+    Volume of the fan split from corner 4: 1 + 0.3 / 3 = 1.1; the other diagonal gives 1.05 (the
+    tetrahedron of the four top corners, 0.3 / 6 = 0.05, is left out): the warning must say about 0.05.
+    """
+    import struct
+
+    from inertia.pipeline import AnalysisOptions, analyze_loaded
+
+    corners = [(0, 0, 0), (1, 0, 0), (1, 1, 0), (0, 1, 0), (0, 0, 1), (1, 0, 1), (1, 1, 1.3), (0, 1, 1)]
+    quads = [(0, 3, 2, 1), (4, 5, 6, 7), (0, 1, 5, 4), (1, 2, 6, 5), (2, 3, 7, 6), (3, 0, 4, 7)]
+    header = (
+        "ply\nformat binary_little_endian 1.0\nelement vertex 8\nproperty double x\nproperty double y\n"
+        "property double z\nelement face 6\nproperty list uchar int vertex_indices\nend_header\n"
+    )
+    data = header.encode() + b"".join(struct.pack("<3d", *c) for c in corners)
+    data += b"".join(struct.pack("<B4i", 4, *q) for q in quads)
+    doc = analyze_loaded(load_body(data, filename="bent.ply"), AnalysisOptions(density=1.0)).as_dict()
+    assert doc["mass"] == pytest.approx(1.1, rel=1e-14)
+    notes = [w for w in doc["warnings"] if "not planar" in w]
+    assert len(notes) == 1 and "1 of the 6 faces" in notes[0] and "about 0.05 of it" in notes[0]
+
+
+def test_off_quads_are_checked_too() -> None:
+    """The bent cube of the binary PLY test as an OFF file (header and counts on one line, as trimesh's whitespace.off)."""
+    from inertia.pipeline import AnalysisOptions, analyze_loaded
+
+    text = "OFF 8 6 12\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n0 0 1\n1 0 1\n1 1 1.3\n0 1 1\n"
+    text += "4 0 3 2 1\n4 4 5 6 7 0.5 0.5 0.5 1\n4 0 1 5 4\n4 1 2 6 5\n4 2 3 7 6\n4 3 0 4 7\n"
+    doc = analyze_loaded(load_body(text.encode(), filename="bent.off"), AnalysisOptions(density=1.0)).as_dict()
+    assert doc["mass"] == pytest.approx(1.1, rel=1e-14)
+    notes = [w for w in doc["warnings"] if "not planar" in w]
+    assert len(notes) == 1 and "OFF file" in notes[0] and "about 0.05 of it" in notes[0]

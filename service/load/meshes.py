@@ -37,11 +37,11 @@ def read_surface_parts(
     if fmt == "obj":
         from .obj import read_obj
 
-        groups = guarded_read(lambda: read_obj(data), fmt)  # our reader; any slip still becomes a sentence
+        groups, notes = guarded_read(lambda: read_obj(data), fmt)  # our reader; any slip still becomes a sentence
         parts = [mesh_part(name or "body", v, f, length_scale, "obj") for name, v, f in groups]
         if len(parts) == 1 and not groups[0][0]:
             parts = [mesh_part("body", groups[0][1], groups[0][2], length_scale, "obj")]
-        return parts, None, []
+        return parts, None, notes
     if fmt == "3mf":
         from .threemf import read_3mf
 
@@ -119,11 +119,95 @@ def read_trimesh_parts(
     if not parts:
         what = " (only points or lines)" if skipped else ""
         raise EmptyGeometryError(f"the {fmt.upper()} file holds no triangles{what}; a solid needs a triangle mesh", format=fmt)
+    if fmt == "ply":
+        notes += _ply_split_notes(scene)
+    elif fmt == "off" and len(parts) == 1:
+        notes += _off_split_notes(data, scene)
     if notes:
         first = parts[0]
         assert isinstance(first.body, MeshBody)
         parts[0] = Part(first.name, replace(first.body, warnings=(*first.body.warnings, *notes)))
     return parts, _declared_unit(scene, fmt)
+
+
+def _ply_split_notes(scene: Any) -> list[str]:
+    """``polygons.fan_split_note`` on the PLY's faces as written (trimesh keeps them as ``_ply_raw``)."""
+    from .polygons import fan_split_note
+
+    notes = []
+    for geom in scene.geometry.values():
+        raw = (getattr(geom, "metadata", None) or {}).get("_ply_raw")
+        faces = _ply_face_lists(raw)
+        if faces is None:
+            continue
+        counts = np.fromiter((len(f) for f in faces), dtype=np.int64, count=len(faces))
+        if not np.any(counts >= 4) or counts.min() < 3:
+            continue
+        corners = np.concatenate([np.asarray(f, dtype=np.int64) for f in faces])
+        if corners.min() < 0 or corners.max() >= len(geom.vertices):
+            continue  # the reader's own checks report a bad index
+        note = fan_split_note(np.asarray(geom.vertices, dtype=np.float64), corners, counts, "ply")
+        if note:
+            notes.append(note)
+    return notes
+
+
+def _off_split_notes(data: bytes, scene: Any) -> list[str]:
+    """``polygons.fan_split_note`` on an OFF file's faces as written (trimesh keeps only its triangles)."""
+    from .polygons import fan_split_note
+
+    geoms = list(scene.geometry.values())
+    faces = _off_face_lists(data)
+    if len(geoms) != 1 or faces is None or not faces:
+        return []
+    vertices = np.asarray(geoms[0].vertices, dtype=np.float64)
+    counts = np.fromiter((len(f) for f in faces), dtype=np.int64, count=len(faces))
+    if not np.any(counts >= 4) or counts.min() < 3:
+        return []
+    corners = np.concatenate([np.asarray(f, dtype=np.int64) for f in faces])
+    if corners.min() < 0 or corners.max() >= len(vertices):
+        return []
+    note = fan_split_note(vertices, corners, counts, "off")
+    return [note] if note else []
+
+
+def _off_face_lists(data: bytes) -> list[list[int]] | None:
+    """The faces of an OFF file ("OFF", counts, vertex lines, then "k i1 ... ik [colour]" lines), or None."""
+    try:
+        lines = [ln.split("#", 1)[0].split() for ln in data.decode("utf-8", "replace").splitlines()]
+        lines = [ln for ln in lines if ln]
+        head = lines[0]
+        if not head[0].upper().endswith("OFF") and not head[0].upper().startswith("OFF"):
+            return None
+        rest = [head[0][head[0].upper().index("OFF") + 3 :], *head[1:]]
+        rest = [t for t in rest if t]
+        body = lines[1:]
+        if len(rest) < 2:
+            rest, body = body[0], body[1:]
+        n_vertices, n_faces = int(rest[0]), int(rest[1])
+        rows = body[n_vertices : n_vertices + n_faces]
+        if len(rows) != n_faces:
+            return None
+        return [[int(t) for t in row[1 : 1 + int(row[0])]] for row in rows]
+    except (ValueError, IndexError):
+        return None
+
+
+def _ply_face_lists(raw: Any) -> list[Any] | None:
+    """Each face's vertex list from trimesh's raw PLY elements (a dict of arrays or a structured array), or None."""
+    try:
+        data = raw["face"]["data"]
+        for key in ("vertex_indices", "vertex_index"):
+            named = isinstance(data, np.ndarray) and bool(data.dtype.names) and key in (data.dtype.names or ())
+            if not ((isinstance(data, dict) and key in data) or named):
+                continue
+            array = np.asarray(data[key])
+            if array.dtype.names and "f1" in array.dtype.names:  # binary lists of one length: (count, indices)
+                array = np.asarray(array["f1"])
+            return list(array) if array.ndim in (1, 2) and not array.dtype.names else None
+        return None
+    except (KeyError, TypeError, IndexError, ValueError):
+        return None
 
 
 def _gltf_document(data: bytes, fmt: str) -> Any:

@@ -11,7 +11,8 @@ B1 of the Advanced Visualizer manual):
 - ``f`` with ``v``, ``v/vt``, ``v//vn`` or ``v/vt/vn`` references, 1-based
   or negative (relative to the vertices read so far); polygons of more than
   three corners are split into a fan from their first corner, as Blender and
-  trimesh do;
+  trimesh do (with a warning when they are not planar, so that the split
+  changes the volume: ``polygons.fan_split_note``);
 - ``o`` and ``g`` name the part the following faces belong to (the pair of
   both names, as trimesh's ``split_objects``/``split_groups``); a name used
   twice gathers its faces in one part;
@@ -26,6 +27,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..errors import EmptyGeometryError, UnreadableFileError
+from .polygons import fan_split_note
 
 __all__ = ["read_obj"]
 
@@ -49,8 +51,9 @@ def _lines(data: bytes) -> list[str]:
     return text.replace("\\\r\n", " ").replace("\\\n", " ").splitlines()
 
 
-def read_obj(data: bytes) -> list[tuple[str, NDArray[np.float64], NDArray[np.int64]]]:
-    """(name, vertices, triangles) of each named group, in order of first use; vertices shared (all of them).
+def read_obj(data: bytes) -> tuple[list[tuple[str, NDArray[np.float64], NDArray[np.int64]]], list[str]]:
+    """(name, vertices, triangles) of each named group, in order of first use; vertices shared (all of them);
+    and warnings on what was assumed (the split of non-planar polygons).
 
     One pass sorts the lines by kind (and records, for each face line, its
     group and how many vertices precede it); numbers are then converted by
@@ -96,14 +99,15 @@ def read_obj(data: bytes) -> list[tuple[str, NDArray[np.float64], NDArray[np.int
         raise EmptyGeometryError(
             "the OBJ file has vertices but no faces (f lines); a solid needs triangles or polygons", format="obj"
         )
-    triangles, owner = _faces(f_rows, f_line, f_part, f_seen, lines)
+    triangles, owner, idx, corners = _faces(f_rows, f_line, f_part, f_seen, lines)
     order = sorted(names, key=names.__getitem__)
     parts = []
     for index, name in enumerate(order):
         tris = triangles[owner == index]
         if len(tris):
             parts.append((name, vertices, tris))
-    return parts
+    note = fan_split_note(vertices, idx, corners, "obj")
+    return parts, [note] if note else []
 
 
 def _vertices(rows: list[list[str]], line_nos: list[int], lines: list[str]) -> NDArray[np.float64]:
@@ -133,8 +137,9 @@ def _vertices(rows: list[list[str]], line_nos: list[int], lines: list[str]) -> N
 
 def _faces(
     rows: list[list[str]], line_nos: list[int], part: list[int], seen: list[int], lines: list[str]
-) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
-    """Triangles (0-based, polygons split into fans from their first corner) and the part of each."""
+) -> tuple[NDArray[np.int64], NDArray[np.int64], NDArray[np.int64], NDArray[np.int64]]:
+    """Triangles (0-based, polygons split into fans from their first corner), the part of each,
+    and the faces as written: every corner's vertex number, and the number of corners of each face."""
     corners = np.fromiter((len(r) - 1 for r in rows), dtype=np.int64, count=len(rows))
     short = np.flatnonzero(corners < 3)
     if len(short):
@@ -165,7 +170,7 @@ def _faces(
     k = np.arange(len(tri_face)) - np.repeat(np.cumsum(fans) - fans, fans)  # fan step within its face
     first = starts[tri_face]
     triangles = np.stack([idx[first], idx[first + 1 + k], idx[first + 2 + k]], axis=1)
-    return triangles, np.asarray(part, dtype=np.int64)[tri_face]
+    return triangles, np.asarray(part, dtype=np.int64)[tri_face], idx, corners
 
 
 def _part_name(obj_name: str, group_name: str) -> str:

@@ -14,7 +14,7 @@ import pytest
 from fastapi.testclient import TestClient
 
 from benchmarks.harness import Server
-from tests.contract.helpers import ROOT, SAMPLES, analyze, strip_elapsed
+from tests.contract.helpers import ROOT, SAMPLES, analyze, strip_elapsed, two_cube_obj
 
 
 def run_cli(*args: str, cwd: Path = SAMPLES) -> subprocess.CompletedProcess[str]:
@@ -174,3 +174,15 @@ def test_cli_batch_reads_xyz_files_from_a_folder(tmp_path: Path) -> None:
     (line,) = [json.loads(x) for x in out.read_text().splitlines()]
     assert line["classification"]["kind"] == "linear_rotator"
     assert len(line["rotational_constants"]["MHz"]) == 1
+
+
+def test_cli_densities_take_the_json_object_inline_as_the_api_does(client: TestClient, tmp_path: Path) -> None:
+    # the API's `densities` is a JSON object; `--densities` takes that object, or a file holding it
+    (tmp_path / "pair.obj").write_bytes(two_cube_obj())
+    densities = json.dumps({"right": 500})
+    p = run_cli("analyze", "pair.obj", "--json", "--densities", densities, cwd=tmp_path)
+    assert p.returncode == 0, p.stderr
+    http = analyze(client, "pair.obj", two_cube_obj(), densities=densities)
+    assert strip_elapsed(json.loads(p.stdout)) == strip_elapsed(http)
+    masses = {part["name"]: part["mass"] for part in http["parts"]}
+    assert masses == {"left": pytest.approx(1000.0, rel=1e-13, abs=0), "right": pytest.approx(500.0, rel=1e-13, abs=0)}
