@@ -8,7 +8,7 @@ Reference values never come from the service: the exact principal moments of
 the polyhedron *as stored* (the float64 vertices every tool receives) come from
 rational integration with Python integers and 50-digit eigenvalues
 (``benchmarks/exact.py``); motion references are mpmath closed forms (Jacobi
-elliptic functions, L&L §37; the symmetric top, L&L §33) at 40 digits.
+elliptic functions, L&L §37; the symmetric top, L&L §33) at 80 digits.
 
 Peers get the same arrays: trimesh (``Trimesh(process=False)``), numpy-stl
 (its ``Mesh`` stores float32, so its input is already a different polyhedron:
@@ -628,8 +628,11 @@ def scipy_motion(moments: Array, omega: Array, t: Array) -> tuple[Array, Array]:
     return y[:, :3], y[:, 3:]
 
 
-def reference_omega(moments: Sequence[float], omega: Sequence[float], t: Array, digits: int = 40) -> Array:
+def reference_omega(moments: Sequence[float], omega: Sequence[float], t: Array, digits: int = 80) -> Array:
     """Omega(t) in the principal frame from the closed forms, at ``digits`` digits.
+
+    80, not 40: within 1e-15 of the separatrix k'^2 ~ 1e-30, and m = 1 - k'^2 at 40 digits keeps only
+    10 of them (a phase error of 1e-8 at 1e5 rad that is the reference's, not the service's).
 
     Symmetric top (two equal moments): the perpendicular part turns at the
     body precession rate (I_s - I_p) / I_p Omega_s (L&L §33).  Asymmetric top:
@@ -961,7 +964,7 @@ def _motion_lines(motion: list[MotionRow]) -> list[str]:
         "Drifts are max over 2001 samples of |E(t) - E(0)|/E(0) and |M(t) - M(0)|/|M(0)| with M in the fixed "
         "frame, recomputed here from the trajectory (Omega_body and the attitude quaternion), not taken from the "
         "service's diagnostics. Omega err is max |Omega(t) - Omega_ref(t)| / |Omega| at 41 times against the "
-        "mpmath closed form at 40 digits; for the exact method it is the phase error of rounding the "
+        "mpmath closed form at 80 digits; for the exact method it is the phase error of rounding the "
         "frequency (~ t x rate x 1e-16: ~1e-11 at 1e5 rad, 9e-6 at the 1e11 rad of the ‖Ω‖ = 1e6 row; "
         "near the separatrix the phase is "
         "exponentially sensitive and any float64 method loses it). Where that phase error can exceed 1e-6 "
@@ -1112,7 +1115,7 @@ def honest_lines(rows: list[dict[str, object]]) -> list[str]:
         "",
         "Tensor input's estimate from its conditioning; the motion of the moments given (the tolerance only "
         "labels); no answer made of float32 rounding. References: mpmath (`eigsy` at 50 digits, the L&L "
-        "closed forms at 40 digits), exact rational integration of the stored float32 polyhedron. The bounds are "
+        "closed forms at 80 digits), exact rational integration of the stored float32 polyhedron. The bounds are "
         "also asserted by `tests/test_tensor_estimate.py`, `tests/motion/test_nearly_symmetric.py` and "
         "`tests/test_resolution.py`.",
         "",
