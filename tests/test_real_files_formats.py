@@ -186,3 +186,15 @@ def test_binary_ply_quads_are_checked_too() -> None:
     assert doc["mass"] == pytest.approx(1.1, rel=1e-14)
     notes = [w for w in doc["warnings"] if "not planar" in w]
     assert len(notes) == 1 and "1 of the 6 faces" in notes[0] and "about 0.05 of it" in notes[0]
+
+
+def test_off_quads_are_checked_too() -> None:
+    """The bent cube of the binary PLY test as an OFF file (header and counts on one line, as trimesh's whitespace.off)."""
+    from inertia.pipeline import AnalysisOptions, analyze_loaded
+
+    text = "OFF 8 6 12\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n0 0 1\n1 0 1\n1 1 1.3\n0 1 1\n"
+    text += "4 0 3 2 1\n4 4 5 6 7 0.5 0.5 0.5 1\n4 0 1 5 4\n4 1 2 6 5\n4 2 3 7 6\n4 3 0 4 7\n"
+    doc = analyze_loaded(load_body(text.encode(), filename="bent.off"), AnalysisOptions(density=1.0)).as_dict()
+    assert doc["mass"] == pytest.approx(1.1, rel=1e-14)
+    notes = [w for w in doc["warnings"] if "not planar" in w]
+    assert len(notes) == 1 and "OFF file" in notes[0] and "about 0.05 of it" in notes[0]

@@ -121,6 +121,8 @@ def read_trimesh_parts(
         raise EmptyGeometryError(f"the {fmt.upper()} file holds no triangles{what}; a solid needs a triangle mesh", format=fmt)
     if fmt == "ply":
         notes += _ply_split_notes(scene)
+    elif fmt == "off" and len(parts) == 1:
+        notes += _off_split_notes(data, scene)
     if notes:
         first = parts[0]
         assert isinstance(first.body, MeshBody)
@@ -148,6 +150,47 @@ def _ply_split_notes(scene: Any) -> list[str]:
         if note:
             notes.append(note)
     return notes
+
+
+def _off_split_notes(data: bytes, scene: Any) -> list[str]:
+    """``polygons.fan_split_note`` on an OFF file's faces as written (trimesh keeps only its triangles)."""
+    from .polygons import fan_split_note
+
+    geoms = list(scene.geometry.values())
+    faces = _off_face_lists(data)
+    if len(geoms) != 1 or faces is None or not faces:
+        return []
+    vertices = np.asarray(geoms[0].vertices, dtype=np.float64)
+    counts = np.fromiter((len(f) for f in faces), dtype=np.int64, count=len(faces))
+    if not np.any(counts >= 4) or counts.min() < 3:
+        return []
+    corners = np.concatenate([np.asarray(f, dtype=np.int64) for f in faces])
+    if corners.min() < 0 or corners.max() >= len(vertices):
+        return []
+    note = fan_split_note(vertices, corners, counts, "off")
+    return [note] if note else []
+
+
+def _off_face_lists(data: bytes) -> list[list[int]] | None:
+    """The faces of an OFF file ("OFF", counts, vertex lines, then "k i1 ... ik [colour]" lines), or None."""
+    try:
+        lines = [ln.split("#", 1)[0].split() for ln in data.decode("utf-8", "replace").splitlines()]
+        lines = [ln for ln in lines if ln]
+        head = lines[0]
+        if not head[0].upper().endswith("OFF") and not head[0].upper().startswith("OFF"):
+            return None
+        rest = [head[0][head[0].upper().index("OFF") + 3 :], *head[1:]]
+        rest = [t for t in rest if t]
+        body = lines[1:]
+        if len(rest) < 2:
+            rest, body = body[0], body[1:]
+        n_vertices, n_faces = int(rest[0]), int(rest[1])
+        rows = body[n_vertices : n_vertices + n_faces]
+        if len(rows) != n_faces:
+            return None
+        return [[int(t) for t in row[1 : 1 + int(row[0])]] for row in rows]
+    except (ValueError, IndexError):
+        return None
 
 
 def _ply_face_lists(raw: Any) -> list[Any] | None:
