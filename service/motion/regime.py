@@ -72,6 +72,12 @@ def _decide(frame: PrincipalFrame, classification: Classification, omega: Array,
             )
         omega_body = omega_body.copy()
         omega_body[0] = 0.0
+    given = np.asarray(frame.moments, dtype=np.float64)
+    if rotor is RotorClass.LINEAR and given[2] - given[1] > MOTION_ROUNDING * given[2]:
+        warnings.append(
+            f"the smallest moment is zero, so all mass is on a line and the other two moments are equal; the "
+            f"given ones differ by {(given[2] - given[1]) / given[2]:.2g} of the largest, and their mean was used"
+        )
     problem = RigidProblem(moments, omega_body, axes, frame.quaternion)
     rate = float(np.linalg.norm(omega_body))
     if rate == 0.0:
@@ -131,6 +137,9 @@ def motion_rotor(frame: PrincipalFrame, classification: Classification) -> Rotor
     """
     from ..classification import classify
 
+    if float(frame.moments[0]) == 0.0 < float(frame.moments[-1]):
+        # all mass on a line: I2 = I3 whatever rounding (within the triangle inequality's allowance) left
+        return RotorClass.LINEAR
     # exact (permutation) axes: the moments are the numbers given, with no rounding to forgive
     level = 0.0 if exact_axes(frame.axes) else min(MOTION_ROUNDING, classification.tolerance)
     if classification.tolerance <= level:

@@ -107,3 +107,17 @@ def test_a_needle_whose_smallest_moment_is_given_moves_as_the_prolate_top_it_is(
             expected.append([omega[0], float(z.real), float(z.imag)])
     assert np.max(np.abs(res.motion.trajectory.omega_body - np.array(expected))) <= 1e-14
     assert res.motion.regime.value == "regular_precession" and not res.warnings
+
+
+@pytest.mark.parametrize("i2", [1.0 - 2.0**-53, 1.0 - 1e-7])
+def test_a_zero_smallest_moment_is_a_linear_rotator_whatever_rounding_left(i2: float) -> None:
+    """I1 = 0 puts all mass on a line, so I2 = I3 (L&L §32); the triangle inequality admits a gap of
+    rounding (or of the tolerance).  Such moments divided by I1 = 0 (ZeroDivisionError, a 422 that
+    said the numbers were too large or too small) before; the rotator turns uniformly about M."""
+    omega = (0.3, 0.5, 0.2)
+    res = precession(omega, principal_moments=(0.0, i2, 1.0), duration=5.0, samples=3)
+    assert res.motion.regime.value == "rotator"
+    assert res.motion.trajectory is not None
+    assert np.array_equal(res.motion.trajectory.omega_body, np.tile([0.0, 0.5, 0.2], (3, 1)))
+    assert any("has no physical effect" in w for w in res.warnings)
+    assert any("their mean was used" in w for w in res.warnings) is (1.0 - i2 > 1e-12)
