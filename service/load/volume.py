@@ -38,8 +38,13 @@ written to our stdout or stderr.
 
 Cells: linear tetrahedra stay a closed-form kernel (``VolumeBody.tets``);
 every other 3-D cell becomes a ``CellBlock`` integrated as its element
-(``cells``), voxels reordered to hexahedra.  A 3-D cell type we cannot
-integrate refuses the file (it is never dropped).
+(``cells``), voxels reordered to hexahedra.  VTK's cells bounded by flat
+polygons (pentagonal and hexagonal prisms, polyhedra) become tetrahedra
+(``_polyhedra``): prisms as VTK itself splits them, polyhedra from their
+centre when their faces close them with one winding and they are
+star-shaped from there (else the file is refused, naming the cell); bent
+faces are said in a warning with the volume they put in doubt.  A 3-D cell
+type we cannot integrate refuses the file (it is never dropped).
 """
 
 from __future__ import annotations
@@ -61,6 +66,7 @@ from numpy.typing import NDArray
 from ..body import CellBlock, Part, VolumeBody
 from ..cells import CELL_NODES, VOXEL_TO_HEXAHEDRON
 from ..errors import EmptyGeometryError, UnreadableFileError, UnsupportedFormatError
+from .polygons import fan_split_note
 from .sniff import VOLUME_FORMATS
 
 __all__ = ["read_volume_parts", "VTK_FORMATS", "VTK_CELL_TYPES"]
@@ -81,13 +87,12 @@ VTK_CELL_TYPES = {
     29: "hexahedron27",
     32: "wedge18",
 }
+# cells bounded by flat polygons: split into tetrahedra from their centre where that is exact (``_polyhedra``)
+_VTK_POLYHEDRA = {15: "pentagonal prism", 16: "hexagonal prism", 42: "polyhedron"}
 # 3-D VTK cells we cannot integrate (refused, never dropped)
 _VTK_OTHER_3D = {
-    15: "pentagonal prism",
-    16: "hexagonal prism",
     33: "24-node hexahedron",
     37: "19-node pyramid",
-    42: "polyhedron",
     71: "Lagrange tetrahedron",
     72: "Lagrange hexahedron",
     73: "Lagrange wedge",
@@ -357,12 +362,19 @@ def _mesh_from_grid(grid: Any, to_numpy: Any, label: str) -> _Mesh:
     if unsupported:
         raise UnsupportedFormatError(_unsupported_cells(label, unsupported), cell_types=sorted(unsupported))
     for t in np.unique(types):
-        if int(t) not in VTK_CELL_TYPES:
+        if int(t) not in VTK_CELL_TYPES and int(t) not in _VTK_POLYHEDRA:
             mesh.other[_VTK_2D_NAMES.get(int(t), f"VTK cell type {int(t)}")] = int(np.count_nonzero(types == t))
     # one block per cell type, in order of first appearance (as meshio groups a VTK file's cells; by type, not
     # by consecutive runs, so a mesh whose types alternate does not become thousands of parts)
     present, first = np.unique(types, return_index=True)
     for vtk_type in (int(t) for t in present[np.argsort(first)]):
+        if vtk_type in _VTK_POLYHEDRA:
+            ids = np.flatnonzero(types == vtk_type)
+            nodes, cell_of, mesh.points, note = _polyhedra(grid, ids, vtk_type, conn, offsets, mesh.points, label)
+            mesh.warnings.extend([note] if note else [])
+            name = _VTK_POLYHEDRA[vtk_type].replace(" ", "_")
+            mesh.blocks.append(_Block("tetra", nodes, cell_of, f"{name}_{len(mesh.blocks)}"))
+            continue
         if vtk_type not in VTK_CELL_TYPES:
             continue
         name = VTK_CELL_TYPES[vtk_type]
@@ -372,6 +384,143 @@ def _mesh_from_grid(grid: Any, to_numpy: Any, label: str) -> _Mesh:
             nodes, name = nodes[:, VOXEL_TO_HEXAHEDRON], "hexahedron"
         mesh.blocks.append(_Block(name, nodes, ids, f"{VTK_CELL_TYPES[vtk_type]}_{len(mesh.blocks)}"))
     return mesh
+
+
+def _polyhedron_faces(grid: Any, cell: int, vtk_type: int, conn: NDArray[np.int64], offsets: NDArray[np.int64]) -> list[list[int]]:
+    """The faces of a polyhedral cell as point ids: a polyhedron's face stream, or a prism's faces from its nodes."""
+    if vtk_type == 42:
+        from vtkmodules.vtkCommonCore import vtkIdList
+
+        stream = vtkIdList()
+        grid.GetFaceStream(cell, stream)
+        ids = [stream.GetId(k) for k in range(stream.GetNumberOfIds())]
+        faces, at = [], 1
+        for _ in range(ids[0] if ids else 0):
+            faces.append(ids[at + 1 : at + 1 + ids[at]])
+            at += 1 + ids[at]
+        return _without_repeats(faces)
+    n = 5 if vtk_type == 15 else 6  # VTK's prisms: bottom polygon 0..n-1, top n..2n-1 above it
+    v = [int(i) for i in conn[offsets[cell] : offsets[cell] + 2 * n]]
+    sides = [[v[i], v[(i + 1) % n], v[n + (i + 1) % n], v[n + i]] for i in range(n)]
+    return _without_repeats([v[n - 1 :: -1], v[n:], *sides])
+
+
+def _without_repeats(faces: list[list[int]]) -> list[list[int]]:
+    """Faces without a corner written twice in a row (a collapsed edge), and without those left with no area."""
+    out = []
+    for f in faces:
+        kept = [a for a, b in zip(f, [*f[1:], f[0]], strict=True) if a != b]
+        if len(kept) >= 3:
+            out.append(kept)
+    return out
+
+
+def _polyhedra(
+    grid: Any,
+    ids: NDArray[np.int64],
+    vtk_type: int,
+    conn: NDArray[np.int64],
+    offsets: NDArray[np.int64],
+    points: NDArray[np.float64],
+    label: str,
+) -> tuple[NDArray[np.int64], NDArray[np.int64], NDArray[np.float64], str | None]:
+    """Polyhedral cells as tetrahedra (centre, a face's first corner, two more), where that split is exact.
+
+    Exact when the faces close the cell with one winding (each edge once each way) and every
+    tetrahedron from the cell's centre (mean of its points) has the same orientation (the cell is
+    star-shaped from there, so the pieces neither overlap nor leave a gap); a cell that fails refuses
+    the file, naming the cell and why.  A face that is not flat (float32 rounding, warped faces) bounds
+    a volume that depends on how it is split: it is split as a fan from its first corner, and when
+    that matters by more than ``polygons.NOTE_REL`` of the volume a warning says by how much
+    (``polygons.fan_split_note``).  Returns the tetrahedra (positively wound), the file cell of each,
+    the points with the centres appended, and the warning if any.
+    """
+    kind = _VTK_POLYHEDRA[vtk_type]
+    tets: list[list[int]] = []
+    owner: list[int] = []
+    centres: list[NDArray[np.float64]] = []
+    all_faces: list[list[int]] = []
+    for cell in (int(c) for c in ids):
+        faces = _polyhedron_faces(grid, cell, vtk_type, conn, offsets)
+        corners = sorted({i for f in faces for i in f})
+        if len(faces) < 4 or any(len(f) < 3 for f in faces) or not corners or max(corners) >= len(points) or min(corners) < 0:
+            raise UnreadableFileError(f"{label} has a {kind} cell ({cell}) whose faces do not bound a solid; fix the mesh")
+        x = points[corners]
+        centre = x.mean(axis=0)
+        size = float(np.ptp(x, axis=0).max())
+        why = _polyhedron_defect(points, faces, centre, size)
+        if why:
+            raise UnsupportedFormatError(
+                f"{label} has a {kind} cell ({cell}) that cannot be weighed exactly: {why}; "
+                "split such cells into tetrahedra, hexahedra, wedges or pyramids (for example with VTK's "
+                "vtkTessellatorFilter or Gmsh)",
+                cell_types=[kind],
+            )
+        first = len(tets)
+        all_faces.extend(faces)
+        if vtk_type == 42:
+            c = len(points) + len(centres)
+            centres.append(centre)
+            for f in faces:
+                tets.extend([c, f[0], f[i], f[i + 1]] for i in range(1, len(f) - 1))
+        else:  # a prism is one of VTK's own cells: split as VTK splits it (vtkCell::Triangulate)
+            tets.extend(_vtk_split(grid, cell, points, label, kind))
+        owner.extend([cell] * (len(tets) - first))
+    nodes = np.asarray(tets, dtype=np.int64).reshape(-1, 4)
+    everything = np.concatenate([points, np.asarray(centres, dtype=np.float64).reshape(-1, 3)])
+    t = everything[nodes]
+    det = np.einsum("ij,ij->i", t[:, 1] - t[:, 0], np.cross(t[:, 2] - t[:, 0], t[:, 3] - t[:, 0]))
+    nodes[det < 0] = nodes[det < 0][:, [0, 2, 1, 3]]  # each cell's pieces share a sign (checked): wind them positively
+    counts = np.fromiter((len(f) for f in all_faces), dtype=np.int64, count=len(all_faces))
+    flat = np.fromiter((i for f in all_faces for i in f), dtype=np.int64, count=int(counts.sum()))
+    how = "as a fan from its first corner" if vtk_type == 42 else "as VTK splits its own cells (vtkCell::Triangulate)"
+    note = fan_split_note(points, flat, counts, kind, volume=float(np.abs(det).sum()) / 6, how=how)
+    return nodes, np.asarray(owner, dtype=np.int64), everything, note
+
+
+def _vtk_split(grid: Any, cell: int, points: NDArray[np.float64], label: str, kind: str) -> list[list[int]]:
+    """VTK's own tetrahedra of a cell (point ids), refused if they do not all turn the same way."""
+    from vtkmodules.vtkCommonCore import vtkIdList, vtkPoints
+
+    ids, where = vtkIdList(), vtkPoints()
+    grid.GetCell(cell).Triangulate(0, ids, where)
+    flat = [int(ids.GetId(k)) for k in range(ids.GetNumberOfIds())]
+    tets = [flat[k : k + 4] for k in range(0, len(flat) - len(flat) % 4, 4)]
+    if not tets or min(flat) < 0 or max(flat) >= len(points):
+        raise UnreadableFileError(f"{label} has a {kind} cell ({cell}) that VTK cannot split into tetrahedra; fix the mesh")
+    t = points[np.asarray(tets, dtype=np.int64)]
+    det = np.einsum("ij,ij->i", t[:, 1] - t[:, 0], np.cross(t[:, 2] - t[:, 0], t[:, 3] - t[:, 0]))
+    size = float(np.ptp(t.reshape(-1, 3), axis=0).max())
+    if np.any(det > 1e-12 * size**3) and np.any(det < -1e-12 * size**3):
+        raise UnsupportedFormatError(
+            f"{label} has a {kind} cell ({cell}) that folds over itself (VTK's own split of it into tetrahedra "
+            "turns both ways); fix the cell's node order",
+            cell_types=[kind],
+        )
+    return tets
+
+
+def _polyhedron_defect(points: NDArray[np.float64], faces: list[list[int]], centre: NDArray[np.float64], size: float) -> str:
+    """Why splitting this cell from its centre would not be exact, or ''."""
+    edges: dict[tuple[int, int], int] = {}
+    for f in faces:
+        for a, b in zip(f, [*f[1:], f[0]], strict=True):
+            key = (min(a, b), max(a, b))
+            edges[key] = edges.get(key, 0) + (1 if a < b else -1)
+    if any(edges.values()):
+        return "its faces do not close it with one winding (an edge is not shared by two faces running opposite ways)"
+    signs = set()
+    for f in faces:
+        x = points[f]
+        normal = np.cross(x[1:-1] - x[0], x[2:] - x[0]).sum(axis=0)  # twice the area vector (Newell)
+        length = float(np.linalg.norm(normal))
+        if length <= 1e-24 * size**2:
+            return "a face has no area"
+        det = np.einsum("ij,ij->i", x[1:-1] - centre, np.cross(x[2:] - centre, np.broadcast_to(x[0] - centre, x[2:].shape)))
+        signs.update(np.sign(det[np.abs(det) > 1e-12 * size**3]).tolist())
+    if len(signs) > 1:
+        return "it is not star-shaped from its centre (the mean of its points)"
+    return ""
 
 
 _VTK_2D_NAMES = {
