@@ -94,6 +94,12 @@ def _body_message(error: dict[str, Any], content_type: str | None) -> str | None
             sent = f"was sent as {content_type}" if content_type else "came without a Content-Type header"
             return f"the request body {sent}; send the JSON document of API.md with the header Content-Type: application/json"
         return "the request body must be a JSON object (the document of API.md), not an array or a single value"
+    if len(loc) >= 2 and loc[0] == "body" and "Expected UploadFile" in str(error.get("msg", "")):
+        # a multipart part without a file name is a form field, not a file (curl -F 'file=<x.stl')
+        return (
+            f"the multipart part '{loc[1]}' came without a file name, so it is a form field rather than a file; "
+            f"send it as a file part with its name, e.g. curl -F {loc[1]}=@part.stl"
+        )
     return None
 
 
