@@ -390,33 +390,45 @@ def _mesh_from_grid(grid: Any, to_numpy: Any, label: str) -> _Mesh:
     return mesh
 
 
-def _polyhedron_faces(grid: Any, cell: int, vtk_type: int, conn: NDArray[np.int64], offsets: NDArray[np.int64]) -> list[list[int]]:
-    """The faces of a polyhedral cell as point ids: a polyhedron's face stream, or a prism's faces from its nodes."""
-    if vtk_type == 42:
-        from vtkmodules.vtkCommonCore import vtkIdList
+def _polyhedron_faces(grid: Any, cells: NDArray[np.int64]) -> tuple[list[list[int]], list[int]]:
+    """The faces of polyhedron cells (point ids, from VTK's face streams) and the cell of each face."""
+    from vtkmodules.vtkCommonCore import vtkIdList
 
-        stream = vtkIdList()
+    faces: list[list[int]] = []
+    owner: list[int] = []
+    stream = vtkIdList()
+    for cell in (int(c) for c in cells):
         grid.GetFaceStream(cell, stream)
         ids = [stream.GetId(k) for k in range(stream.GetNumberOfIds())]
-        faces, at = [], 1
+        at = 1
         for _ in range(ids[0] if ids else 0):
-            faces.append(ids[at + 1 : at + 1 + ids[at]])
+            face = ids[at + 1 : at + 1 + ids[at]]
             at += 1 + ids[at]
-        return _without_repeats(faces)
-    n = 5 if vtk_type == 15 else 6  # VTK's prisms: bottom polygon 0..n-1, top n..2n-1 above it
-    v = [int(i) for i in conn[offsets[cell] : offsets[cell] + 2 * n]]
-    sides = [[v[i], v[(i + 1) % n], v[n + (i + 1) % n], v[n + i]] for i in range(n)]
-    return _without_repeats([v[n - 1 :: -1], v[n:], *sides])
+            kept = [a for a, b in zip(face, [*face[1:], face[0]], strict=True) if a != b]  # a collapsed edge: one corner
+            if len(kept) >= 3:
+                faces.append(kept)
+                owner.append(cell)
+    return faces, owner
 
 
-def _without_repeats(faces: list[list[int]]) -> list[list[int]]:
-    """Faces without a corner written twice in a row (a collapsed edge), and without those left with no area."""
-    out = []
-    for f in faces:
-        kept = [a for a, b in zip(f, [*f[1:], f[0]], strict=True) if a != b]
-        if len(kept) >= 3:
-            out.append(kept)
-    return out
+def _prism_faces(
+    cells: NDArray[np.int64], vtk_type: int, conn: NDArray[np.int64], offsets: NDArray[np.int64]
+) -> tuple[list[list[int]], list[int]]:
+    """The faces of VTK's prisms (bottom polygon 0..n-1, top n..2n-1 above it), wound outward alike."""
+    n = 5 if vtk_type == 15 else 6
+    v = conn[offsets[cells][:, None] + np.arange(2 * n)[None, :]]
+    local = [list(range(n - 1, -1, -1)), list(range(n, 2 * n))]
+    local += [[i, (i + 1) % n, n + (i + 1) % n, n + i] for i in range(n)]
+    faces: list[list[int]] = []
+    owner: list[int] = []
+    for row, cell in zip(v.tolist(), cells.tolist(), strict=True):
+        for f in local:
+            face = [row[i] for i in f]
+            kept = [a for a, b in zip(face, [*face[1:], face[0]], strict=True) if a != b]
+            if len(kept) >= 3:
+                faces.append(kept)
+                owner.append(cell)
+    return faces, owner
 
 
 def _polyhedra(
@@ -428,104 +440,112 @@ def _polyhedra(
     points: NDArray[np.float64],
     label: str,
 ) -> tuple[NDArray[np.int64], NDArray[np.int64], NDArray[np.float64], str | None]:
-    """Polyhedral cells as tetrahedra (a corner of the cell, a face's first corner, two more), where exact.
+    """Polyhedral cells as tetrahedra, where exact; the file cell of each, the points (unchanged), a warning.
 
-    Prisms are split as VTK splits them.  A polyhedron is split from its first corner: exact when
-    the faces close the cell with one winding (each edge once each way) and every tetrahedron from
-    that corner has the same orientation (the cell is star-shaped from there, as every convex cell
-    is, so the pieces neither overlap nor leave a gap); a cell that fails refuses the file, naming
-    the cell and why.  No point is added, so the file's points stay its own.  A face that is not
-    flat (float32 rounding, warped faces) bounds a volume that depends on how it is split: it is
-    split as a fan, and when that matters by more than ``polygons.NOTE_REL`` of the volume a
-    warning says by how much
-    (``polygons.fan_split_note``).  Returns the tetrahedra (positively wound), the file cell of each,
-    the points (unchanged), and the warning if any.
+    Prisms are split as VTK splits them (its own local tetrahedra, ``TriangulateLocalIds``; a cell
+    whose pieces turn both ways folds over itself and is refused).  A polyhedron is split from its
+    first corner: exact when its faces close it with one winding (each edge once each way) and every
+    tetrahedron from that corner turns the same way (the cell is star-shaped from there, as every
+    convex cell is, so the pieces neither overlap nor leave a gap); a cell that fails refuses the
+    file, naming the cell and why.  No point is added.  A face that is not flat (float32 rounding,
+    warped faces) bounds a volume that depends on how it is split: when that matters by more than
+    ``polygons.NOTE_REL`` of the volume a warning says by how much (``polygons.fan_split_note``).
+    Vectorised over the cells but for reading VTK's face streams.
     """
     kind = _VTK_POLYHEDRA[vtk_type]
-    tets: list[list[int]] = []
-    owner: list[int] = []
-    all_faces: list[list[int]] = []
-    for cell in (int(c) for c in ids):
-        faces = _polyhedron_faces(grid, cell, vtk_type, conn, offsets)
-        corners = sorted({i for f in faces for i in f})
-        if len(faces) < 4 or any(len(f) < 3 for f in faces) or not corners or max(corners) >= len(points) or min(corners) < 0:
-            raise UnreadableFileError(f"{label} has a {kind} cell ({cell}) whose faces do not bound a solid; fix the mesh")
-        size = float(np.ptp(points[corners], axis=0).max())
-        apex = faces[0][0]
-        why = _polyhedron_defect(points, faces, apex, size)
-        if why:
-            raise UnsupportedFormatError(
-                f"{label} has a {kind} cell ({cell}) that cannot be weighed exactly: {why}; "
-                "split such cells into tetrahedra, hexahedra, wedges or pyramids (for example with VTK's "
-                "vtkTessellatorFilter or Gmsh)",
-                cell_types=[kind],
-            )
-        first = len(tets)
-        all_faces.extend(faces)
-        if vtk_type == 42:  # from one corner: the faces through it add nothing (split from it, they are flat to it)
-            for f in faces:
-                if apex not in f:
-                    tets.extend([apex, f[0], f[i], f[i + 1]] for i in range(1, len(f) - 1))
-        else:  # a prism is one of VTK's own cells: split as VTK splits it (vtkCell::Triangulate)
-            tets.extend(_vtk_split(grid, cell, points, label, kind))
-        owner.extend([cell] * (len(tets) - first))
-    nodes = np.asarray(tets, dtype=np.int64).reshape(-1, 4)
-    t = points[nodes]
-    det = np.einsum("ij,ij->i", t[:, 1] - t[:, 0], np.cross(t[:, 2] - t[:, 0], t[:, 3] - t[:, 0]))
-    nodes[det < 0] = nodes[det < 0][:, [0, 2, 1, 3]]  # each cell's pieces share a sign (checked): wind them positively
-    counts = np.fromiter((len(f) for f in all_faces), dtype=np.int64, count=len(all_faces))
-    flat = np.fromiter((i for f in all_faces for i in f), dtype=np.int64, count=int(counts.sum()))
-    how = "as a fan from one corner" if vtk_type == 42 else "as VTK splits its own cells (vtkCell::Triangulate)"
-    note = fan_split_note(points, flat, counts, kind, volume=float(np.abs(det).sum()) / 6, how=how)
-    return nodes, np.asarray(owner, dtype=np.int64), points, note
 
-
-def _vtk_split(grid: Any, cell: int, points: NDArray[np.float64], label: str, kind: str) -> list[list[int]]:
-    """VTK's own tetrahedra of a cell (point ids), refused if they do not all turn the same way."""
-    from vtkmodules.vtkCommonCore import vtkIdList, vtkPoints
-
-    ids, where = vtkIdList(), vtkPoints()
-    grid.GetCell(cell).Triangulate(0, ids, where)
-    flat = [int(ids.GetId(k)) for k in range(ids.GetNumberOfIds())]
-    tets = [flat[k : k + 4] for k in range(0, len(flat) - len(flat) % 4, 4)]
-    if not tets or min(flat) < 0 or max(flat) >= len(points):
-        raise UnreadableFileError(f"{label} has a {kind} cell ({cell}) that VTK cannot split into tetrahedra; fix the mesh")
-    t = points[np.asarray(tets, dtype=np.int64)]
-    det = np.einsum("ij,ij->i", t[:, 1] - t[:, 0], np.cross(t[:, 2] - t[:, 0], t[:, 3] - t[:, 0]))
-    size = float(np.ptp(t.reshape(-1, 3), axis=0).max())
-    if np.any(det > 1e-12 * size**3) and np.any(det < -1e-12 * size**3):
-        raise UnsupportedFormatError(
-            f"{label} has a {kind} cell ({cell}) that folds over itself (VTK's own split of it into tetrahedra "
-            "turns both ways); fix the cell's node order",
+    def refuse(cell: int, why: str) -> UnsupportedFormatError:
+        return UnsupportedFormatError(
+            f"{label} has a {kind} cell ({cell}) that cannot be weighed exactly: {why}; split such cells into "
+            "tetrahedra, hexahedra, wedges or pyramids (for example with VTK's vtkTessellatorFilter or Gmsh)",
             cell_types=[kind],
         )
-    return tets
 
+    faces, face_cell = _polyhedron_faces(grid, ids) if vtk_type == 42 else _prism_faces(ids, vtk_type, conn, offsets)
+    counts = np.fromiter((len(f) for f in faces), dtype=np.int64, count=len(faces))
+    flat = np.fromiter((i for f in faces for i in f), dtype=np.int64, count=int(counts.sum()))
+    cell_of_face = np.asarray(face_cell, dtype=np.int64)
+    if len(flat) == 0 or flat.min() < 0 or flat.max() >= len(points) or len(np.unique(cell_of_face)) != len(ids):
+        raise UnreadableFileError(f"{label} has {kind} cells whose faces do not bound a solid; fix the mesh")
+    starts = np.concatenate([[0], np.cumsum(counts)[:-1]])
+    corner_face = np.repeat(np.arange(len(counts)), counts)
+    nxt = np.arange(len(flat)) + 1
+    nxt[starts + counts - 1] = starts  # each corner's successor around its face
+    # one winding: within each cell every edge runs once each way
+    a, b = flat, flat[nxt]
+    cell = cell_of_face[corner_face]
+    lo, hi, sign = np.minimum(a, b), np.maximum(a, b), np.where(a < b, 1, -1)
+    order = np.lexsort((hi, lo, cell))
+    key_change = np.r_[
+        True, (lo[order][1:] != lo[order][:-1]) | (hi[order][1:] != hi[order][:-1]) | (cell[order][1:] != cell[order][:-1])
+    ]
+    runs = np.flatnonzero(key_change)
+    unbalanced = np.add.reduceat(sign[order], runs) != 0
+    if np.any(unbalanced):
+        raise refuse(int(cell[order][runs[np.argmax(unbalanced)]]), "its faces do not close it with one winding")
+    # fan triangles of every face, from its first corner
+    fans = counts - 2
+    tri_face = np.repeat(np.arange(len(counts)), fans)
+    step = np.arange(len(tri_face)) - np.repeat(np.cumsum(fans) - fans, fans)
+    first = starts[tri_face]
+    tri = np.stack([flat[first], flat[first + 1 + step], flat[first + 2 + step]], axis=1)
+    x = points[tri]
+    area2 = np.zeros((len(counts), 3))
+    np.add.at(area2, tri_face, np.cross(x[:, 1] - x[:, 0], x[:, 2] - x[:, 0]))
+    cell_lo = np.full((len(ids), 3), np.inf)
+    cell_hi = np.full((len(ids), 3), -np.inf)
+    slot = np.searchsorted(ids, cell_of_face[corner_face])
+    for k in range(3):
+        np.minimum.at(cell_lo[:, k], slot, points[flat, k])
+        np.maximum.at(cell_hi[:, k], slot, points[flat, k])
+    size = (cell_hi - cell_lo).max(axis=1)  # per cell, in the order of ids
+    face_size = size[np.searchsorted(ids, cell_of_face)]
+    flat_face = np.linalg.norm(area2, axis=1) <= 1e-24 * face_size**2
+    if np.any(flat_face):
+        raise refuse(int(cell_of_face[np.argmax(flat_face)]), "a face has no area")
+    if vtk_type == 42:
+        first_face = np.searchsorted(cell_of_face, ids)  # faces are grouped by cell, in the order of ids
+        apex = flat[starts[first_face]]
+        tri_cell = np.searchsorted(ids, cell_of_face[tri_face])
+        o = points[apex[tri_cell]]
+        through = np.zeros(len(counts), dtype=bool)  # faces through their cell's apex: split from it, they add nothing
+        np.logical_or.at(through, corner_face, flat == apex[np.searchsorted(ids, cell_of_face[corner_face])])
+        keep = ~through[tri_face]
+        nodes = np.concatenate([apex[tri_cell][:, None], tri], axis=1)[keep]
+        owner = ids[tri_cell][keep]
+        o, x = o[keep], x[keep]
+        det = np.einsum("ij,ij->i", x[:, 0] - o, np.cross(x[:, 1] - o, x[:, 2] - o))
+        tol = 1e-12 * size[tri_cell[keep]] ** 3
+    else:
+        from vtkmodules.vtkCommonCore import vtkIdList
 
-def _polyhedron_defect(points: NDArray[np.float64], faces: list[list[int]], apex: int, size: float) -> str:
-    """Why splitting this cell from its corner ``apex`` would not be exact, or ''."""
-    edges: dict[tuple[int, int], int] = {}
-    for f in faces:
-        for a, b in zip(f, [*f[1:], f[0]], strict=True):
-            key = (min(a, b), max(a, b))
-            edges[key] = edges.get(key, 0) + (1 if a < b else -1)
-    if any(edges.values()):
-        return "its faces do not close it with one winding (an edge is not shared by two faces running opposite ways)"
-    signs = set()
-    for f in faces:
-        x = points[f]
-        normal = np.cross(x[1:-1] - x[0], x[2:] - x[0]).sum(axis=0)  # twice the area vector (Newell)
-        length = float(np.linalg.norm(normal))
-        if length <= 1e-24 * size**2:
-            return "a face has no area"
-        if apex in f:
-            continue
-        o = points[apex]
-        det = np.einsum("ij,ij->i", x[1:-1] - o, np.cross(x[2:] - o, np.broadcast_to(x[0] - o, x[2:].shape)))
-        signs.update(np.sign(det[np.abs(det) > 1e-12 * size**3]).tolist())
-    if len(signs) > 1:
-        return f"it is not star-shaped from its corner {apex} (not convex)"
-    return ""
+        local = vtkIdList()
+        grid.GetCell(int(ids[0])).TriangulateLocalIds(0, local)
+        pattern = np.asarray([local.GetId(k) for k in range(local.GetNumberOfIds())], dtype=np.int64).reshape(-1, 4)
+        n_nodes = 10 if vtk_type == 15 else 12
+        cell_nodes = conn[offsets[ids][:, None] + np.arange(n_nodes)[None, :]]
+        nodes = cell_nodes[:, pattern].reshape(-1, 4)
+        owner = np.repeat(ids, len(pattern))
+        t = points[nodes]
+        det = np.einsum("ij,ij->i", t[:, 1] - t[:, 0], np.cross(t[:, 2] - t[:, 0], t[:, 3] - t[:, 0]))
+        tol = 1e-12 * np.repeat(size, len(pattern)) ** 3
+    positive = np.zeros(len(ids), dtype=bool)
+    negative = np.zeros(len(ids), dtype=bool)
+    np.logical_or.at(positive, np.searchsorted(ids, owner), det > tol)
+    np.logical_or.at(negative, np.searchsorted(ids, owner), det < -tol)
+    both = positive & negative
+    if np.any(both):
+        why = (
+            "it is not star-shaped from its first corner (not convex)"
+            if vtk_type == 42
+            else "VTK's own split of it turns both ways (it folds over itself)"
+        )
+        raise refuse(int(ids[np.argmax(both)]), why)
+    nodes = nodes.copy()
+    nodes[det < 0] = nodes[det < 0][:, [0, 2, 1, 3]]  # each cell's pieces share a sign (checked): wind them positively
+    how = "as a fan from one corner" if vtk_type == 42 else "as VTK splits its own cells (vtkCell::Triangulate)"
+    note = fan_split_note(points, flat, counts, kind, volume=float(np.abs(det).sum()) / 6, how=how)
+    return nodes, owner.astype(np.int64), points, note
 
 
 _VTK_2D_NAMES = {
