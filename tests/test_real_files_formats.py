@@ -213,7 +213,9 @@ def test_polyhedron_cells_are_weighed() -> None:
         AnalysisOptions(density=1.0),
     ).as_dict()
     assert doc["mass"] == pytest.approx(8 / 3, rel=1e-14)
-    assert not doc["warnings"]
+    assert doc["source"]["points"] == 18  # the file's own points: the split adds none
+    assert any("2 polyhedron cells were weighed as" in w for w in doc["warnings"])
+    assert not any("not planar" in w for w in doc["warnings"])
 
 
 def test_prism_cells_are_weighed_as_vtk_weighs_them() -> None:
@@ -243,11 +245,11 @@ def test_prism_cells_are_weighed_as_vtk_weighs_them() -> None:
 
 
 def test_polyhedron_that_is_not_star_shaped_is_refused() -> None:
-    """An L-shaped polyhedron (VTK type 42) whose centre sees a face from behind: no exact split from there."""
+    """An L-shaped polyhedron (VTK type 42): from its first corner (the L's outer corner) one arm's end is seen from behind."""
     pytest.importorskip("vtkmodules")
     from inertia.errors import UnsupportedFormatError
 
-    # an L of two arms 4 long and 0.1 wide, 1 high: the mean of its corners lies outside it
+    # an L of two arms 4 long and 0.1 wide, 1 high
     pts = [(0, 0, 0), (4, 0, 0), (4, 0.1, 0), (0.1, 0.1, 0), (0.1, 4, 0), (0, 4, 0)]
     pts += [(x, y, 1) for x, y, _ in pts]
     bottom = [5, 4, 3, 2, 1, 0]

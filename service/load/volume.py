@@ -40,8 +40,8 @@ Cells: linear tetrahedra stay a closed-form kernel (``VolumeBody.tets``);
 every other 3-D cell becomes a ``CellBlock`` integrated as its element
 (``cells``), voxels reordered to hexahedra.  VTK's cells bounded by flat
 polygons (pentagonal and hexagonal prisms, polyhedra) become tetrahedra
-(``_polyhedra``): prisms as VTK itself splits them, polyhedra from their
-centre when their faces close them with one winding and they are
+(``_polyhedra``): prisms as VTK itself splits them, polyhedra from a
+corner when their faces close them with one winding and they are
 star-shaped from there (else the file is refused, naming the cell); bent
 faces are said in a warning with the volume they put in doubt.  A 3-D cell
 type we cannot integrate refuses the file (it is never dropped).
@@ -87,7 +87,7 @@ VTK_CELL_TYPES = {
     29: "hexahedron27",
     32: "wedge18",
 }
-# cells bounded by flat polygons: split into tetrahedra from their centre where that is exact (``_polyhedra``)
+# cells bounded by polygons: split into tetrahedra where that is exact (``_polyhedra``)
 _VTK_POLYHEDRA = {15: "pentagonal prism", 16: "hexagonal prism", 42: "polyhedron"}
 # 3-D VTK cells we cannot integrate (refused, never dropped)
 _VTK_OTHER_3D = {
@@ -371,6 +371,10 @@ def _mesh_from_grid(grid: Any, to_numpy: Any, label: str) -> _Mesh:
         if vtk_type in _VTK_POLYHEDRA:
             ids = np.flatnonzero(types == vtk_type)
             nodes, cell_of, mesh.points, note = _polyhedra(grid, ids, vtk_type, conn, offsets, mesh.points, label)
+            mesh.warnings.append(
+                f"{len(ids)} {_VTK_POLYHEDRA[vtk_type]} cells were weighed as {len(nodes)} tetrahedra "
+                "(source.cells and source.tetrahedra count those)"
+            )
             mesh.warnings.extend([note] if note else [])
             name = _VTK_POLYHEDRA[vtk_type].replace(" ", "_")
             mesh.blocks.append(_Block("tetra", nodes, cell_of, f"{name}_{len(mesh.blocks)}"))
@@ -424,31 +428,31 @@ def _polyhedra(
     points: NDArray[np.float64],
     label: str,
 ) -> tuple[NDArray[np.int64], NDArray[np.int64], NDArray[np.float64], str | None]:
-    """Polyhedral cells as tetrahedra (centre, a face's first corner, two more), where that split is exact.
+    """Polyhedral cells as tetrahedra (a corner of the cell, a face's first corner, two more), where exact.
 
-    Exact when the faces close the cell with one winding (each edge once each way) and every
-    tetrahedron from the cell's centre (mean of its points) has the same orientation (the cell is
-    star-shaped from there, so the pieces neither overlap nor leave a gap); a cell that fails refuses
-    the file, naming the cell and why.  A face that is not flat (float32 rounding, warped faces) bounds
-    a volume that depends on how it is split: it is split as a fan from its first corner, and when
-    that matters by more than ``polygons.NOTE_REL`` of the volume a warning says by how much
+    Prisms are split as VTK splits them.  A polyhedron is split from its first corner: exact when
+    the faces close the cell with one winding (each edge once each way) and every tetrahedron from
+    that corner has the same orientation (the cell is star-shaped from there, as every convex cell
+    is, so the pieces neither overlap nor leave a gap); a cell that fails refuses the file, naming
+    the cell and why.  No point is added, so the file's points stay its own.  A face that is not
+    flat (float32 rounding, warped faces) bounds a volume that depends on how it is split: it is
+    split as a fan, and when that matters by more than ``polygons.NOTE_REL`` of the volume a
+    warning says by how much
     (``polygons.fan_split_note``).  Returns the tetrahedra (positively wound), the file cell of each,
-    the points with the centres appended, and the warning if any.
+    the points (unchanged), and the warning if any.
     """
     kind = _VTK_POLYHEDRA[vtk_type]
     tets: list[list[int]] = []
     owner: list[int] = []
-    centres: list[NDArray[np.float64]] = []
     all_faces: list[list[int]] = []
     for cell in (int(c) for c in ids):
         faces = _polyhedron_faces(grid, cell, vtk_type, conn, offsets)
         corners = sorted({i for f in faces for i in f})
         if len(faces) < 4 or any(len(f) < 3 for f in faces) or not corners or max(corners) >= len(points) or min(corners) < 0:
             raise UnreadableFileError(f"{label} has a {kind} cell ({cell}) whose faces do not bound a solid; fix the mesh")
-        x = points[corners]
-        centre = x.mean(axis=0)
-        size = float(np.ptp(x, axis=0).max())
-        why = _polyhedron_defect(points, faces, centre, size)
+        size = float(np.ptp(points[corners], axis=0).max())
+        apex = faces[0][0]
+        why = _polyhedron_defect(points, faces, apex, size)
         if why:
             raise UnsupportedFormatError(
                 f"{label} has a {kind} cell ({cell}) that cannot be weighed exactly: {why}; "
@@ -458,24 +462,22 @@ def _polyhedra(
             )
         first = len(tets)
         all_faces.extend(faces)
-        if vtk_type == 42:
-            c = len(points) + len(centres)
-            centres.append(centre)
+        if vtk_type == 42:  # from one corner: the faces through it add nothing (split from it, they are flat to it)
             for f in faces:
-                tets.extend([c, f[0], f[i], f[i + 1]] for i in range(1, len(f) - 1))
+                if apex not in f:
+                    tets.extend([apex, f[0], f[i], f[i + 1]] for i in range(1, len(f) - 1))
         else:  # a prism is one of VTK's own cells: split as VTK splits it (vtkCell::Triangulate)
             tets.extend(_vtk_split(grid, cell, points, label, kind))
         owner.extend([cell] * (len(tets) - first))
     nodes = np.asarray(tets, dtype=np.int64).reshape(-1, 4)
-    everything = np.concatenate([points, np.asarray(centres, dtype=np.float64).reshape(-1, 3)])
-    t = everything[nodes]
+    t = points[nodes]
     det = np.einsum("ij,ij->i", t[:, 1] - t[:, 0], np.cross(t[:, 2] - t[:, 0], t[:, 3] - t[:, 0]))
     nodes[det < 0] = nodes[det < 0][:, [0, 2, 1, 3]]  # each cell's pieces share a sign (checked): wind them positively
     counts = np.fromiter((len(f) for f in all_faces), dtype=np.int64, count=len(all_faces))
     flat = np.fromiter((i for f in all_faces for i in f), dtype=np.int64, count=int(counts.sum()))
-    how = "as a fan from its first corner" if vtk_type == 42 else "as VTK splits its own cells (vtkCell::Triangulate)"
+    how = "as a fan from one corner" if vtk_type == 42 else "as VTK splits its own cells (vtkCell::Triangulate)"
     note = fan_split_note(points, flat, counts, kind, volume=float(np.abs(det).sum()) / 6, how=how)
-    return nodes, np.asarray(owner, dtype=np.int64), everything, note
+    return nodes, np.asarray(owner, dtype=np.int64), points, note
 
 
 def _vtk_split(grid: Any, cell: int, points: NDArray[np.float64], label: str, kind: str) -> list[list[int]]:
@@ -500,8 +502,8 @@ def _vtk_split(grid: Any, cell: int, points: NDArray[np.float64], label: str, ki
     return tets
 
 
-def _polyhedron_defect(points: NDArray[np.float64], faces: list[list[int]], centre: NDArray[np.float64], size: float) -> str:
-    """Why splitting this cell from its centre would not be exact, or ''."""
+def _polyhedron_defect(points: NDArray[np.float64], faces: list[list[int]], apex: int, size: float) -> str:
+    """Why splitting this cell from its corner ``apex`` would not be exact, or ''."""
     edges: dict[tuple[int, int], int] = {}
     for f in faces:
         for a, b in zip(f, [*f[1:], f[0]], strict=True):
@@ -516,10 +518,13 @@ def _polyhedron_defect(points: NDArray[np.float64], faces: list[list[int]], cent
         length = float(np.linalg.norm(normal))
         if length <= 1e-24 * size**2:
             return "a face has no area"
-        det = np.einsum("ij,ij->i", x[1:-1] - centre, np.cross(x[2:] - centre, np.broadcast_to(x[0] - centre, x[2:].shape)))
+        if apex in f:
+            continue
+        o = points[apex]
+        det = np.einsum("ij,ij->i", x[1:-1] - o, np.cross(x[2:] - o, np.broadcast_to(x[0] - o, x[2:].shape)))
         signs.update(np.sign(det[np.abs(det) > 1e-12 * size**3]).tolist())
     if len(signs) > 1:
-        return "it is not star-shaped from its centre (the mean of its points)"
+        return f"it is not star-shaped from its corner {apex} (not convex)"
     return ""
 
 
