@@ -178,6 +178,8 @@ def test_api_key_guards_v1_but_not_healthz() -> None:
         assert_error(c.post("/v1/analyze/points", json=TRIATOMIC), 401, "unauthorized")
         files = [("files", ("box.stl", (SAMPLES / "box.stl").read_bytes(), "application/octet-stream"))]
         assert_error(c.post("/v1/batch", files=files), 401, "unauthorized")
+        # RFC 9110: a 401 carries a WWW-Authenticate challenge; it names the header the key goes in
+        assert "X-API-Key" in c.get("/v1/formats").headers.get("www-authenticate", "")
         key = {"X-API-Key": "s3cret"}
         assert c.get("/v1/formats", headers=key).status_code == 200
         r = c.post("/v1/analyze/mesh", files={"file": ("box.stl", (SAMPLES / "box.stl").read_bytes())}, headers=key)
