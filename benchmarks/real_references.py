@@ -17,8 +17,10 @@ element VTK defines up to the triquadratic hexahedron.  A cell whose
 Jacobian keeps one sign counts with its absolute volume (VTK's own cell
 sizes are signed: an inverted cell is the same solid); a cell whose Jacobian
 changes sign is integrated with its sign, as ``vtkCellSizeFilter`` does.
-Polyhedra and pentagonal or hexagonal prisms are not integrated (the files
-holding them are expected to be refused).
+Polyhedra and pentagonal or hexagonal prisms, which VTK defines by their
+faces, are split by VTK's own ``Triangulate`` and each tetrahedron integrated
+exactly (with its absolute volume; ``vtkCellSizeFilter``'s cell volumes are
+checked to agree).
 
 STEP files: imported by Gmsh's OpenCASCADE kernel (``gmsh.model.occ``) in
 millimetres, each volume's ``getMass``, ``getCenterOfMass`` and
@@ -47,7 +49,8 @@ REAL = ROOT / "tests" / "data" / "real"
 ORDER = 8
 _SIMPLEX = {10, 24}  # tetrahedra: r + s + t <= 1
 _WEDGE = {13, 26, 32}  # wedges: r + s <= 1, 0 <= t <= 1
-_NOT_INTEGRATED = {15, 16, 42}
+_NOT_INTEGRATED: set[int] = set()
+_BY_FACES = {15, 16, 42}  # pentagonal and hexagonal prisms, polyhedra: VTK's own split into tetrahedra
 # STEP files and the length unit their solids are written in (mm per unit): the reference is in file units
 STEP_UNITS = {
     "featuretype.STEP": 25.4,
@@ -104,6 +107,10 @@ def vtk_moments(grid: Any) -> tuple[float, np.ndarray, np.ndarray, dict[int, int
         if cell.GetCellDimension() != 3 or cell_type in _NOT_INTEGRATED:
             skipped[cell_type] = len(ids)
             continue
+        if cell_type in _BY_FACES:
+            v, first, second = _split_moments(grid, ids)
+            m0, m1, m2 = m0 + v, m1 + first, m2 + second
+            continue
         n = cell.GetNumberOfPoints()
         pcoords, weights = _rule(cell_type)
         shape = np.zeros((len(pcoords), n))
@@ -124,6 +131,27 @@ def vtk_moments(grid: Any) -> tuple[float, np.ndarray, np.ndarray, dict[int, int
         m1 += np.einsum("cq,cqd->d", wdet, xq)
         m2 += np.einsum("cq,cqd,cqe->de", wdet, xq, xq)
     return m0, m1, m2, skipped
+
+
+def _split_moments(grid: Any, ids: list[int]) -> tuple[float, np.ndarray, np.ndarray]:
+    """Moments of cells split into tetrahedra by VTK (``Triangulate``), each tetrahedron exactly (closed form)."""
+    from vtkmodules.util.numpy_support import vtk_to_numpy
+    from vtkmodules.vtkCommonCore import vtkIdList, vtkPoints
+
+    to_numpy: Any = vtk_to_numpy
+    points = np.asarray(to_numpy(grid.GetPoints().GetData()), dtype=np.float64)
+    m0, m1, m2 = 0.0, np.zeros(3), np.zeros((3, 3))
+    for i in ids:
+        split = vtkIdList()
+        grid.GetCell(i).Triangulate(0, split, vtkPoints())  # the points it also returns are float32: ids are used
+        t = points[[split.GetId(k) for k in range(split.GetNumberOfIds())]].reshape(-1, 4, 3)
+        v = np.abs(np.einsum("ij,ij->i", t[:, 1] - t[:, 0], np.cross(t[:, 2] - t[:, 0], t[:, 3] - t[:, 0]))) / 6
+        c = t.sum(axis=1)  # sum of the four corners
+        m0 += float(v.sum())
+        m1 += (v[:, None] * c).sum(axis=0) / 4
+        # integral of x x^T over a tetrahedron: V/20 (sum_i x_i x_i^T + (sum x_i)(sum x_i)^T)
+        m2 += np.einsum("t,tkd,tke->de", v, t, t) / 20 + np.einsum("t,td,te->de", v, c, c) / 20
+    return m0, m1, m2
 
 
 def _about_centre(m0: float, m1: np.ndarray, m2: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

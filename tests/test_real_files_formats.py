@@ -198,3 +198,73 @@ def test_off_quads_are_checked_too() -> None:
     assert doc["mass"] == pytest.approx(1.1, rel=1e-14)
     notes = [w for w in doc["warnings"] if "not planar" in w]
     assert len(notes) == 1 and "OFF file" in notes[0] and "about 0.05 of it" in notes[0]
+
+
+def test_polyhedron_cells_are_weighed() -> None:
+    """VTK's polyhedron2pieces.vtu: two unit cubes written as polyhedra (VTK type 42), each under a pyramid of height 1.
+
+    From the file's own coordinates: V = 2 (1 + 1/3) = 8/3.
+    """
+    pytest.importorskip("vtkmodules")
+    from inertia.pipeline import AnalysisOptions, analyze_loaded
+
+    doc = analyze_loaded(
+        load_body((REAL / "vtu" / "polyhedron2pieces.vtu").read_bytes(), filename="polyhedron2pieces.vtu"),
+        AnalysisOptions(density=1.0),
+    ).as_dict()
+    assert doc["mass"] == pytest.approx(8 / 3, rel=1e-14)
+    assert doc["source"]["points"] == 18  # the file's own points: the split adds none
+    assert any("2 polyhedron cells were weighed as" in w for w in doc["warnings"])
+    assert not any("not planar" in w for w in doc["warnings"])
+
+
+def test_prism_cells_are_weighed_as_vtk_weighs_them() -> None:
+    """VTK's PentaHexa.vtk: 60 pentagonal and 150 hexagonal prisms on a sphere, their faces bent.
+
+    VTK's own cell sizes (vtkCellSizeFilter, signed: 150 cells are wound inward) sum in absolute
+    value to the volume; the bent faces are said in a warning.
+    """
+    pytest.importorskip("vtkmodules")
+    import numpy as np
+    from vtkmodules.util.numpy_support import vtk_to_numpy
+    from vtkmodules.vtkFiltersVerdict import vtkCellSizeFilter
+    from vtkmodules.vtkIOLegacy import vtkUnstructuredGridReader
+
+    from inertia.pipeline import AnalysisOptions, analyze_loaded
+
+    path = REAL / "vtk" / "PentaHexa.vtk"
+    reader = vtkUnstructuredGridReader()
+    reader.SetFileName(str(path))
+    sizes = vtkCellSizeFilter()
+    sizes.SetInputConnection(reader.GetOutputPort())
+    sizes.Update()
+    volumes = np.asarray(vtk_to_numpy(sizes.GetOutput().GetCellData().GetArray("Volume")))  # type: ignore[no-untyped-call]
+    doc = analyze_loaded(load_body(path.read_bytes(), filename="PentaHexa.vtk"), AnalysisOptions(density=1.0)).as_dict()
+    assert doc["mass"] == pytest.approx(float(np.abs(volumes).sum()), rel=1e-12)
+    assert any("hexagonal prism cells" in w and "not planar" in w for w in doc["warnings"])
+
+
+def test_polyhedron_that_is_not_star_shaped_is_refused() -> None:
+    """An L-shaped polyhedron (VTK type 42): from its first corner (the L's outer corner) one arm's end is seen from behind."""
+    pytest.importorskip("vtkmodules")
+    from inertia.errors import UnsupportedFormatError
+
+    # an L of two arms 4 long and 0.1 wide, 1 high
+    pts = [(0, 0, 0), (4, 0, 0), (4, 0.1, 0), (0.1, 0.1, 0), (0.1, 4, 0), (0, 4, 0)]
+    pts += [(x, y, 1) for x, y, _ in pts]
+    bottom = [5, 4, 3, 2, 1, 0]
+    top = [6, 7, 8, 9, 10, 11]
+    sides = [[i, (i + 1) % 6, (i + 1) % 6 + 6, i + 6] for i in range(6)]
+    faces = [bottom, top, *sides]
+    stream = [len(faces)] + [v for f in faces for v in (len(f), *f)]
+    points = "\n".join(f"{x} {y} {z}" for x, y, z in pts)
+    text = (
+        "# vtk DataFile Version 5.1\nL\nASCII\nDATASET UNSTRUCTURED_GRID\n"
+        f"POINTS {len(pts)} double\n{points}\n"
+        f"CELLS 2 {len(stream)}\nOFFSETS vtktypeint64\n0 {len(stream)}\nCONNECTIVITY vtktypeint64\n"
+        + " ".join(map(str, stream))
+        + "\nCELL_TYPES 1\n42\n"
+    )
+    with pytest.raises(UnsupportedFormatError) as info:
+        load_body(text.encode(), filename="L.vtk")
+    assert "star-shaped" in info.value.message

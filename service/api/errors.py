@@ -48,6 +48,9 @@ STATUS: dict[type[ServiceError], int] = {
     ServiceError: 500,
 }
 
+# the challenge of a 401: the API key goes in the X-API-Key header (INERTIA_API_KEY)
+WWW_AUTHENTICATE = 'API-Key header="X-API-Key"'
+
 # framework errors that are not ServiceErrors: status -> code
 _HTTP_CODES = {401: "unauthorized", 404: "not_found", 405: "method_not_allowed", 413: "payload_too_large"}
 
@@ -64,6 +67,8 @@ def error_response(exc: ServiceError) -> JSONResponse:
         headers["Retry-After"] = str(retry)
     if status >= 500 and status != 503:
         headers["Connection"] = "close"  # a bug: start the client's next request on a fresh connection
+    if status == 401:  # RFC 9110 §15.5.2: a 401 names the challenge; here, the header that carries the key
+        headers["WWW-Authenticate"] = WWW_AUTHENTICATE
     return JSONResponse(exc.as_dict(), status_code=status, headers=headers)
 
 
@@ -94,6 +99,12 @@ def _body_message(error: dict[str, Any], content_type: str | None) -> str | None
             sent = f"was sent as {content_type}" if content_type else "came without a Content-Type header"
             return f"the request body {sent}; send the JSON document of API.md with the header Content-Type: application/json"
         return "the request body must be a JSON object (the document of API.md), not an array or a single value"
+    if len(loc) >= 2 and loc[0] == "body" and "Expected UploadFile" in str(error.get("msg", "")):
+        # a multipart part without a file name is a form field, not a file (curl -F 'file=<x.stl')
+        return (
+            f"the multipart part '{loc[1]}' came without a file name, so it is a form field rather than a file; "
+            f"send it as a file part with its name, e.g. curl -F {loc[1]}=@part.stl"
+        )
     return None
 
 

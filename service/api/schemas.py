@@ -500,4 +500,8 @@ def error_responses(*statuses: int) -> dict[int | str, dict[str, Any]]:
             out[status]["headers"] = {
                 "Retry-After": {"description": "server_busy: seconds to wait before retrying", "schema": {"type": "integer"}}
             }
+        if status == 401:
+            out[status]["headers"] = {
+                "WWW-Authenticate": {"description": "the key goes in the X-API-Key header", "schema": {"type": "string"}}
+            }
     return out

@@ -38,6 +38,8 @@ def read_surface_parts(
         from .obj import read_obj
 
         groups, notes = guarded_read(lambda: read_obj(data), fmt)  # our reader; any slip still becomes a sentence
+        if len(groups) > 1:  # each part keeps the vertices its faces use, not the file's whole list
+            groups = [(name, *_compact(v, f)) for name, v, f in groups]
         parts = [mesh_part(name or "body", v, f, length_scale, "obj") for name, v, f in groups]
         if len(parts) == 1 and not groups[0][0]:
             parts = [mesh_part("body", groups[0][1], groups[0][2], length_scale, "obj")]
@@ -50,6 +52,12 @@ def read_surface_parts(
         return parts, model.unit, model.notes
     parts, unit = read_trimesh_parts(data, fmt, length_scale, companions)
     return parts, unit, []
+
+
+def _compact(vertices: NDArray[np.float64], faces: NDArray[np.int64]) -> tuple[NDArray[np.float64], NDArray[np.int64]]:
+    """The vertices the faces use, and the faces renumbered onto them."""
+    used, renumbered = np.unique(faces, return_inverse=True)
+    return vertices[used], renumbered.reshape(faces.shape).astype(np.int64)
 
 
 def mesh_part(name: str, vertices: NDArray[Any], faces: NDArray[Any], length_scale: float, fmt: str) -> Part:

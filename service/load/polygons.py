@@ -23,10 +23,21 @@ __all__ = ["NOTE_REL", "fan_split_note"]
 NOTE_REL = 1e-9  # below this share of the volume, the split is lost in the file's own rounding
 
 
-def fan_split_note(vertices: NDArray[np.float64], corners: NDArray[np.int64], counts: NDArray[np.int64], fmt: str) -> str | None:
+def fan_split_note(
+    vertices: NDArray[np.float64],
+    corners: NDArray[np.int64],
+    counts: NDArray[np.int64],
+    what: str,
+    *,
+    volume: float | None = None,
+    how: str = "as a fan from its first corner (as Blender and trimesh do)",
+) -> str | None:
     """A warning when the file's non-planar polygons make the volume depend on how they are split.
 
-    corners : every face's vertex numbers, one face after another; counts : corners per face.
+    corners : every face's vertex numbers, one face after another; counts : corners per face;
+    what : the format ("ply": "faces of the PLY file") or the cells ("polyhedron": "faces of its
+    polyhedron cells"); volume : the volume to weigh the change against, by default the one the
+    faces enclose as one surface.
     """
     counts = np.asarray(counts, dtype=np.int64)
     if not np.any(counts >= 4):
@@ -40,7 +51,8 @@ def fan_split_note(vertices: NDArray[np.float64], corners: NDArray[np.int64], co
     step = np.arange(len(face)) - np.repeat(np.cumsum(fans) - fans, fans)
     first = starts[face]
     a, b, c = x[corners[first]], x[corners[first + 1 + step]], x[corners[first + 2 + step]]
-    volume = abs(float(np.einsum("ij,ij->", a, np.cross(b, c)))) / 6
+    if volume is None:
+        volume = abs(float(np.einsum("ij,ij->", a, np.cross(b, c)))) / 6
     # each inner diagonal of a fan flipped: the tetrahedron (c0, ci+1, ci+2, ci+3)
     flips = np.maximum(counts - 3, 0)
     face = np.repeat(np.arange(len(counts)), flips)
@@ -56,8 +68,9 @@ def fan_split_note(vertices: NDArray[np.float64], corners: NDArray[np.int64], co
         return None
     polygons = int(np.count_nonzero(counts >= 4))
     bent_faces = int(np.unique(face[bent]).size)
+    where = f"the {what.upper()} file" if what in ("ply", "obj", "off") else f"the {what} cells"
     return (
-        f"{bent_faces} of the {polygons} faces of the {fmt.upper()} file with more than three corners are not planar; "
-        "each was split into triangles as a fan from its first corner (as Blender and trimesh do), and splitting "
-        f"them along their other diagonals changes the volume by up to about {change / volume:.1g} of it"
+        f"{bent_faces} of the {polygons} faces of {where} with more than three corners are not planar; "
+        f"each was split into triangles {how}, and splitting "
+        f"them along other diagonals changes the volume by up to about {change / volume:.1g} of it"
     )

@@ -38,8 +38,13 @@ written to our stdout or stderr.
 
 Cells: linear tetrahedra stay a closed-form kernel (``VolumeBody.tets``);
 every other 3-D cell becomes a ``CellBlock`` integrated as its element
-(``cells``), voxels reordered to hexahedra.  A 3-D cell type we cannot
-integrate refuses the file (it is never dropped).
+(``cells``), voxels reordered to hexahedra.  VTK's cells bounded by flat
+polygons (pentagonal and hexagonal prisms, polyhedra) become tetrahedra
+(``_polyhedra``): prisms as VTK itself splits them, polyhedra from a
+corner when their faces close them with one winding and they are
+star-shaped from there (else the file is refused, naming the cell); bent
+faces are said in a warning with the volume they put in doubt.  A 3-D cell
+type we cannot integrate refuses the file (it is never dropped).
 """
 
 from __future__ import annotations
@@ -61,6 +66,7 @@ from numpy.typing import NDArray
 from ..body import CellBlock, Part, VolumeBody
 from ..cells import CELL_NODES, VOXEL_TO_HEXAHEDRON
 from ..errors import EmptyGeometryError, UnreadableFileError, UnsupportedFormatError
+from .polygons import fan_split_note
 from .sniff import VOLUME_FORMATS
 
 __all__ = ["read_volume_parts", "VTK_FORMATS", "VTK_CELL_TYPES"]
@@ -81,13 +87,12 @@ VTK_CELL_TYPES = {
     29: "hexahedron27",
     32: "wedge18",
 }
+# cells bounded by polygons: split into tetrahedra where that is exact (``_polyhedra``)
+_VTK_POLYHEDRA = {15: "pentagonal prism", 16: "hexagonal prism", 42: "polyhedron"}
 # 3-D VTK cells we cannot integrate (refused, never dropped)
 _VTK_OTHER_3D = {
-    15: "pentagonal prism",
-    16: "hexagonal prism",
     33: "24-node hexahedron",
     37: "19-node pyramid",
-    42: "polyhedron",
     71: "Lagrange tetrahedron",
     72: "Lagrange hexahedron",
     73: "Lagrange wedge",
@@ -357,12 +362,23 @@ def _mesh_from_grid(grid: Any, to_numpy: Any, label: str) -> _Mesh:
     if unsupported:
         raise UnsupportedFormatError(_unsupported_cells(label, unsupported), cell_types=sorted(unsupported))
     for t in np.unique(types):
-        if int(t) not in VTK_CELL_TYPES:
+        if int(t) not in VTK_CELL_TYPES and int(t) not in _VTK_POLYHEDRA:
             mesh.other[_VTK_2D_NAMES.get(int(t), f"VTK cell type {int(t)}")] = int(np.count_nonzero(types == t))
     # one block per cell type, in order of first appearance (as meshio groups a VTK file's cells; by type, not
     # by consecutive runs, so a mesh whose types alternate does not become thousands of parts)
     present, first = np.unique(types, return_index=True)
     for vtk_type in (int(t) for t in present[np.argsort(first)]):
+        if vtk_type in _VTK_POLYHEDRA:
+            ids = np.flatnonzero(types == vtk_type)
+            nodes, cell_of, mesh.points, note = _polyhedra(grid, ids, vtk_type, conn, offsets, mesh.points, label)
+            mesh.warnings.append(
+                f"{len(ids)} {_VTK_POLYHEDRA[vtk_type]} cells were weighed as {len(nodes)} tetrahedra "
+                "(source.cells and source.tetrahedra count those)"
+            )
+            mesh.warnings.extend([note] if note else [])
+            name = _VTK_POLYHEDRA[vtk_type].replace(" ", "_")
+            mesh.blocks.append(_Block("tetra", nodes, cell_of, f"{name}_{len(mesh.blocks)}"))
+            continue
         if vtk_type not in VTK_CELL_TYPES:
             continue
         name = VTK_CELL_TYPES[vtk_type]
@@ -372,6 +388,164 @@ def _mesh_from_grid(grid: Any, to_numpy: Any, label: str) -> _Mesh:
             nodes, name = nodes[:, VOXEL_TO_HEXAHEDRON], "hexahedron"
         mesh.blocks.append(_Block(name, nodes, ids, f"{VTK_CELL_TYPES[vtk_type]}_{len(mesh.blocks)}"))
     return mesh
+
+
+def _polyhedron_faces(grid: Any, cells: NDArray[np.int64]) -> tuple[list[list[int]], list[int]]:
+    """The faces of polyhedron cells (point ids, from VTK's face streams) and the cell of each face."""
+    from vtkmodules.vtkCommonCore import vtkIdList
+
+    faces: list[list[int]] = []
+    owner: list[int] = []
+    stream = vtkIdList()
+    for cell in (int(c) for c in cells):
+        grid.GetFaceStream(cell, stream)
+        ids = [stream.GetId(k) for k in range(stream.GetNumberOfIds())]
+        at = 1
+        for _ in range(ids[0] if ids else 0):
+            face = ids[at + 1 : at + 1 + ids[at]]
+            at += 1 + ids[at]
+            kept = [a for a, b in zip(face, [*face[1:], face[0]], strict=True) if a != b]  # a collapsed edge: one corner
+            if len(kept) >= 3:
+                faces.append(kept)
+                owner.append(cell)
+    return faces, owner
+
+
+def _prism_faces(
+    cells: NDArray[np.int64], vtk_type: int, conn: NDArray[np.int64], offsets: NDArray[np.int64]
+) -> tuple[list[list[int]], list[int]]:
+    """The faces of VTK's prisms (bottom polygon 0..n-1, top n..2n-1 above it), wound outward alike."""
+    n = 5 if vtk_type == 15 else 6
+    v = conn[offsets[cells][:, None] + np.arange(2 * n)[None, :]]
+    local = [list(range(n - 1, -1, -1)), list(range(n, 2 * n))]
+    local += [[i, (i + 1) % n, n + (i + 1) % n, n + i] for i in range(n)]
+    faces: list[list[int]] = []
+    owner: list[int] = []
+    for row, cell in zip(v.tolist(), cells.tolist(), strict=True):
+        for f in local:
+            face = [row[i] for i in f]
+            kept = [a for a, b in zip(face, [*face[1:], face[0]], strict=True) if a != b]
+            if len(kept) >= 3:
+                faces.append(kept)
+                owner.append(cell)
+    return faces, owner
+
+
+def _polyhedra(
+    grid: Any,
+    ids: NDArray[np.int64],
+    vtk_type: int,
+    conn: NDArray[np.int64],
+    offsets: NDArray[np.int64],
+    points: NDArray[np.float64],
+    label: str,
+) -> tuple[NDArray[np.int64], NDArray[np.int64], NDArray[np.float64], str | None]:
+    """Polyhedral cells as tetrahedra, where exact; the file cell of each, the points (unchanged), a warning.
+
+    Prisms are split as VTK splits them (its own local tetrahedra, ``TriangulateLocalIds``; a cell
+    whose pieces turn both ways folds over itself and is refused).  A polyhedron is split from its
+    first corner: exact when its faces close it with one winding (each edge once each way) and every
+    tetrahedron from that corner turns the same way (the cell is star-shaped from there, as every
+    convex cell is, so the pieces neither overlap nor leave a gap); a cell that fails refuses the
+    file, naming the cell and why.  No point is added.  A face that is not flat (float32 rounding,
+    warped faces) bounds a volume that depends on how it is split: when that matters by more than
+    ``polygons.NOTE_REL`` of the volume a warning says by how much (``polygons.fan_split_note``).
+    Vectorised over the cells but for reading VTK's face streams.
+    """
+    kind = _VTK_POLYHEDRA[vtk_type]
+
+    def refuse(cell: int, why: str) -> UnsupportedFormatError:
+        return UnsupportedFormatError(
+            f"{label} has a {kind} cell ({cell}) that cannot be weighed exactly: {why}; split such cells into "
+            "tetrahedra, hexahedra, wedges or pyramids (for example with VTK's vtkTessellatorFilter or Gmsh)",
+            cell_types=[kind],
+        )
+
+    faces, face_cell = _polyhedron_faces(grid, ids) if vtk_type == 42 else _prism_faces(ids, vtk_type, conn, offsets)
+    counts = np.fromiter((len(f) for f in faces), dtype=np.int64, count=len(faces))
+    flat = np.fromiter((i for f in faces for i in f), dtype=np.int64, count=int(counts.sum()))
+    cell_of_face = np.asarray(face_cell, dtype=np.int64)
+    if len(flat) == 0 or flat.min() < 0 or flat.max() >= len(points) or len(np.unique(cell_of_face)) != len(ids):
+        raise UnreadableFileError(f"{label} has {kind} cells whose faces do not bound a solid; fix the mesh")
+    starts = np.concatenate([[0], np.cumsum(counts)[:-1]])
+    corner_face = np.repeat(np.arange(len(counts)), counts)
+    nxt = np.arange(len(flat)) + 1
+    nxt[starts + counts - 1] = starts  # each corner's successor around its face
+    # one winding: within each cell every edge runs once each way
+    a, b = flat, flat[nxt]
+    cell = cell_of_face[corner_face]
+    lo, hi, sign = np.minimum(a, b), np.maximum(a, b), np.where(a < b, 1, -1)
+    order = np.lexsort((hi, lo, cell))
+    key_change = np.r_[
+        True, (lo[order][1:] != lo[order][:-1]) | (hi[order][1:] != hi[order][:-1]) | (cell[order][1:] != cell[order][:-1])
+    ]
+    runs = np.flatnonzero(key_change)
+    unbalanced = np.add.reduceat(sign[order], runs) != 0
+    if np.any(unbalanced):
+        raise refuse(int(cell[order][runs[np.argmax(unbalanced)]]), "its faces do not close it with one winding")
+    # fan triangles of every face, from its first corner
+    fans = counts - 2
+    tri_face = np.repeat(np.arange(len(counts)), fans)
+    step = np.arange(len(tri_face)) - np.repeat(np.cumsum(fans) - fans, fans)
+    first = starts[tri_face]
+    tri = np.stack([flat[first], flat[first + 1 + step], flat[first + 2 + step]], axis=1)
+    x = points[tri]
+    area2 = np.zeros((len(counts), 3))
+    np.add.at(area2, tri_face, np.cross(x[:, 1] - x[:, 0], x[:, 2] - x[:, 0]))
+    cell_lo = np.full((len(ids), 3), np.inf)
+    cell_hi = np.full((len(ids), 3), -np.inf)
+    slot = np.searchsorted(ids, cell_of_face[corner_face])
+    for k in range(3):
+        np.minimum.at(cell_lo[:, k], slot, points[flat, k])
+        np.maximum.at(cell_hi[:, k], slot, points[flat, k])
+    size = (cell_hi - cell_lo).max(axis=1)  # per cell, in the order of ids
+    face_size = size[np.searchsorted(ids, cell_of_face)]
+    flat_face = np.linalg.norm(area2, axis=1) <= 1e-24 * face_size**2
+    if np.any(flat_face):
+        raise refuse(int(cell_of_face[np.argmax(flat_face)]), "a face has no area")
+    if vtk_type == 42:
+        first_face = np.searchsorted(cell_of_face, ids)  # faces are grouped by cell, in the order of ids
+        apex = flat[starts[first_face]]
+        tri_cell = np.searchsorted(ids, cell_of_face[tri_face])
+        o = points[apex[tri_cell]]
+        through = np.zeros(len(counts), dtype=bool)  # faces through their cell's apex: split from it, they add nothing
+        np.logical_or.at(through, corner_face, flat == apex[np.searchsorted(ids, cell_of_face[corner_face])])
+        keep = ~through[tri_face]
+        nodes = np.concatenate([apex[tri_cell][:, None], tri], axis=1)[keep]
+        owner = ids[tri_cell][keep]
+        o, x = o[keep], x[keep]
+        det = np.einsum("ij,ij->i", x[:, 0] - o, np.cross(x[:, 1] - o, x[:, 2] - o))
+        tol = 1e-12 * size[tri_cell[keep]] ** 3
+    else:
+        from vtkmodules.vtkCommonCore import vtkIdList
+
+        local = vtkIdList()
+        grid.GetCell(int(ids[0])).TriangulateLocalIds(0, local)
+        pattern = np.asarray([local.GetId(k) for k in range(local.GetNumberOfIds())], dtype=np.int64).reshape(-1, 4)
+        n_nodes = 10 if vtk_type == 15 else 12
+        cell_nodes = conn[offsets[ids][:, None] + np.arange(n_nodes)[None, :]]
+        nodes = cell_nodes[:, pattern].reshape(-1, 4)
+        owner = np.repeat(ids, len(pattern))
+        t = points[nodes]
+        det = np.einsum("ij,ij->i", t[:, 1] - t[:, 0], np.cross(t[:, 2] - t[:, 0], t[:, 3] - t[:, 0]))
+        tol = 1e-12 * np.repeat(size, len(pattern)) ** 3
+    positive = np.zeros(len(ids), dtype=bool)
+    negative = np.zeros(len(ids), dtype=bool)
+    np.logical_or.at(positive, np.searchsorted(ids, owner), det > tol)
+    np.logical_or.at(negative, np.searchsorted(ids, owner), det < -tol)
+    both = positive & negative
+    if np.any(both):
+        why = (
+            "it is not star-shaped from its first corner (not convex)"
+            if vtk_type == 42
+            else "VTK's own split of it turns both ways (it folds over itself)"
+        )
+        raise refuse(int(ids[np.argmax(both)]), why)
+    nodes = nodes.copy()
+    nodes[det < 0] = nodes[det < 0][:, [0, 2, 1, 3]]  # each cell's pieces share a sign (checked): wind them positively
+    how = "as a fan from one corner" if vtk_type == 42 else "as VTK splits its own cells (vtkCell::Triangulate)"
+    note = fan_split_note(points, flat, counts, kind, volume=float(np.abs(det).sum()) / 6, how=how)
+    return nodes, owner.astype(np.int64), points, note
 
 
 _VTK_2D_NAMES = {

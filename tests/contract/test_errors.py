@@ -178,6 +178,8 @@ def test_api_key_guards_v1_but_not_healthz() -> None:
         assert_error(c.post("/v1/analyze/points", json=TRIATOMIC), 401, "unauthorized")
         files = [("files", ("box.stl", (SAMPLES / "box.stl").read_bytes(), "application/octet-stream"))]
         assert_error(c.post("/v1/batch", files=files), 401, "unauthorized")
+        # RFC 9110: a 401 carries a WWW-Authenticate challenge; it names the header the key goes in
+        assert "X-API-Key" in c.get("/v1/formats").headers.get("www-authenticate", "")
         key = {"X-API-Key": "s3cret"}
         assert c.get("/v1/formats", headers=key).status_code == 200
         r = c.post("/v1/analyze/mesh", files={"file": ("box.stl", (SAMPLES / "box.stl").read_bytes())}, headers=key)
@@ -262,3 +264,12 @@ def test_malformed_json_is_named_as_such(client: TestClient) -> None:
 def test_a_bad_vector_component_names_its_field_not_the_index(client: TestClient, path: str, body: Any, field: str) -> None:
     err = assert_error(client.post(path, json=body), 422, "invalid_parameter")
     assert err["details"]["parameter"] == field, err
+
+
+@pytest.mark.parametrize("path,part", [("/v1/analyze/mesh", "file"), ("/v1/batch", "files")])
+def test_a_file_part_without_a_file_name_is_told_to_send_a_file(client: TestClient, path: str, part: str) -> None:
+    # curl -F 'file=<box.stl' (or a client that omits the file name) sends a form field, not a file
+    data = (SAMPLES / "box.stl").read_bytes()
+    err = assert_error(client.post(path, files={part: (None, data)}, params={"format": "stl"}), 422, "invalid_parameter")
+    assert "file name" in err["message"] and f"{part}=@" in err["message"], err
+    assert err["details"]["parameter"] == part

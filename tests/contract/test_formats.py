@@ -243,11 +243,6 @@ def test_obj_groups_are_parts(client: TestClient) -> None:
     assert res["mass"] == pytest.approx(1500, rel=1e-13, abs=0)
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="the OBJ reader gives every object the file's whole vertex list, so source.vertices counts "
-    "each vertex once per object (service/load, reported to its owner)",
-)
 @pytest.mark.parametrize("objects", [2, 3])
 def test_source_counts_each_vertex_of_a_multi_object_obj_once(client: TestClient, objects: int) -> None:
     # API.md's source section counts the body's vertices (8 for a box); n cubes written as n objects hold 8 n
