@@ -573,8 +573,20 @@ def motion_cases() -> list[MotionCase]:
         # I3 (I3 - I2) = 12 = 4 I1 (I2 - I1): Omega = (2, W2, 1) is exactly on the separatrix
         MotionCase("1 ulp off the separatrix, I = (3, 4, 6)", (3.0, 4.0, 6.0), (2.0 + math.ulp(2.0), 0.3, 1.0)),
         MotionCase("1e-15 off the intermediate axis", i, (1e-15, 1.0, 1e-15)),
-        MotionCase("moments 1 and 3 ulp apart, I = (1, 1 + eps, 1 + 3 eps)", (1.0, 1.0 + ulp, 1.0 + 3 * ulp), (0.6, 0.3, 0.8)),
-        MotionCase("needle I = (1e-20, 1, 1)", (1e-20, 1.0, 1.0), (0.6, 0.3, 0.8)),
+        MotionCase(
+            "moments 1 and 3 ulp apart, I = (1, 1 + eps, 1 + 3 eps)",
+            (1.0, 1.0 + ulp, 1.0 + 3 * ulp),
+            (0.6, 0.3, 0.8),
+            tolerance=1e-17,
+            note="tolerance 1e-17: modelled as the asymmetric top it is",
+        ),
+        MotionCase(
+            "needle I = (1e-20, 1, 1)",
+            (1e-20, 1.0, 1.0),
+            (0.6, 0.3, 0.8),
+            tolerance=1e-30,
+            note="tolerance 1e-30: modelled as the prolate top it is",
+        ),
     ]
     return cases
 
@@ -978,8 +990,10 @@ def _motion_lines(motion: list[MotionRow]) -> list[str]:
         "the motion was computed in power-of-two units, moments of 1e-300 and ‖Ω‖ ~ 1e-150 "
         "failed with ZeroDivisionError, moments of 1e300 and ‖Ω‖ ~ 1e150 were refused as overflowing; before states "
         "were snapped only within the rounding they carry, the separatrix and intermediate-axis rows were "
-        "off by O(1) of |Omega| after their first flip, and the needle and 1-ulp rows moved as idealised "
-        "(linear, spherical) tops. scipy's DOP853 fails on the ‖Ω‖ ~ 1e±150 rows (its step control "
+        "off by O(1) of |Omega| after their first flip. The needle and 1-ulp rows, like the nearly linear "
+        "and nearly symmetric ones, pass a tolerance below their gaps; at the default one, moments within "
+        "64 eps of each other (or a smallest one within 64 eps of 0) get the ideal top's closed form, "
+        "which for computed moments is within their own rounding. scipy's DOP853 fails on the ‖Ω‖ ~ 1e±150 rows (its step control "
         "underflows or overflows in those units).",
         "",
         "scipy runs the full 1e5 time units except where that is more than 1e6 rad (the ‖Ω‖ = 1e6 row: "

@@ -40,10 +40,10 @@ Modelling decisions (stated once, here):
   forms of those tops are used only where the moments agree to rounding
   (``MOTION_ROUNDING`` x the largest moment, ``motion_rotor``), and then the
   moments that agree are replaced by their mean (a change at rounding level).
-  Where the axes are an exact signed permutation (principal moments given,
-  a diagonal tensor) the moments carry no rounding, so only exactly equal
-  moments (an exactly zero smallest one for a linear rotator) get a closed
-  form of a degenerate top.
+  Moments the caller declares exact (``exact_moments``: principal moments
+  given as numbers) carry no rounding, so only exactly equal ones get a
+  closed form of a degenerate top; an exactly zero smallest moment is a
+  linear rotator in any case.
   Moments that differ by more, even if the classification calls them equal,
   move by the exact asymmetric (Jacobi elliptic) solution: a nearly
   symmetric top is not replaced by an ideal one whose motion departs from
@@ -125,6 +125,7 @@ def predict_motion(
     samples: int | None = None,
     method: MotionMethod | str = MotionMethod.EXACT,
     tolerances: Tolerances = DEFAULT_TOLERANCES,
+    exact_moments: bool = False,
 ) -> FreeMotion:
     """Torque-free motion of the body from its initial angular velocity.
 
@@ -133,6 +134,9 @@ def predict_motion(
         request the trajectory at ``samples`` equally spaced times in [0, duration].
     method : ``exact`` (default), ``dop853``, ``rk45`` or ``splitting``.
     tolerances : thresholds (``Tolerances``); the default is the service's.
+    exact_moments : the frame's moments are exact numbers (principal moments given by the
+        caller), not computed ones: moments then get a degenerate top's closed form only where
+        they are equal, not merely within rounding (``MOTION_ROUNDING``) of each other.
 
     Raises ``InvalidParameterError`` for malformed input and ``MotionError``
     when the method cannot treat this body or this horizon.
@@ -146,8 +150,8 @@ def predict_motion(
     units = Units.of(np.asarray(frame.moments, dtype=np.float64), omega)
     frame = units.frame(frame)
     times = None if given_times is None else units.times(given_times)
-    chosen.check(motion_rotor(frame, classification))
-    setup = decide_regime(frame, classification, units.angular_velocity(omega), tolerances, units.omega)
+    chosen.check(motion_rotor(frame, classification, exact_moments))
+    setup = decide_regime(frame, classification, units.angular_velocity(omega), tolerances, units.omega, exact_moments)
     motion = precession_quantities(setup, chosen.name, tolerances)
     if times is None:
         motion = units.restore(motion, None)

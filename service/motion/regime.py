@@ -44,22 +44,30 @@ class Setup:
 
 
 def decide_regime(
-    frame: PrincipalFrame, classification: Classification, omega: Array, tol: Tolerances, omega_exponent: int = 0
+    frame: PrincipalFrame,
+    classification: Classification,
+    omega: Array,
+    tol: Tolerances,
+    omega_exponent: int = 0,
+    exact_moments: bool = False,
 ) -> Setup:
     """The regime, and the ideal problem that is solved; the state as given is kept beside it.
 
     ``omega`` is in units of 2^omega_exponent rad/s (``scaling.Units``); warnings quote rad/s.
+    ``exact_moments``: the moments are numbers given, not computed (see ``motion_rotor``).
     """
-    decided = _decide(frame, classification, omega, tol, omega_exponent)
+    decided = _decide(frame, classification, omega, tol, omega_exponent, exact_moments)
     axes = np.asarray(frame.axes, dtype=np.float64)
     given = RigidProblem(np.asarray(frame.moments, dtype=np.float64), axes @ omega, axes, frame.quaternion)
     return replace(decided, initial=given)
 
 
-def _decide(frame: PrincipalFrame, classification: Classification, omega: Array, tol: Tolerances, omega_exponent: int) -> Setup:
+def _decide(
+    frame: PrincipalFrame, classification: Classification, omega: Array, tol: Tolerances, omega_exponent: int, exact_moments: bool
+) -> Setup:
     axes = np.asarray(frame.axes, dtype=np.float64)
     omega_body = axes @ omega
-    rotor = motion_rotor(frame, classification)
+    rotor = motion_rotor(frame, classification, exact_moments)
     moments = ideal_moments(np.asarray(frame.moments, dtype=np.float64), rotor)
     warnings: list[str] = []
     if rotor is RotorClass.LINEAR and omega_body[0] != 0.0:
@@ -124,14 +132,15 @@ def ideal_moments(moments: ArrayLike, rotor: RotorClass) -> Array:
     return ideal
 
 
-def motion_rotor(frame: PrincipalFrame, classification: Classification) -> RotorClass:
+def motion_rotor(frame: PrincipalFrame, classification: Classification, exact_moments: bool = False) -> RotorClass:
     """The rotor class whose motion is computed: the classification's only where its moments agree to rounding.
 
     The classification labels the body with its own ``tolerance``; the motion
     uses a closed form (symmetric, spherical, linear) only for moments equal
     within ``MOTION_ROUNDING`` (or the classification's tolerance, if smaller),
-    and for moments given exactly (``exact_axes``) only for equal ones (a
-    smallest moment of exactly 0 for a linear rotator).
+    and for moments the caller knows to be exact (``exact_moments``: principal
+    moments given as numbers) only for equal ones.  A smallest moment of
+    exactly 0 is a linear rotator in any case.
     Otherwise the class is decided again at that level, so a nearly symmetric
     top moves as the asymmetric top it is.
     """
@@ -140,8 +149,9 @@ def motion_rotor(frame: PrincipalFrame, classification: Classification) -> Rotor
     if float(frame.moments[0]) == 0.0 < float(frame.moments[-1]):
         # all mass on a line: I2 = I3 whatever rounding (within the triangle inequality's allowance) left
         return RotorClass.LINEAR
-    # exact (permutation) axes: the moments are the numbers given, with no rounding to forgive
-    level = 0.0 if exact_axes(frame.axes) else min(MOTION_ROUNDING, classification.tolerance)
+    # exact moments carry no rounding to forgive; computed ones (a mesh's, a tensor's eigenvalues) do,
+    # even where their axes came out exact (an axis-aligned part)
+    level = 0.0 if exact_moments else min(MOTION_ROUNDING, classification.tolerance)
     if classification.tolerance <= level:
         return classification.rotor
     return classify(frame, level).rotor

@@ -16,8 +16,11 @@ from typing import Any
 import numpy as np
 import pytest
 
-from inertia import precession
-from tests.support.motion import elliptic_reference
+from benchmarks.cases import box
+from inertia import analyze, precession
+from inertia.motion import predict_motion
+from inertia.options import AnalysisOptions
+from tests.support.motion import body, elliptic_reference
 
 EPS = float(np.finfo(float).eps)
 
@@ -71,13 +74,20 @@ def test_an_exact_principal_axis_is_still_permanent_rotation() -> None:
     assert res.motion.regime.value == "permanent_rotation" and res.motion.stable is False
 
 
+def _exact_motion(moments: Any, omega: Any, duration: float, samples: int) -> Any:
+    """The motion of principal moments declared exact (``exact_moments``), axes the input axes."""
+    frame, classification = body(moments)
+    return predict_motion(frame, classification, np.asarray(omega), duration=duration, samples=samples, exact_moments=True)
+
+
 @pytest.mark.parametrize("ulps", [1, 4, 32, 63])
 @pytest.mark.parametrize("shape", ["oblate", "prolate", "spherical"])
-def test_moments_a_few_ulps_apart_move_as_given(ulps: int, shape: str) -> None:
-    """Principal moments given exactly: a gap of one ulp is the body's, not rounding to be idealised.
+def test_exact_moments_a_few_ulps_apart_move_as_given(ulps: int, shape: str) -> None:
+    """Moments declared exact: a gap of one ulp is the body's, not rounding to be idealised.
 
-    Replacing such moments by their mean (the symmetric or spherical closed form) was off by up to
-    25 eps per radian turned, three times the 8 eps per radian the exact motion keeps."""
+    Replacing such moments by their mean (the symmetric or spherical closed form, what computed
+    moments get) is off by up to 25 eps per radian turned, three times the 8 eps per radian the exact
+    motion keeps."""
     gap = ulps * EPS
     moments = {
         "oblate": (1.0, 1.0 + gap, 2.0),
@@ -85,29 +95,42 @@ def test_moments_a_few_ulps_apart_move_as_given(ulps: int, shape: str) -> None:
         "spherical": (1.0, 1.0 + gap, 1.0 + 3 * gap),
     }[shape]
     omega = (0.6, 0.5, 0.4)
-    duration = 1e4
-    res, error = _omega_error(moments, omega, duration=duration)
-    assert error <= 8 * EPS * (1 + np.linalg.norm(omega) * duration), error
-    assert res.motion.regime.value == "asymmetric"
+    duration, samples = 1e4, 9
+    motion = _exact_motion(moments, omega, duration, samples)
+    reference = elliptic_reference(moments, omega, np.linspace(0.0, duration, samples), dps=90)
+    speed = float(np.linalg.norm(omega))
+    error = float(np.max(np.abs(motion.trajectory.omega_body - reference))) / speed
+    assert error <= 8 * EPS * (1 + speed * duration), error
+    assert motion.regime.value == "asymmetric"
 
 
-def test_a_needle_whose_smallest_moment_is_given_moves_as_the_prolate_top_it_is() -> None:
-    """I = (1e-20, 1, 1): the spin about the needle's axis turns Omega_perp in the body (L&L eq. 36.7)
-    at omega = Omega_1 (I1 - I_perp) / I_perp; a linear rotator (I1 = 0) would drop Omega_1."""
+def test_a_needle_whose_smallest_moment_is_exact_moves_as_the_prolate_top_it_is() -> None:
+    """I = (1e-20, 1, 1) declared exact: the spin about the needle's axis turns Omega_perp in the body
+    (L&L eq. 36.7) at omega = Omega_1 (I1 - I_perp) / I_perp; a linear rotator (I1 = 0) drops Omega_1."""
     import mpmath as mp
 
     moments, omega = (1e-20, 1.0, 1.0), (1.0, 0.5, 0.2)
     duration, samples = 10.0, 6
-    res = precession(omega, principal_moments=moments, duration=duration, samples=samples)
-    assert res.motion.trajectory is not None
+    motion = _exact_motion(moments, omega, duration, samples)
     with mp.workdps(40):
         rate = mp.mpf(omega[0]) * (mp.mpf(moments[0]) - 1) / 1
         expected = []
         for t in np.linspace(0.0, duration, samples):
             z = (mp.mpf(omega[1]) + 1j * mp.mpf(omega[2])) * mp.expj(rate * mp.mpf(float(t)))
             expected.append([omega[0], float(z.real), float(z.imag)])
-    assert np.max(np.abs(res.motion.trajectory.omega_body - np.array(expected))) <= 1e-14
-    assert res.motion.regime.value == "regular_precession" and not res.warnings
+    assert np.max(np.abs(motion.trajectory.omega_body - np.array(expected))) <= 1e-14
+    assert motion.regime.value == "regular_precession" and not motion.warnings
+
+
+@pytest.mark.parametrize("offset", [0.0, 0.1])
+def test_computed_moments_of_an_axis_aligned_cube_stay_a_spherical_top(offset: float) -> None:
+    """A cube's computed moments differ by rounding even where its principal axes come out exact (axis
+    aligned): they keep the spherical closed form (Omega constant), as computed moments always have."""
+    vertices, faces = box(1.0, 1.0, 1.0)
+    result = analyze((vertices + offset, faces), options=AnalysisOptions(omega=(0.3, 0.5, 0.7), duration=10.0, samples=3))
+    assert result.motion is not None and result.motion.regime.value == "spherical"
+    assert result.motion.trajectory is not None
+    assert np.array_equal(result.motion.trajectory.omega_body, np.tile([0.3, 0.5, 0.7], (3, 1)))
 
 
 @pytest.mark.parametrize("i2", [1.0 - 2.0**-53, 1.0 - 1e-7])
