@@ -88,7 +88,7 @@ from ..errors import InvalidParameterError
 from ..principal import PrincipalFrame
 from ..tolerances import DEFAULT_TOLERANCES, Tolerances
 from . import quaternions as quat
-from .accuracy import departure_warning, phase_warnings
+from .accuracy import departure_warning, phase_warnings, unstable_axis_warnings
 from .invariants import RigidProblem, invariant_drifts
 from .methods import CAPABILITIES, EXACT_REST, method_for
 from .quantities import precession_quantities
@@ -153,6 +153,7 @@ def predict_motion(
         motion = units.restore(motion, None)
         return replace(motion, diagnostics=MotionDiagnostics(elapsed_s=time.perf_counter() - started))
     notes = phase_warnings(setup, motion, float(times[-1]))  # refuses a horizon whose phase float64 cannot place
+    notes += unstable_axis_warnings(setup, float(times[-1]), units.omega)
     # a body at rest stays at rest: no method needs to integrate that
     propagator = EXACT_REST if setup.regime is Regime.REST else chosen
     omega_body, attitude = propagator.propagate(setup, times, tolerances)

@@ -18,6 +18,8 @@ may still be at the wrong place on its orbit.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 from numpy.typing import NDArray
 
@@ -26,7 +28,15 @@ from ..tolerances import EPS
 from .regime import Setup
 from .result import FreeMotion, Regime
 
-__all__ = ["PHASE_ERROR_PER_RADIAN", "PHASE_WARN", "PHASE_REFUSE", "NUMERICAL_WARN", "phase_warnings", "departure_warning"]
+__all__ = [
+    "PHASE_ERROR_PER_RADIAN",
+    "PHASE_WARN",
+    "PHASE_REFUSE",
+    "NUMERICAL_WARN",
+    "phase_warnings",
+    "unstable_axis_warnings",
+    "departure_warning",
+]
 
 Array = NDArray[np.float64]
 
@@ -86,6 +96,35 @@ def phase_warnings(setup: Setup, motion: FreeMotion, duration: float) -> tuple[s
             f"{PHASE_ERROR_PER_RADIAN:.1e} per radian)",
         )
     return ()
+
+
+def unstable_axis_warnings(setup: Setup, duration: float, omega_exponent: int) -> tuple[str, ...]:
+    """Permanent rotation about the intermediate axis that holds only to rounding, over a long horizon.
+
+    The given Omega had a tilt at rounding level (the noise of a rotated principal frame), which the
+    regime treats as zero.  About the intermediate axis such a tilt grows like exp(sigma t),
+    sigma = |Omega_2| sqrt((I2 - I1)(I3 - I2) / (I1 I3)) (L&L §37), into a flip after about
+    ln(|Omega| / tilt) / sigma: beyond that the ideal permanent rotation is no prediction.
+    ``duration`` is in computation units, 2^-omega_exponent s (``scaling.Units``).
+    """
+    if setup.regime is not Regime.PERMANENT_ROTATION or setup.stable is not False or setup.initial is None:
+        return ()
+    given = setup.initial.omega_body
+    speed = float(np.max(np.abs(given)))
+    tilt = float(max(abs(given[0]), abs(given[2])))
+    if tilt == 0.0:
+        return ()
+    i1, i2, i3 = (float(x) for x in setup.problem.moments)
+    sigma = abs(float(given[1])) * float(np.sqrt((i2 - i1) * (i3 - i2) / (i1 * i3)))
+    flip = float(np.log(speed / tilt)) / sigma
+    if duration <= flip:
+        return ()
+    return (
+        f"Omega is along the intermediate axis only to rounding (a tilt of {tilt / speed:.1g} of |omega|, the "
+        f"noise of the principal frame): rotation about that axis is unstable and such a tilt grows into a flip "
+        f"after about {math.ldexp(flip, -omega_exponent):.3g} s of the {math.ldexp(duration, -omega_exponent):.3g} s "
+        "asked for; beyond that the trajectory is the ideal permanent rotation, not a prediction",
+    )
 
 
 def departure_warning(method: str, omega_body: Array, exact_omega_body: Array, speed: float) -> tuple[str, ...]:

@@ -10,6 +10,7 @@ true motion by O(1) after ~ln(1/gap)/rate, while the invariants (the only diagno
 from __future__ import annotations
 
 import math
+import re
 from typing import Any
 
 import numpy as np
@@ -121,3 +122,24 @@ def test_a_zero_smallest_moment_is_a_linear_rotator_whatever_rounding_left(i2: f
     assert np.array_equal(res.motion.trajectory.omega_body, np.tile([0.0, 0.5, 0.2], (3, 1)))
     assert any("has no physical effect" in w for w in res.warnings)
     assert any("their mean was used" in w for w in res.warnings) is (1.0 - i2 > 1e-12)
+
+
+def test_rounding_level_permanent_rotation_about_the_intermediate_axis_says_when_it_stops_holding() -> None:
+    """A rotated tensor spun along its intermediate axis: axes @ omega carries ~1e-15 of noise, which the
+    regime treats as zero (permanent rotation, unstable).  Over a long horizon the result says when such
+    a tilt becomes a flip: a quarter of L&L's period (mpmath) of the state with that noise."""
+    from tests.support.motion import ll_period
+
+    rotation = np.array([[0.36, 0.48, -0.8], [-0.8, 0.6, 0.0], [0.48, 0.64, 0.6]])
+    tensor = rotation.T @ np.diag([1.0, 2.0, 3.0]) @ rotation
+    omega = list(2.0 * rotation[1])
+    short = precession(omega, inertia_tensor=tensor, duration=10.0, samples=3)
+    assert short.motion.regime.value == "permanent_rotation" and short.motion.stable is False
+    assert not any("intermediate axis only to rounding" in w for w in short.warnings)
+    long = precession(omega, inertia_tensor=tensor, duration=1000.0, samples=3)
+    stated = [w for w in long.warnings if "intermediate axis only to rounding" in w]
+    assert len(stated) == 1
+    found = re.search(r"flip after about ([0-9.e+-]+) s", stated[0])
+    assert found is not None
+    noisy = np.asarray(long.frame.axes) @ np.asarray(omega)
+    assert float(found.group(1)) == pytest.approx(ll_period(long.frame.moments, noisy) / 4, rel=0.1)
