@@ -141,6 +141,7 @@ def analyze_loaded(loaded: Loaded, options: AnalysisOptions, start: float | None
     if loaded.units_from == "file":
         warnings.append(f"length unit {loaded.units!r} taken from the file")
     warnings.extend(_unit_warning(loaded))
+    warnings.extend(_overridden_density(loaded, options))
     if options.model == Model.SHELL:
         warnings.extend(_shell_thickness_warning(loaded, options))
     reference = None
@@ -321,6 +322,22 @@ def _shell_thickness_warning(loaded: Loaded, options: AnalysisOptions) -> list[s
             out.append(
                 f"thickness {thickness:.4g} m is {100 * ratio:.2g}% of the part's size{where}: the thin-shell "
                 f"model (mass = area x thickness x density) is only approximate for so thick a wall"
+            )
+    return out
+
+
+def _overridden_density(loaded: Loaded, options: AnalysisOptions) -> list[str]:
+    """Cells with their own densities take precedence over a requested density (API.md): say so, naming it."""
+    from .body import VolumeBody
+
+    out = []
+    for part in loaded.parts:
+        given = _part_density(part.name, options)
+        if given is not None and isinstance(part.body, VolumeBody) and part.body.weighted:
+            where = f" of {part.name!r}" if len(loaded.parts) > 1 else ""
+            out.append(
+                f"the cells{where} carry their own 'density' array, which takes precedence: the requested density "
+                f"{given:g} kg/m^3 was not used"
             )
     return out
 

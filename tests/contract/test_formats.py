@@ -41,7 +41,9 @@ def test_volume_mesh_cell_density_takes_precedence_and_mass_scales_it(client: Te
     assert base["mass"] == pytest.approx(9000, rel=1e-12, abs=0)
     np.testing.assert_allclose(base["principal"]["moments"], [1500, 21500 / 9, 21500 / 9], rtol=1e-12)
     np.testing.assert_allclose(base["center_of_mass"], [12.5 / 9, 0.5, 0.5], rtol=1e-12)
+    assert any("density 5 kg/m^3 was not used" in w for w in base["warnings"])  # never silently ignored
     scaled = analyze(client, "two_density.vtu", mass=18)
+    assert not any("was not used" in w for w in scaled["warnings"])  # mass scales the cells' densities: all used
     assert scaled["mass"] == pytest.approx(18, rel=1e-12, abs=0)
     np.testing.assert_allclose(scaled["principal"]["moments"], np.array([1500, 21500 / 9, 21500 / 9]) * 18 / 9000, rtol=1e-12)
     np.testing.assert_allclose(scaled["center_of_mass"], [12.5 / 9, 0.5, 0.5], rtol=1e-12)
