@@ -108,6 +108,8 @@ class VolumeBody:
     cell_density : (k,) float64 kg/m^3 per tetrahedron, or None (uniform).
     cells : blocks of hexahedra, wedges, pyramids and quadratic cells, each
         integrated as the element it is (``cells``), with its own densities.
+    tet_cells : how many of the file's cells ``tets`` stand for, where they
+        are polyhedral cells split into tetrahedra (None: one cell each).
     """
 
     points: NDArray[np.float64]
@@ -117,6 +119,7 @@ class VolumeBody:
     name: str | None = None
     warnings: tuple[str, ...] = ()
     cells: tuple[CellBlock, ...] = ()
+    tet_cells: int | None = None
 
     def __post_init__(self) -> None:
         p = _frozen(self.points, np.float64)
@@ -145,7 +148,9 @@ class VolumeBody:
 
     @property
     def cell_count(self) -> int:
-        return len(self.tets) + sum(len(b.nodes) for b in self.cells)
+        """The file's 3-D cells this body holds (a polyhedron split into tetrahedra is one)."""
+        tets = len(self.tets) if self.tet_cells is None else self.tet_cells
+        return tets + sum(len(b.nodes) for b in self.cells)
 
 
 @dataclass(frozen=True, slots=True)

@@ -218,6 +218,7 @@ def test_polyhedron_cells_are_weighed() -> None:
     ).as_dict()
     assert doc["mass"] == pytest.approx(8 / 3, rel=1e-14)
     assert doc["source"]["points"] == 18  # the file's own points: the split adds none
+    assert doc["source"]["cells"] == 4  # the file's cells (2 polyhedra, 2 pyramids), not the tetrahedra of the split
     assert any("2 polyhedron cells were weighed as" in w for w in doc["warnings"])
     assert not any("not planar" in w for w in doc["warnings"])
 
@@ -246,6 +247,7 @@ def test_prism_cells_are_weighed_as_vtk_weighs_them() -> None:
     volumes = np.asarray(to_numpy(sizes.GetOutput().GetCellData().GetArray("Volume")))
     doc = analyze_loaded(load_body(path.read_bytes(), filename="PentaHexa.vtk"), AnalysisOptions(density=1.0)).as_dict()
     assert doc["mass"] == pytest.approx(float(np.abs(volumes).sum()), rel=1e-12)
+    assert doc["source"]["cells"] == sizes.GetOutput().GetNumberOfCells() == 210  # the file's cells, as VTK counts them
     assert any("hexagonal prism cells" in w and "not planar" in w for w in doc["warnings"])
 
 

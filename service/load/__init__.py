@@ -203,7 +203,7 @@ def _rescaled(part: Part, scale: float) -> Part:
     if isinstance(body, MeshBody):
         new: Body = MeshBody(body.vertices, body.faces, scale, body.name, body.warnings, body.welded, body.coordinate_eps)
     elif isinstance(body, VolumeBody):
-        new = VolumeBody(body.points, body.tets, body.cell_density, scale, body.name, body.warnings, body.cells)
+        new = VolumeBody(body.points, body.tets, body.cell_density, scale, body.name, body.warnings, body.cells, body.tet_cells)
     else:
         assert isinstance(body, PointBody)
         new = PointBody(body.masses, body.positions, scale, body.name, body.warnings)

@@ -154,6 +154,7 @@ class _Block:
     nodes: NDArray[np.int64]
     cell_ids: NDArray[np.int64]
     name: str
+    file_cells: int | None = None  # the file's cells, where a block's tetrahedra are split polyhedra
 
 
 @dataclass
@@ -373,11 +374,11 @@ def _mesh_from_grid(grid: Any, to_numpy: Any, label: str) -> _Mesh:
             nodes, cell_of, mesh.points, note = _polyhedra(grid, ids, vtk_type, conn, offsets, mesh.points, label)
             mesh.warnings.append(
                 f"{len(ids)} {_VTK_POLYHEDRA[vtk_type]} cells were weighed as {len(nodes)} tetrahedra "
-                "(source.cells and source.tetrahedra count those)"
+                "(source.tetrahedra counts those, source.cells the file's cells)"
             )
             mesh.warnings.extend([note] if note else [])
             name = _VTK_POLYHEDRA[vtk_type].replace(" ", "_")
-            mesh.blocks.append(_Block("tetra", nodes, cell_of, f"{name}_{len(mesh.blocks)}"))
+            mesh.blocks.append(_Block("tetra", nodes, cell_of, f"{name}_{len(mesh.blocks)}", len(ids)))
             continue
         if vtk_type not in VTK_CELL_TYPES:
             continue
@@ -804,7 +805,7 @@ def _parts(mesh: _Mesh, label: str, length_scale: float) -> list[Part]:
         notes = tuple(mesh.warnings) if i == 0 else ()  # file-wide notes, said once
         rho = None if mesh.density is None else mesh.density[b.cell_ids]
         if b.type == "tetra":
-            body = VolumeBody(mesh.points, b.nodes, rho, length_scale, b.name, notes)
+            body = VolumeBody(mesh.points, b.nodes, rho, length_scale, b.name, notes, tet_cells=b.file_cells)
         else:
             body = VolumeBody(
                 mesh.points, np.empty((0, 4), np.int64), None, length_scale, b.name, notes, (CellBlock(b.type, b.nodes, rho),)
