@@ -398,7 +398,8 @@ def _combined(loaded: Loaded, parts: Sequence[PartResult], options: AnalysisOpti
     )
 
 
-def _motion(frame: PrincipalFrame, cls: Classification, options: AnalysisOptions) -> FreeMotion:
+def _motion(frame: PrincipalFrame, cls: Classification, options: AnalysisOptions, exact_moments: bool = False) -> FreeMotion:
+    """The torque-free motion; ``exact_moments``: the moments are the caller's numbers, not computed ones."""
     from .motion import predict_motion
 
     return predict_motion(
@@ -408,6 +409,7 @@ def _motion(frame: PrincipalFrame, cls: Classification, options: AnalysisOptions
         duration=options.duration,
         samples=options.samples,
         method=options.method,
+        exact_moments=exact_moments,
     )
 
 
@@ -496,6 +498,6 @@ def precession(
         frame = PrincipalFrame.from_tensor(np.diag(moments), tolerance)
         estimate, notes = 8 * EPS, ()  # the moments as given: only the motion's own arithmetic
     cls = classify(frame)
-    motion = _motion(frame, cls, options)
+    motion = _motion(frame, cls, options, exact_moments=principal_moments is not None)
     warnings = tuple(dict.fromkeys((*notes, *motion.warnings)))
     return PrecessionResult(frame, cls, motion, Diagnostics(time.perf_counter() - start, max(estimate, 8 * EPS)), warnings)

@@ -166,3 +166,12 @@ def test_rounding_level_permanent_rotation_about_the_intermediate_axis_says_when
     assert found is not None
     noisy = np.asarray(long.frame.axes) @ np.asarray(omega)
     assert float(found.group(1)) == pytest.approx(ll_period(long.frame.moments, noisy) / 4, rel=0.1)
+
+
+@pytest.mark.parametrize("ulps", [(32, 64), (1, 2)])
+def test_principal_moments_given_within_rounding_of_equal_move_as_the_numbers_given(ulps: tuple[int, int]) -> None:
+    # moments a client sends are its own numbers, not rounded results: (1, 1 + 32 eps, 1 + 64 eps) is an
+    # asymmetric top whose Omega turns slowly, not a spherical top whose Omega stays put
+    moments = (1.0, 1.0 + ulps[0] * EPS, 1.0 + ulps[1] * EPS)
+    _, error = _omega_error(moments, (0.6, 0.5, 0.4), duration=1e4)
+    assert error <= 64 * EPS, error  # the ideal top's closed form was 1e-12..4e-11 off by t = 1e4
