@@ -108,12 +108,29 @@ def _body_message(error: dict[str, Any], content_type: str | None) -> str | None
     return None
 
 
+_BOUNDS = {
+    "less_than_equal": ("le", "at most"),
+    "less_than": ("lt", "less than"),
+    "greater_than_equal": ("ge", "at least"),
+    "greater_than": ("gt", "greater than"),
+}
+
+
+def _bound_message(error: Any) -> str:
+    """pydantic's message, with a numeric bound written as a number (1e+100, not 101 digits)."""
+    kind = _BOUNDS.get(str(error.get("type", "")))
+    bound = (error.get("ctx") or {}).get(kind[0]) if kind else None
+    if kind is None or not isinstance(bound, float):
+        return str(error.get("msg", ""))
+    return f"Input should be {kind[1]} {bound:.17g}"
+
+
 def invalid_request(exc: RequestValidationError, content_type: str | None = None) -> InvalidParameterError:
     """A schema failure as ``invalid_parameter``, naming the first bad field."""
     errors = [
         {
             "loc": [str(p) if not isinstance(p, int) else p for p in e.get("loc", ())],
-            "msg": str(e.get("msg", "")),
+            "msg": _bound_message(e),
             "type": str(e.get("type", "")),
         }
         for e in exc.errors()

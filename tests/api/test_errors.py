@@ -199,3 +199,11 @@ def test_unexpected_exception_is_500_envelope_with_logged_traceback(caplog: LogC
 def test_validation_error_names_the_field(client: TestClient) -> None:
     error = assert_envelope(points({"points": [{"mass": 1, "position": [0, 0, "x"]}]})(client), "invalid_parameter", 422)
     assert "points.0.position" in error["message"] and error["details"]["errors"][0]["loc"][0] == "body"
+
+
+def test_a_numeric_bound_is_written_as_a_number(client: TestClient) -> None:
+    # pydantic writes the float bound 1e100 as a 101-digit integer; a person reads 1e+100
+    body = {"principal_moments": [1, 2, 3], "omega": [1, 0, 0], "duration": 1e101, "samples": 3}
+    error = client.post("/v1/precession", json=body).json()["error"]
+    assert error["code"] == "invalid_parameter" and error["details"]["parameter"] == "duration"
+    assert "at most 1e+100;" in error["message"] and "0000000000" not in error["message"]
