@@ -409,6 +409,8 @@ def report(result: dict[str, object], sampler: MemorySampler, args: argparse.Nam
     assert isinstance(pairs, list)
     ratios = [p.rate / b.rate for b, p in pairs]
     cpu_ratios = [b.cpu_ms_per_request / p.cpu_ms_per_request for b, p in pairs]
+    bare_ms = statistics.median(b.cpu_ms_per_request for b, _ in pairs)
+    points_ms = statistics.median(p.cpu_ms_per_request for _, p in pairs)
     command = (
         "python -m benchmarks.load"
         + (f" --seconds {args.seconds:g}" if args.seconds != 8 else "")
@@ -442,6 +444,10 @@ def report(result: dict[str, object], sampler: MemorySampler, args: argparse.Nam
         "ratio one server core would reach, independent of the client's share of the machine): "
         + ", ".join(f"{r:.2f}" for r in cpu_ratios)
         + f"; median **{statistics.median(cpu_ratios):.2f}**.",
+        "",
+        f"What the goal asks of the analysis: at 0.70 a 3-point request may cost the server at most "
+        f"{1 / 0.7:.2f} times the bare route's {bare_ms:.2f} ms (medians), which leaves {0.3 / 0.7 * bare_ms:.2f} ms "
+        f"for everything the points route does beyond it; it takes {points_ms - bare_ms:.2f} ms.",
         "",
         f"The small-request rounds use a plain asyncio stream client (prebuilt request bytes, the reply read by "
         f"its Content-Length and checked for status 200 and its `mass` or `status`), so that the server, not "
