@@ -54,7 +54,7 @@ import numpy as np
 
 from benchmarks.batch import ANALYZE_SCRIPT, TRIMESH_SCRIPT, write_stl
 from benchmarks.cases import box, uv_sphere
-from benchmarks.harness import Report, TreeLog, available_cores, interleaved, machine, run_process, sampled
+from benchmarks.harness import Report, TreeLog, available_cores, byte_compiled, interleaved, machine, run_process, sampled
 
 ROOT = Path(__file__).resolve().parents[1]
 DOC = ROOT / "docs" / "scaling.md"
@@ -372,6 +372,7 @@ def render(
     loads: list[float],
     rounds: int,
     command: str,
+    compiled: str = "",
 ) -> Report:
     m = machine(("numpy", "trimesh", "dask", "distributed"))
     report = Report("", command)
@@ -385,7 +386,7 @@ def render(
         "machine): " + ", ".join(f"{x:.2f}" for x in loads) + ".",
         f"{rounds} interleaved round(s); each figure is the best of them. Every contender is a whole process "
         "from launch to exit (interpreter, imports, start-up and shutdown included); every batch output is "
-        "checked (one row per file, no errors).",
+        "checked (one row per file, no errors)." + (f" Before the runs, {compiled}." if compiled else ""),
         "",
         "- *speed-up* is the serial `analyze()` loop's wall time over the row's; *parallel efficiency* is the "
         "row's files/s over N times the same contender's files/s at 1 worker;",
@@ -496,6 +497,7 @@ def main(argv: list[str] | None = None) -> int:
         ]
     )
     local_n = max(n for n in workers if n <= cores)
+    compiled = byte_compiled()
     work = Path(tempfile.mkdtemp(prefix="inertia-scale-"))
     results: list[SetResult] = []
     loads: list[float] = []
@@ -544,7 +546,7 @@ def main(argv: list[str] | None = None) -> int:
             shutil.rmtree(folder)
     finally:
         shutil.rmtree(work, ignore_errors=True)
-    report = render(results, workers, overheads, starts, loads, rounds, command.strip())
+    report = render(results, workers, overheads, starts, loads, rounds, command.strip(), compiled)
     if str(args.out) != "-":  # the measured part, between the markers; text around them is kept
         report.write(args.out, section=True)
     print(report.text())

@@ -122,3 +122,22 @@ def test_proc_stat_and_descendants_see_live_processes() -> None:
         child.kill()
         child.wait()
     assert harness.proc_stat(child.pid) is None
+
+
+def test_byte_compiled_writes_each_modules_bytecode_without_importing_it(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    import importlib.util
+
+    package = tmp_path / "scratch_pkg_for_bytecode"
+    (package / "sub").mkdir(parents=True)
+    sources = [package / "__init__.py", package / "sub" / "__init__.py", package / "sub" / "mod.py"]
+    for source in sources:
+        source.write_text("raise RuntimeError('imported')\n")  # compiling must not run it
+    monkeypatch.syspath_prepend(str(tmp_path))
+    sentence = harness.byte_compiled("scratch_pkg_for_bytecode")
+    assert "compiled to bytecode first" in sentence
+    assert all(Path(importlib.util.cache_from_source(str(s))).is_file() for s in sources)
+    assert "scratch_pkg_for_bytecode" not in sys.modules
+
+
+def test_byte_compiled_says_when_the_package_is_missing() -> None:
+    assert "was not found" in harness.byte_compiled("no_such_package_for_bytecode_xyz")
