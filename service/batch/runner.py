@@ -87,7 +87,9 @@ HEAD_START_SWITCH_S = 0.0005
 # triangles and ~1.5x on 1e6 (even with a 32 MiB mmap threshold added).  Our
 # tasks hold one file at a time, so glibc's own dynamic thresholds (which
 # trim freed heap beyond twice the largest recent mmap, at most 64 MiB) keep
-# worker memory flat; the local workers run without the variable.
+# worker memory flat; the local workers run without the variable, and on a
+# cluster started elsewhere each worker's first task raises the thresholds
+# itself (``workers.relax_frozen_heap_thresholds``).
 DROPPED_ENV = ("MALLOC_TRIM_THRESHOLD_",)
 
 

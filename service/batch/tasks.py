@@ -23,6 +23,7 @@ from ..sections import AnalysisDocument
 from .rows import Row, error_row
 from .sinks import render
 from .sources import Source, ZipCache, read_source
+from .workers import relax_frozen_heap_thresholds
 
 __all__ = ["InternalError", "analyze_row", "analyze_rows", "analyze_source", "analyze_sources", "render_sources"]
 
@@ -49,6 +50,7 @@ def analyze_row(source: Source, options: AnalysisOptions, zips: ZipCache | None 
 
 def analyze_rows(sources: Sequence[Source], options: AnalysisOptions) -> list[Row]:
     """The rows of a group of inputs, in the group's order."""
+    relax_frozen_heap_thresholds()  # on a Dask worker: see ``workers``
     zips = ZipCache()
     try:
         return [analyze_row(src, options, zips) for src in sources]
