@@ -101,7 +101,9 @@ def test_exact_moments_a_few_ulps_apart_move_as_given(ulps: int, shape: str) -> 
     speed = float(np.linalg.norm(omega))
     error = float(np.max(np.abs(motion.trajectory.omega_body - reference))) / speed
     assert error <= 8 * EPS * (1 + speed * duration), error
-    assert motion.regime.value == "asymmetric"
+    # the section names the class the moments are given within the default tolerance (API.md: regular
+    # precession for a symmetric top), while the trajectory above is the motion of the moments as given
+    assert motion.regime.value == {"oblate": "regular_precession", "prolate": "regular_precession", "spherical": "spherical"}[shape]
 
 
 def test_a_needle_whose_smallest_moment_is_exact_moves_as_the_prolate_top_it_is() -> None:
