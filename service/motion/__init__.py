@@ -70,7 +70,9 @@ Modelling decisions (stated once, here):
   section reports ``spherical``, or ``regular_precession`` with the symmetric
   top's rates of the equal pair's mean moment (``permanent_rotation`` for Omega
   across its axis), and a warning says so; the trajectory is still the exact
-  motion of the moments as they are.
+  motion of the moments as they are.  A rod within tolerance of a linear
+  rotator is the ``rotator`` regime with its own prolate top's rates (a spin
+  about its own axis stays a permanent rotation).
 - ``stable`` follows the contract: an asymmetric top is unstable when Omega
   starts nearest its intermediate axis; permanent rotation about the
   intermediate axis is unstable; every other regime is stable (a symmetric

@@ -59,22 +59,24 @@ def precession_quantities(setup: Setup, method: MotionMethod, tol: Tolerances) -
 
 def _labelled_quantities(base: FreeMotion, setup: Setup) -> FreeMotion:
     """The section of the regime the classification names (``Setup.label``): a symmetric top's rates are
-    those of its ideal top, the equal pair's mean moment (L&L §§33-36), from the state as given."""
+    those of its ideal top, the equal pair's mean moment (L&L §§33-36), from the state as given; a needle
+    labelled a rotator has the prolate top's rates of its own moments (the pair's mean)."""
     assert setup.label is not None
     labelled = replace(base, regime=setup.label, stable=True)
-    if setup.label is not Regime.REGULAR_PRECESSION:
+    if setup.label not in (Regime.REGULAR_PRECESSION, Regime.ROTATOR):
         return labelled
     assert setup.label_unique is not None
     unique = setup.label_unique
     rotor = RotorClass.SYMMETRIC_PROLATE if unique == 0 else RotorClass.SYMMETRIC_OBLATE
     top = SymmetricTop(ideal_moments(setup.problem.moments, rotor), setup.problem.omega_body, unique)
+    rate = top.body_precession_rate
     return replace(
         labelled,
-        body_precession_rate=top.body_precession_rate,
+        body_precession_rate=rate if rate != 0.0 else None,
         space_precession_rate=top.space_precession_rate,
-        spin_rate=top.spin_rate,
+        spin_rate=top.spin_rate if rate != 0.0 else None,
         nutation_angle=top.nutation_angle,
-        period=2.0 * np.pi / abs(top.body_precession_rate),
+        period=2.0 * np.pi / abs(rate) if rate != 0.0 else None,
     )
 
 

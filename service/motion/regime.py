@@ -74,12 +74,22 @@ def _labelled(setup: Setup, classification: Classification) -> Setup:
     rotor, regime = classification.rotor, setup.regime
     if rotor is RotorClass.SPHERICAL and regime not in (Regime.REST, Regime.SPHERICAL):
         label, unique = Regime.SPHERICAL, None
+    elif rotor is RotorClass.LINEAR and _needle_moves(setup):
+        # a body of I1 > 0 within tolerance of zero: the rotator's label, the needle's own rates
+        label, unique = Regime.ROTATOR, 0
     elif rotor.is_symmetric and regime is Regime.ASYMMETRIC:
         unique = 0 if rotor is RotorClass.SYMMETRIC_PROLATE else 2
         label = Regime.REGULAR_PRECESSION if setup.problem.omega_body[unique] != 0.0 else Regime.PERMANENT_ROTATION
     else:
         return setup
     moments = np.asarray(setup.problem.moments, dtype=np.float64)
+    if label is Regime.ROTATOR:
+        note = (
+            f"the smallest principal moment is {float(moments[0] / moments[-1]):.2g} of the largest, within the "
+            f"tolerance {classification.tolerance:g} of zero: the precession section names the rotator regime of "
+            "that linear_rotator, with the rates of the body's own moments; the trajectory is its motion"
+        )
+        return replace(setup, label=label, label_unique=unique, warnings=(*setup.warnings, note))
     spread = float(moments[-1] - moments[0]) if label is Regime.SPHERICAL else _pair_gap(moments, rotor)
     note = (
         f"the principal moments the classification calls equal differ by {spread / float(moments[-1]):.2g} of the "
@@ -88,6 +98,14 @@ def _labelled(setup: Setup, classification: Classification) -> Setup:
         "motion of the moments as they are"
     )
     return replace(setup, label=label, label_unique=unique, warnings=(*setup.warnings, note))
+
+
+def _needle_moves(setup: Setup) -> bool:
+    """A linear rotator's class on a body whose smallest moment is not 0: the motion is that of a prolate
+    or asymmetric top, unless it is a spin about the needle's own axis (a permanent rotation it is)."""
+    if setup.regime in (Regime.REGULAR_PRECESSION, Regime.ASYMMETRIC):
+        return True
+    return setup.regime is Regime.PERMANENT_ROTATION and setup.problem.omega_body[0] == 0.0
 
 
 def _pair_gap(moments: Array, rotor: RotorClass) -> float:

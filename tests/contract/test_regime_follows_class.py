@@ -102,3 +102,34 @@ def test_a_float32_cylinder_precesses_as_the_symmetric_top_it_is_classified(clie
     omega_body = list(axes @ [0.3, 0.2, 1.0])
     for key, value in _symmetric_rates((i2 + i3) / 2, i1, omega_body, 0).items():
         assert p[key] == pytest.approx(value, rel=1e-9), key
+
+
+def _needle_rates(i1: float, i_perp: float, omega_body: list[float]) -> dict[str, float]:
+    """A needle's free motion is the prolate top's (L&L §33), whatever its class's label."""
+    return _symmetric_rates(i_perp, i1, omega_body, 0)
+
+
+def test_a_needle_classified_a_linear_rotator_is_the_rotator_regime(client: TestClient) -> None:
+    omega = [0.3, 0.2, 1.0]
+    res = client.post("/v1/precession", json={"principal_moments": [1e-9, 1.0, 1.0], "omega": omega}).json()
+    assert res["classification"]["kind"] == "linear_rotator"
+    p = res["precession"]
+    assert p["regime"] == "rotator" and p["stable"] is True
+    want = _needle_rates(1e-9, 1.0, omega)
+    # the rates of the needle itself: |M|/I_perp about M, its axis ~pi/2 from M (a rotator's)
+    assert p["space_precession_rate"] == pytest.approx(want["space_precession_rate"], rel=1e-15)
+    assert p["nutation_angle"] == pytest.approx(want["nutation_angle"], rel=1e-15)
+    assert p["body_precession_rate"] == pytest.approx(want["body_precession_rate"], rel=1e-12)
+
+
+def test_a_needle_spun_across_its_axis_is_the_rotator_regime(client: TestClient) -> None:
+    res = client.post("/v1/precession", json={"principal_moments": [1e-9, 1.0, 1.0], "omega": [0.0, 0.6, 0.8]}).json()
+    p = res["precession"]
+    assert p["regime"] == "rotator"
+    assert p["space_precession_rate"] == pytest.approx(1.0, rel=1e-15)
+    assert p["nutation_angle"] == pytest.approx(math.pi / 2, rel=1e-15)
+
+
+def test_a_needle_spun_about_its_own_axis_stays_a_permanent_rotation(client: TestClient) -> None:
+    res = client.post("/v1/precession", json={"principal_moments": [1e-9, 1.0, 1.0], "omega": [2.0, 0.0, 0.0]}).json()
+    assert res["precession"]["regime"] == "permanent_rotation"  # a real spin of a body with I1 > 0
