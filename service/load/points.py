@@ -127,9 +127,13 @@ def _file_records(text: str, fmt: str) -> tuple[list[Any], list[str], str | None
         if not isinstance(doc, dict):
             return records, [], None, MassUnit.KG
         return (records, *_document_keys(doc))
-    rows = list(csv.DictReader(io.StringIO(text)))
-    if not rows or not {"x", "y", "z"} <= set(rows[0]) or not {"mass", "element"} & set(rows[0]):
+    reader = csv.DictReader(io.StringIO(text))
+    rows = list(reader)
+    header = set(reader.fieldnames or ())
+    if not {"x", "y", "z"} <= header or not {"mass", "element"} & header:
         raise UnreadableFileError("the CSV needs a header with columns mass,x,y,z (or element,x,y,z) and one row per point")
+    if not rows:
+        raise EmptyGeometryError("the CSV has its header but no rows; send one row per point mass")
     return (
         [{"mass": r.get("mass") or None, "element": r.get("element") or None, "position": [r["x"], r["y"], r["z"]]} for r in rows],
         [],

@@ -80,3 +80,11 @@ def test_json_points_file_with_units_of_the_wrong_kind_is_refused(client: TestCl
     r = client.post("/v1/analyze/mesh", files={"file": ("rod.json", _doc(**extra), "application/json")})
     assert r.status_code == 422, r.text
     assert r.json()["error"]["code"] == "unreadable_file"
+
+
+def test_a_points_csv_with_a_header_and_no_rows_is_empty_geometry(client: TestClient) -> None:
+    r = client.post("/v1/analyze/mesh", files={"file": ("p.csv", b"mass,x,y,z\n", "text/csv")})
+    assert r.status_code == 422, r.text
+    assert r.json()["error"]["code"] == "empty_geometry"
+    r = client.post("/v1/analyze/mesh", files={"file": ("p.csv", b"a,b\n1,2\n", "text/csv")})
+    assert r.json()["error"]["code"] == "unreadable_file"
