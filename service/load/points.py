@@ -146,7 +146,8 @@ def _document_keys(doc: Mapping[str, Any]) -> tuple[list[str], str | None, str]:
     """A points document's declared length unit and mass unit, and a warning naming its request options."""
     from ..conventions import LENGTH_UNITS
 
-    units, mass_unit = doc.get("units"), doc.get("mass_unit", MassUnit.KG)
+    units = doc.get("units")
+    mass_unit = MassUnit.KG if doc.get("mass_unit") is None else doc["mass_unit"]
     if units is not None and (not isinstance(units, str) or units not in LENGTH_UNITS):
         known = ", ".join(LENGTH_UNITS)
         raise UnreadableFileError(f"the points file's units {units!r} is not a length unit; use one of {known}")

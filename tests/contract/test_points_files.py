@@ -88,3 +88,8 @@ def test_a_points_csv_with_a_header_and_no_rows_is_empty_geometry(client: TestCl
     assert r.json()["error"]["code"] == "empty_geometry"
     r = client.post("/v1/analyze/mesh", files={"file": ("p.csv", b"a,b\n1,2\n", "text/csv")})
     assert r.json()["error"]["code"] == "unreadable_file"
+
+
+def test_json_points_file_with_null_units_reads_as_the_defaults(client: TestClient) -> None:
+    res = analyze(client, "rod.json", _doc(units=None, mass_unit=None))
+    assert res["source"]["units"] == "m" and res["mass"] == 4.0
