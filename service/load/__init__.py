@@ -153,9 +153,9 @@ def _load_bytes(
         ]
         kind = SourceKind.MESH
     elif fmt in POINT_FORMATS:
-        from .points import read_points
+        from .points import read_points_document
 
-        body, molecule = read_points(data, fmt, scale, isotopes=isotopes)
+        body, molecule, declared = read_points_document(data, fmt, scale, isotopes=isotopes)
         parts = [Part(_stem(filename), body, {"molecule": True} if molecule else {})]
         kind = SourceKind.POINTS
     elif fmt in VOLUME_FORMATS:

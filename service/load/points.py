@@ -22,7 +22,7 @@ from ..body import PointBody
 from ..errors import EmptyGeometryError, InvalidParameterError, UnreadableFileError
 from ..vocabulary import Isotopes, MassUnit, values
 
-__all__ = ["MASS_UNITS", "names_elements", "points_from_records", "read_points", "read_points_file"]
+__all__ = ["MASS_UNITS", "names_elements", "points_from_records", "read_points", "read_points_document", "read_points_file"]
 
 MASS_UNITS = values(MassUnit)
 
@@ -89,16 +89,33 @@ def read_points_file(data: bytes, fmt: str, length_scale: float = 1.0, *, isotop
 
 def read_points(data: bytes, fmt: str, length_scale: float = 1.0, *, isotopes: str = Isotopes.STANDARD) -> tuple[PointBody, bool]:
     """The points of a file, and whether it names elements (a molecule: XYZ always does)."""
-    records, warnings = _file_records(data.decode("utf-8-sig", errors="replace"), fmt)
-    body = points_from_records(records, length_scale, isotopes=isotopes)
+    body, molecule, _ = read_points_document(data, fmt, length_scale, isotopes=isotopes)
+    return body, molecule
+
+
+def read_points_document(
+    data: bytes, fmt: str, length_scale: float = 1.0, *, isotopes: str = Isotopes.STANDARD
+) -> tuple[PointBody, bool, str | None]:
+    """``read_points``, and the length unit the file declares (a JSON document's ``units``), if any.
+
+    A JSON file may hold the whole document of POST /v1/analyze/points: its ``mass_unit`` applies to
+    the masses, its ``units`` is returned for the caller to apply when the request names none, and its
+    other keys (options of a request: omega, tolerance, ...) are named in a warning, not applied.
+    """
+    records, warnings, declared, mass_unit = _file_records(data.decode("utf-8-sig", errors="replace"), fmt)
+    body = points_from_records(records, length_scale, isotopes=isotopes, mass_unit=mass_unit)
     if warnings:
         body = replace(body, warnings=body.warnings + tuple(warnings))
-    return body, fmt == "xyz" or names_elements(records)
+    return body, fmt == "xyz" or names_elements(records), declared
 
 
-def _file_records(text: str, fmt: str) -> tuple[list[Any], list[str]]:
+# keys of the points document that describe the body itself; the others are options of a request
+_BODY_KEYS = ("points", "units", "mass_unit")
+
+
+def _file_records(text: str, fmt: str) -> tuple[list[Any], list[str], str | None, str]:
     if fmt == "xyz":
-        return _xyz_records(text)
+        return (*_xyz_records(text), None, MassUnit.KG)
     if fmt == "json":
         try:
             doc = json.loads(text)
@@ -107,13 +124,43 @@ def _file_records(text: str, fmt: str) -> tuple[list[Any], list[str]]:
         records = doc.get("points") if isinstance(doc, dict) else doc
         if not isinstance(records, list):
             raise UnreadableFileError('the JSON must be a list of points or {"points": [...]}')
-        return records, []
-    rows = list(csv.DictReader(io.StringIO(text)))
-    if not rows or not {"x", "y", "z"} <= set(rows[0]) or not {"mass", "element"} & set(rows[0]):
+        if not isinstance(doc, dict):
+            return records, [], None, MassUnit.KG
+        return (records, *_document_keys(doc))
+    reader = csv.DictReader(io.StringIO(text))
+    rows = list(reader)
+    header = set(reader.fieldnames or ())
+    if not {"x", "y", "z"} <= header or not {"mass", "element"} & header:
         raise UnreadableFileError("the CSV needs a header with columns mass,x,y,z (or element,x,y,z) and one row per point")
-    return [
-        {"mass": r.get("mass") or None, "element": r.get("element") or None, "position": [r["x"], r["y"], r["z"]]} for r in rows
-    ], []
+    if not rows:
+        raise EmptyGeometryError("the CSV has its header but no rows; send one row per point mass")
+    return (
+        [{"mass": r.get("mass") or None, "element": r.get("element") or None, "position": [r["x"], r["y"], r["z"]]} for r in rows],
+        [],
+        None,
+        MassUnit.KG,
+    )
+
+
+def _document_keys(doc: Mapping[str, Any]) -> tuple[list[str], str | None, str]:
+    """A points document's declared length unit and mass unit, and a warning naming its request options."""
+    from ..conventions import LENGTH_UNITS
+
+    units = doc.get("units")
+    mass_unit = MassUnit.KG if doc.get("mass_unit") is None else doc["mass_unit"]
+    if units is not None and (not isinstance(units, str) or units not in LENGTH_UNITS):
+        known = ", ".join(LENGTH_UNITS)
+        raise UnreadableFileError(f"the points file's units {units!r} is not a length unit; use one of {known}")
+    if not isinstance(mass_unit, str) or mass_unit not in MASS_UNITS:
+        raise UnreadableFileError(f"the points file's mass_unit {mass_unit!r} is not 'kg' or 'u'")
+    options = [str(k) for k in doc if k not in _BODY_KEYS]
+    warnings = []
+    if options:
+        warnings.append(
+            f"the points file also holds {', '.join(options)}: options of a request, not of the body, and not "
+            "applied; give them as options of the analysis"
+        )
+    return warnings, units, mass_unit
 
 
 def _xyz_records(text: str) -> tuple[list[Any], list[str]]:

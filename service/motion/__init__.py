@@ -65,6 +65,14 @@ Modelling decisions (stated once, here):
   motion of the numbers given; only an exact zero moves along the
   separatrix's hyperbolic limit (which the true motion leaves after its first
   approach to the intermediate axis).
+- The regime names the body's class (API.md): where the classification's
+  ``tolerance`` calls moments equal that differ by more than rounding, the
+  section reports ``spherical``, or ``regular_precession`` with the symmetric
+  top's rates of the equal pair's mean moment (``permanent_rotation`` for Omega
+  across its axis), and a warning says so; the trajectory is still the exact
+  motion of the moments as they are.  A rod within tolerance of a linear
+  rotator is the ``rotator`` regime with its own prolate top's rates (a spin
+  about its own axis stays a permanent rotation).
 - ``stable`` follows the contract: an asymmetric top is unstable when Omega
   starts nearest its intermediate axis; permanent rotation about the
   intermediate axis is unstable; every other regime is stable (a symmetric

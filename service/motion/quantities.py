@@ -6,9 +6,10 @@ from dataclasses import replace
 
 import numpy as np
 
+from ..classification import RotorClass
 from ..tolerances import Tolerances
 from .jacobi import AsymmetricTop
-from .regime import Setup
+from .regime import Setup, ideal_moments
 from .result import FreeMotion, MotionDiagnostics, MotionMethod, Regime
 from .symmetric import SymmetricTop
 
@@ -32,6 +33,8 @@ def precession_quantities(setup: Setup, method: MotionMethod, tol: Tolerances) -
         stable=setup.stable,
         warnings=setup.warnings,
     )
+    if setup.label is not None:
+        return _labelled_quantities(base, setup)
     if setup.regime is Regime.REGULAR_PRECESSION:
         assert setup.unique is not None
         top = SymmetricTop(problem.moments, problem.omega_body, setup.unique)
@@ -52,6 +55,29 @@ def precession_quantities(setup: Setup, method: MotionMethod, tol: Tolerances) -
     if setup.regime is Regime.ASYMMETRIC:
         return _asymmetric_quantities(base, AsymmetricTop.from_initial(problem.moments, problem.omega_body, tol.separatrix_rel))
     return base
+
+
+def _labelled_quantities(base: FreeMotion, setup: Setup) -> FreeMotion:
+    """The section of the regime the classification names (``Setup.label``): a symmetric top's rates are
+    those of its ideal top, the equal pair's mean moment (L&L §§33-36), from the state as given; a needle
+    labelled a rotator has the prolate top's rates of its own moments (the pair's mean)."""
+    assert setup.label is not None
+    labelled = replace(base, regime=setup.label, stable=True)
+    if setup.label not in (Regime.REGULAR_PRECESSION, Regime.ROTATOR):
+        return labelled
+    assert setup.label_unique is not None
+    unique = setup.label_unique
+    rotor = RotorClass.SYMMETRIC_PROLATE if unique == 0 else RotorClass.SYMMETRIC_OBLATE
+    top = SymmetricTop(ideal_moments(setup.problem.moments, rotor), setup.problem.omega_body, unique)
+    rate = top.body_precession_rate
+    return replace(
+        labelled,
+        body_precession_rate=rate if rate != 0.0 else None,
+        space_precession_rate=top.space_precession_rate,
+        spin_rate=top.spin_rate if rate != 0.0 else None,
+        nutation_angle=top.nutation_angle,
+        period=2.0 * np.pi / abs(rate) if rate != 0.0 else None,
+    )
 
 
 def _asymmetric_quantities(base: FreeMotion, top: AsymmetricTop) -> FreeMotion:

@@ -41,6 +41,12 @@ class Setup:
     warnings: tuple[str, ...]
     unique: int | None = None  # symmetry axis index of a symmetric top
     initial: RigidProblem | None = None  # the state as given: reported M, E and omega_body come from it
+    # the regime of the body's class where the motion is that of a finer class (moments equal within the
+    # classification's tolerance, apart by more than rounding): the precession section names it and gives
+    # its quantities (API.md), the trajectory stays the motion of ``problem``; ``label_unique`` is the
+    # symmetry axis index of a symmetric top's label
+    label: Regime | None = None
+    label_unique: int | None = None
 
 
 def decide_regime(
@@ -59,7 +65,51 @@ def decide_regime(
     decided = _decide(frame, classification, omega, tol, omega_exponent, exact_moments)
     axes = np.asarray(frame.axes, dtype=np.float64)
     given = RigidProblem(np.asarray(frame.moments, dtype=np.float64), axes @ omega, axes, frame.quaternion)
-    return replace(decided, initial=given)
+    return _labelled(replace(decided, initial=given), classification)
+
+
+def _labelled(setup: Setup, classification: Classification) -> Setup:
+    """The regime the classification names (API.md: spherical for a spherical top, regular_precession or
+    permanent_rotation for a symmetric top), where the motion is computed as a finer class's."""
+    rotor, regime = classification.rotor, setup.regime
+    if rotor is RotorClass.SPHERICAL and regime not in (Regime.REST, Regime.SPHERICAL):
+        label, unique = Regime.SPHERICAL, None
+    elif rotor is RotorClass.LINEAR and _needle_moves(setup):
+        # a body of I1 > 0 within tolerance of zero: the rotator's label, the needle's own rates
+        label, unique = Regime.ROTATOR, 0
+    elif rotor.is_symmetric and regime is Regime.ASYMMETRIC:
+        unique = 0 if rotor is RotorClass.SYMMETRIC_PROLATE else 2
+        label = Regime.REGULAR_PRECESSION if setup.problem.omega_body[unique] != 0.0 else Regime.PERMANENT_ROTATION
+    else:
+        return setup
+    moments = np.asarray(setup.problem.moments, dtype=np.float64)
+    if label is Regime.ROTATOR:
+        note = (
+            f"the smallest principal moment is {float(moments[0] / moments[-1]):.2g} of the largest, within the "
+            f"tolerance {classification.tolerance:g} of zero: the precession section names the rotator regime of "
+            "that linear_rotator, with the rates of the body's own moments; the trajectory is its motion"
+        )
+        return replace(setup, label=label, label_unique=unique, warnings=(*setup.warnings, note))
+    spread = float(moments[-1] - moments[0]) if label is Regime.SPHERICAL else _pair_gap(moments, rotor)
+    note = (
+        f"the principal moments the classification calls equal differ by {spread / float(moments[-1]):.2g} of the "
+        f"largest, within its tolerance {classification.tolerance:g}: the precession section reports the "
+        f"{label.value} regime of that {rotor.kind} (its rates from the equal moments' mean); the trajectory is the "
+        "motion of the moments as they are"
+    )
+    return replace(setup, label=label, label_unique=unique, warnings=(*setup.warnings, note))
+
+
+def _needle_moves(setup: Setup) -> bool:
+    """A linear rotator's class on a body whose smallest moment is not 0: the motion is that of a prolate
+    or asymmetric top, unless it is a spin about the needle's own axis (a permanent rotation it is)."""
+    if setup.regime in (Regime.REGULAR_PRECESSION, Regime.ASYMMETRIC):
+        return True
+    return setup.regime is Regime.PERMANENT_ROTATION and setup.problem.omega_body[0] == 0.0
+
+
+def _pair_gap(moments: Array, rotor: RotorClass) -> float:
+    return float(moments[2] - moments[1]) if rotor is RotorClass.SYMMETRIC_PROLATE else float(moments[1] - moments[0])
 
 
 def _decide(

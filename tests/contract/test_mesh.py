@@ -354,9 +354,10 @@ def test_needle_of_aspect_1e6_is_a_linear_rotator_within_the_default_tolerance(c
     strict = analyze(client, "rod.obj", data, tolerance="1e-14")
     check_classification(strict, "symmetric_top", "prolate", planar=False, tolerance=1e-14)
     spin = analyze(client, "rod.obj", data, omega=",".join(repr(float(x)) for x in R @ [0, 0, 1.0]))
-    # labelled a rotator, it moves as the thin prolate top its moments make (issue 12): spun
-    # perpendicular to its axis, that is a permanent rotation
-    assert spin["precession"]["regime"] == "permanent_rotation"
+    # labelled a rotator, and its regime with it (API.md: rotator for a linear rotator), it moves as the
+    # thin prolate top its moments make (issue 12): spun perpendicular to its axis, Omega stays put
+    assert spin["precession"]["regime"] == "rotator"
+    assert spin["precession"]["nutation_angle"] == pytest.approx(np.pi / 2, rel=1e-12)
 
 
 def test_random_convex_body_far_from_the_origin_within_the_estimate(client: TestClient) -> None:

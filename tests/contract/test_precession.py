@@ -311,9 +311,10 @@ def test_nearly_symmetric_mesh_reports_momentum_and_energy_of_its_own_tensor(cli
     res = analyze(client, "hex_prism.stl", omega="0.3,0.2,1", duration=20, samples=5)
     I = np.asarray(res["inertia_tensor"], float)
     pre = res["precession"]
-    # labelled symmetric by the tolerance, it moves as the asymmetric top its moments make (issue 12)
+    # labelled symmetric by the tolerance, and its regime with it (API.md: regular_precession for a
+    # symmetric top), it moves as the asymmetric top its moments make (issue 12)
     assert res["classification"]["kind"] == "symmetric_top"
-    assert pre["regime"] == "asymmetric"
+    assert pre["regime"] == "regular_precession"
     check_invariants(pre, I, omega)
     check_trajectory(pre, res["principal"]["moments"], res["principal"]["axes"], omega, 20.0, 5, I, tol=1e-9)
 
