@@ -134,6 +134,8 @@ def analyze_loaded(loaded: Loaded, options: AnalysisOptions, start: float | None
         parts = None
     else:
         props = _combined(loaded, part_results, options, factor)
+        if options.mass is not None:  # the requested total is exact by definition; the scaled sums round it by an ulp
+            props = replace(props, mass=float(options.mass))
         frame = principal_frame(props, options.tolerance)
         cls = classify(frame)
         parts = part_results

@@ -117,6 +117,17 @@ def test_assembly_total_mass_scales_every_part() -> None:
     assert [p["mass"] for p in doc["parts"]] == pytest.approx([2.0, 8.0], rel=1e-14)
 
 
+@pytest.mark.parametrize("mass", [10.0, 7.0, 0.3, 3.3])
+def test_assembly_total_mass_is_the_requested_one_exactly(mass: float) -> None:
+    # three parts of unequal volume: sharing out the requested total and adding it up again rounds
+    scene = trimesh.Scene()
+    for i, extents in enumerate([(1, 1, 1), (1.3, 0.7, 2.9), (0.1, 3.7, 0.3)]):
+        scene.add_geometry(trimesh.creation.box(extents=extents).apply_translation([5.0 * i, 0.3, 0.1]), node_name=f"p{i}")
+    doc = analyze(export(scene, "glb"), filename="three.glb", options=AnalysisOptions(mass=mass)).as_dict()
+    assert doc["mass"] == mass
+    assert sum(p["mass"] for p in doc["parts"]) == pytest.approx(mass, rel=4e-16, abs=0)
+
+
 def test_single_body_scene_has_no_parts() -> None:
     doc = analyze(export(trimesh.Scene(box_mesh()), "glb"), filename="one.glb").as_dict()
     assert "parts" not in doc
