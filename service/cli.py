@@ -340,9 +340,10 @@ def _batch(args: argparse.Namespace) -> int:
     """
     if not _output_folder_ready(args.out):
         return EXIT_ENVIRONMENT
-    if args.scheduler is None:  # a local cluster: its workers' imports start now, beside this process's
-        from .batch.workers import start_forkserver
+    from .batch.workers import limit_numeric_threads, start_forkserver
 
+    limit_numeric_threads()  # this process computes nothing: no thread per core for numpy (imported next)
+    if args.scheduler is None:  # a local cluster: its workers' imports start now, beside this process's
         start_forkserver()
     from .batch import run_batch
 

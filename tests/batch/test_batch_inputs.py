@@ -309,3 +309,31 @@ def test_local_workers_fork_from_a_frozen_server_with_one_thread_per_numeric_lib
     assert in_forkserver == ["3", "1", "1"]
     assert in_client == ["3", None, None]  # this process's environment is left as it was
     assert frozen > 10_000  # Dask's and the pipeline's objects, frozen before the fork
+
+
+BATCH_COMMAND_ENV = """
+import json, os, sys
+from inertia.batch import workers
+from inertia.cli import main
+code = main(["batch", sys.argv[1], "--out", sys.argv[2], "--workers", "1", "--no-progress"])
+print(json.dumps([code, "numpy" in sys.modules, [os.getenv(k) for k in workers.WORKER_THREAD_LIMITS]]))
+"""
+
+
+def test_the_batch_command_runs_its_own_numeric_libraries_on_one_thread(tmp_path: Path) -> None:
+    """The command computes nothing; numpy's OpenBLAS would start (and spin) a thread per core in it."""
+    stl = tmp_path / "box.stl"
+    stl.write_bytes(stl_bytes(box((1.0, 2.0, 3.0), 0.3, (0.0, 0.0, 0.0))))
+    env = {k: v for k, v in os.environ.items() if k not in workers.WORKER_THREAD_LIMITS}
+    env["MKL_NUM_THREADS"] = "4"  # a value the user set wins
+    done = subprocess.run(
+        [sys.executable, "-c", BATCH_COMMAND_ENV, str(stl), str(tmp_path / "out.jsonl")],
+        env=env,
+        capture_output=True,
+        text=True,
+        check=True,
+        timeout=60,
+    )
+    code, numpy_loaded, limits = json.loads(done.stdout.splitlines()[-1])
+    assert code == 0 and numpy_loaded  # numpy was imported after the limits were set
+    assert limits == ["1", "4", "1"]
