@@ -494,6 +494,7 @@ def main(argv: list[str] | None = None) -> int:
             *(["--rounds", str(args.rounds)] if args.rounds != 2 and not args.quick else []),
             *(["--quick"] if args.quick else []),
             *(["--no-cluster"] if args.no_cluster else []),
+            *(["--out", str(args.out)] if args.out != DOC else []),
         ]
     )
     local_n = max(n for n in workers if n <= cores)
