@@ -309,7 +309,10 @@ def exit_code(exc: ServiceError) -> int:
 
 
 def _analyze(args: argparse.Namespace) -> int:
+    from .blocks import single_heap
     from .pipeline import analyze
+
+    single_heap()  # a large mesh's passes run on several threads: one heap keeps the peak memory of one
 
     document = analyze(args.file, options=options_from_args(args)).document()
     if getattr(args, "export", None) and not args.json:

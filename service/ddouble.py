@@ -13,6 +13,8 @@ from typing import TypeVar
 import numpy as np
 from numpy.typing import NDArray
 
+from .blocks import for_each_block
+
 __all__ = ["two_sum", "two_prod", "rotated"]
 
 _SPLIT = 134217729.0  # 2^27 + 1, Dekker's splitting constant for float64
@@ -52,7 +54,8 @@ def rotated(points: NDArray[np.float64], origin: NDArray[np.float64], rotation: 
     of points are formed together, as (n, 3) arrays.
     """
     out = np.empty((len(points), 3))
-    for start in range(0, len(points), ROTATE_BLOCK):
+
+    def rotate_block(start: int) -> None:
         block = points[start : start + ROTATE_BLOCK]
         d_hi, d_lo = two_sum(block, np.broadcast_to(-origin, block.shape))  # the exact difference
         # output coordinate j sums rotation[i, j] * d[:, i] over i: rows of ``rotation`` broadcast over j
@@ -63,4 +66,6 @@ def rotated(points: NDArray[np.float64], origin: NDArray[np.float64], rotation: 
             hi, e2 = two_sum(hi, p)
             lo = lo + (e + e2 + rotation[i] * d_lo[:, i : i + 1])
         out[start : start + ROTATE_BLOCK] = hi + lo
+
+    for_each_block(rotate_block, range(0, len(points), ROTATE_BLOCK))
     return out

@@ -25,6 +25,8 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from .blocks import for_each_block
+
 __all__ = ["Sums", "simplex_sums", "point_sums", "local_origin", "CHUNK", "point_records", "gather_corners"]
 
 CHUNK = 1 << 15  # elements per vectorised block: its (n,) temporaries (256 KB each) stay in cache
@@ -170,10 +172,14 @@ def simplex_sums(
     xyz = point_records(points)
     starts = range(0, len(cells), CHUNK)
     per_block = np.empty((2, ROWS, len(starts)))
-    for b, start in enumerate(starts):
+
+    def block(start: int) -> None:
         w = None if weight is None else weight[start : start + CHUNK]
+        b = start // CHUNK
         per_block[0, :, b], per_block[1, :, b] = _block_sums(xyz, cells[start : start + CHUNK], kind, w)
-    total, total_abs = per_block.sum(axis=2)  # pairwise over the blocks too
+
+    for_each_block(block, starts)  # blocks on several threads; each fills its own column
+    total, total_abs = per_block.sum(axis=2)  # pairwise over the blocks too, in block order
     return _sums_from_rows(total, total_abs, len(cells), len(starts))
 
 

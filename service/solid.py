@@ -27,6 +27,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
+from .blocks import for_each_block
 from .body import MeshBody
 from .errors import NotWatertightError, ZeroVolumeError
 from .integrals import CHUNK, gather_corners, local_origin, point_records
@@ -89,11 +90,14 @@ def _signed_volumes(x: NDArray[np.float64], faces: NDArray[np.int64]) -> NDArray
     """
     records = point_records(x)
     det = np.empty(len(faces))
-    for start in range(0, len(faces), CHUNK):
+
+    def block(start: int) -> None:
         a, b, c = gather_corners(records, faces[start : start + CHUNK])
         det[start : start + CHUNK] = (
             a[0] * (b[1] * c[2] - b[2] * c[1]) + a[1] * (b[2] * c[0] - b[0] * c[2]) + a[2] * (b[0] * c[1] - b[1] * c[0])
         )
+
+    for_each_block(block, range(0, len(faces), CHUNK))
     return det
 
 

@@ -12,6 +12,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
+from .blocks import for_each_block
 from .body import MeshBody, Part
 from .integrals import gather_corners, point_records
 
@@ -31,8 +32,11 @@ def triangle_area(vertices: NDArray[np.float64], faces: NDArray[np.int64]) -> fl
     # each triangle's |n| in blocks (temporaries bounded), then one pairwise sum over all of them
     norms = np.empty(len(f))
     records = point_records(v)
-    for start in range(0, len(f), AREA_BLOCK):
+
+    def block(start: int) -> None:
         twice_areas(records, f[start : start + AREA_BLOCK], origin, out=norms[start : start + AREA_BLOCK], einsum_order=True)
+
+    for_each_block(block, range(0, len(f), AREA_BLOCK))
     return float(0.5 * np.sum(norms))
 
 

@@ -24,6 +24,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from .blocks import for_each_block
 from .errors import NotWatertightError
 
 __all__ = ["weld", "row_ids", "SurfaceTopology", "surface_topology", "orient_consistently", "face_components"]
@@ -112,11 +113,11 @@ def _row_hash(columns: Sequence[NDArray[np.unsignedinteger]]) -> NDArray[np.uint
     """A 64-bit hash of each row, well mixed in its high bits (multiply-xorshift), in blocks."""
     n = len(columns[0])
     h = np.empty(n, dtype=np.uint64)
-    tmp = np.empty(min(n, BLOCK), dtype=np.uint64)
-    with np.errstate(over="ignore"):
-        for start in range(0, n, BLOCK):
-            stop = min(n, start + BLOCK)
-            hb, t = h[start:stop], tmp[: stop - start]
+
+    def block(start: int) -> None:
+        stop = min(n, start + BLOCK)
+        hb, t = h[start:stop], np.empty(stop - start, dtype=np.uint64)
+        with np.errstate(over="ignore"):  # numpy's error state is per thread
             hb[...] = columns[0][start:stop]
             hb *= _MIX[0]
             for col in columns[1:]:
@@ -130,6 +131,8 @@ def _row_hash(columns: Sequence[NDArray[np.unsignedinteger]]) -> NDArray[np.uint
             hb *= _MIX[2]
             np.right_shift(hb, np.uint64(32), out=t)
             hb ^= t
+
+    for_each_block(block, range(0, n, BLOCK))
     return h
 
 
@@ -156,24 +159,33 @@ def _packed_sort(key: NDArray[np.uint64], index_bits: int, shift: bool = False) 
     n = len(key)
     low = np.uint64((1 << index_bits) - 1)
     bits = np.uint64(index_bits)
-    for start in range(0, n, BLOCK):
+
+    def pack(start: int) -> None:
         part = key[start : start + BLOCK]
         if shift:
             part &= ~low
         else:
             part <<= bits
         part |= np.arange(start, start + len(part), dtype=np.uint64)
+
+    for_each_block(pack, range(0, n, BLOCK))
     key.sort()
     same = np.empty(max(n - 1, 0), dtype=bool)
-    tmp = np.empty(min(n, BLOCK), dtype=np.uint64)
-    for start in range(0, n - 1, BLOCK):
-        stop = min(n - 1, start + BLOCK)
-        t = tmp[: stop - start]
-        np.bitwise_xor(key[start + 1 : stop + 1], key[start:stop], out=t)
-        np.less_equal(t, low, out=same[start:stop])  # equal above the index bits
-    for start in range(0, n, BLOCK):
-        key[start : start + BLOCK] &= low
+
+    # the comparisons read key[stop], the first key of the next block: compare every block, then unpack
+    for_each_block(lambda start: _compare(key, low, same, start, n), range(0, n - 1, BLOCK))
+    for_each_block(lambda start: _unpack(key, low, start), range(0, n, BLOCK))
     return key.view(np.int64), same
+
+
+def _compare(key: NDArray[np.uint64], low: np.uint64, same: NDArray[np.bool_], start: int, n: int) -> None:
+    stop = min(n - 1, start + BLOCK)
+    t = np.bitwise_xor(key[start + 1 : stop + 1], key[start:stop])
+    np.less_equal(t, low, out=same[start:stop])  # equal above the index bits
+
+
+def _unpack(key: NDArray[np.uint64], low: np.uint64, start: int) -> None:
+    key[start : start + BLOCK] &= low
 
 
 def _equal_neighbours(table: NDArray[np.unsignedinteger], order: NDArray[np.int64]) -> NDArray[np.bool_]:
@@ -188,15 +200,17 @@ def _equal_neighbours(table: NDArray[np.unsignedinteger], order: NDArray[np.int6
     same = np.empty(max(n - 1, 0), dtype=bool)
     if n < 2:
         return same
-    eq = np.empty(min(n, BLOCK), dtype=bool)
-    for start in range(0, n - 1, BLOCK):
+
+    def block(start: int) -> None:
         stop = min(n - 1, start + BLOCK)
         gathered = records.take(order[start : stop + 1]).view(table.dtype).reshape(-1, k)
-        out, e = same[start:stop], eq[: stop - start]
+        out, e = same[start:stop], np.empty(stop - start, dtype=bool)
         np.equal(gathered[1:, 0], gathered[:-1, 0], out=out)
         for j in range(1, k):
             np.equal(gathered[1:, j], gathered[:-1, j], out=e)
             out &= e
+
+    for_each_block(block, range(0, n - 1, BLOCK))
     return same
 
 

@@ -32,6 +32,7 @@ LAYERS: list[tuple[str, list[str]]] = [
             "eigen",
             "ddouble",
             "cpus",
+            "blocks",
             "cells",
             "elements",
             "vocabulary",

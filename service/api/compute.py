@@ -44,6 +44,7 @@ from contextlib import contextmanager
 from multiprocessing.connection import Connection
 from typing import Any
 
+from ..blocks import set_block_threads
 from ..errors import ServiceError, UnreadableFileError
 from .jobs import Job, MeshJob, run_job
 from .transport import ComputeTimeoutError, ServerBusyError
@@ -126,6 +127,9 @@ def _serve_jobs(conn: Connection) -> None:
     # engine) without these modules preloaded, which made a replacement's first job seconds long.
     for name in PRELOAD:
         importlib.import_module(name)
+    # several compute processes share the machine, and a job's address-space limit leaves no room for the
+    # stacks and heaps of more threads: a large mesh's block passes run on this process's one thread
+    set_block_threads(1)
     conn.send(("ready", os.getpid()))
     while True:
         try:

@@ -1,0 +1,116 @@
+"""Block passes on several threads: every block once, errors raised, results bit-identical to one thread."""
+
+from __future__ import annotations
+
+import json
+import platform
+import subprocess
+import sys
+import threading
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from benchmarks.cases import torus, triangles_stl_bytes
+from inertia import blocks
+from inertia.pipeline import analyze
+
+
+@pytest.fixture
+def threads(monkeypatch: pytest.MonkeyPatch) -> object:
+    """Each test sets its own thread count; the process's setting comes back afterwards."""
+    yield
+    blocks.set_block_threads(None)
+
+
+def test_every_block_runs_once_on_several_threads(threads: object) -> None:
+    blocks.set_block_threads(3)
+    starts = range(0, 1000, 10)
+    seen = np.zeros(len(starts), dtype=np.int64)
+    idents: set[int] = set()
+    barrier = threading.Barrier(3, timeout=10)  # the first three blocks wait for each other: three threads ran
+
+    def work(start: int) -> None:
+        if start < 30:
+            barrier.wait()
+        idents.add(threading.get_ident())
+        seen[start // 10] += 1
+
+    blocks.for_each_block(work, starts)
+    assert seen.tolist() == [1] * len(starts)
+    assert threading.get_ident() in idents and len(idents) == 3
+
+
+def test_a_failing_block_raises_after_the_running_ones_and_stops_the_rest(threads: object) -> None:
+    blocks.set_block_threads(2)
+    done: list[int] = []
+
+    def work(start: int) -> None:
+        if start == 4:
+            raise ValueError("block 4")
+        done.append(start)
+
+    with pytest.raises(ValueError, match="block 4"):
+        blocks.for_each_block(work, range(1000))
+    assert len(done) < 999  # the blocks after the error were not started
+
+
+def test_a_block_inside_a_block_runs_on_its_own_thread(threads: object) -> None:
+    blocks.set_block_threads(2)
+    inner: dict[int, set[int]] = {}
+
+    def outer(start: int) -> None:
+        mine: set[int] = set()
+        blocks.for_each_block(lambda _s: mine.add(threading.get_ident()), range(8))
+        inner[start] = mine
+
+    blocks.for_each_block(outer, range(8))
+    assert all(len(ids) == 1 for ids in inner.values())
+
+
+def test_few_blocks_run_on_the_calling_thread(threads: object) -> None:
+    blocks.set_block_threads(4)
+    idents: set[int] = set()
+    blocks.for_each_block(lambda _s: idents.add(threading.get_ident()), range(7))  # fewer than 2 per thread
+    assert idents == {threading.get_ident()}
+
+
+@pytest.mark.parametrize(
+    ("env", "expected"),
+    [
+        ({"INERTIA_THREADS": "3", "OMP_NUM_THREADS": "1"}, 3),
+        ({"OMP_NUM_THREADS": "1"}, 1),  # a Dask or batch worker
+        ({"INERTIA_THREADS": "many", "OMP_NUM_THREADS": "2"}, 2),  # not a number: as if unset
+        ({"INERTIA_THREADS": "0"}, 1),
+        ({"INERTIA_THREADS": "999"}, blocks.MAX_THREADS),
+    ],
+)
+def test_thread_count_from_the_environment(monkeypatch: pytest.MonkeyPatch, env: dict[str, str], expected: int) -> None:
+    for name in ("INERTIA_THREADS", "OMP_NUM_THREADS"):
+        monkeypatch.delenv(name, raising=False)
+    for name, value in env.items():
+        monkeypatch.setenv(name, value)
+    assert blocks.block_threads() == expected
+
+
+def test_analysis_on_four_threads_is_bit_identical_to_one(tmp_path: Path, threads: object) -> None:
+    """A mesh of many blocks in every pass, far from the origin (the double-double pass does work)."""
+    v, f = torus(500, 300, 3.0, 1.0)  # 300,000 triangles: 10 blocks of the integration passes, 2 or more a thread
+    far = v + np.array([1000.0, -250.0, 30.0])
+    path = tmp_path / "torus.stl"
+    path.write_bytes(triangles_stl_bytes(far.astype("<f4")[f], b"blocks".ljust(80, b" ")))
+    docs = []
+    for n in (1, 4):
+        blocks.set_block_threads(n)
+        doc = analyze(str(path)).as_dict()
+        doc["diagnostics"].pop("elapsed_s")  # the one field that may differ
+        docs.append(json.dumps(doc, sort_keys=True))
+    assert docs[0] == docs[1]
+
+
+def test_one_heap_for_every_thread_where_the_c_library_is_glibc() -> None:
+    code = "from inertia.blocks import single_heap; print(single_heap())"
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True, timeout=60).stdout
+    if platform.libc_ver()[0] == "glibc":
+        assert out.strip() == "True"
