@@ -17,6 +17,7 @@ scipy import.
 
 from __future__ import annotations
 
+import functools
 import itertools
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -31,7 +32,7 @@ __all__ = ["weld", "row_ids", "SurfaceTopology", "surface_topology", "orient_con
 
 _MIX = (np.uint64(0x9E3779B97F4A7C15), np.uint64(0xBF58476D1CE4E5B9), np.uint64(0x94D049BB133111EB))
 MIN_HASH_BITS = 16  # below this many hash bits beside the index, collisions would dominate: argsort instead
-SCATTER_CHUNK = 1 << 20  # rows per block when scattering ids back: bounds the temporaries to ~16 MB
+SCATTER_CHUNK = 1 << 18  # rows per block when scattering ids back: bounds the temporaries to ~4 MB
 BLOCK = 1 << 15  # elements per block of an element-wise chain: its temporaries (256 KB) stay in the cache
 
 
@@ -92,13 +93,17 @@ def row_ids(
     group_rank -= 1  # hash-order group -> its number in order of first occurrence
     del is_head, firsts
     ids = np.empty(n, dtype=np.int64)
-    before = 0  # groups that start before this block
-    for start in range(0, n, SCATTER_CHUNK):
+    starts = range(0, n, SCATTER_CHUNK)
+    # groups that start before each block, so that the blocks are independent
+    before = np.cumsum([0] + [np.count_nonzero(new[start : start + SCATTER_CHUNK]) for start in starts[:-1]])
+
+    def scatter(start: int) -> None:
         stop = start + SCATTER_CHUNK
         group = np.cumsum(new[start:stop], dtype=index)  # hash-order group of each sorted row, less ``before``
-        group += before - 1
-        before = int(group[-1]) + 1
+        group += before[start // SCATTER_CHUNK] - 1
         ids[order[start:stop]] = group_rank[group]
+
+    for_each_block(scatter, starts)
     return ids, heads
 
 
@@ -290,15 +295,7 @@ def surface_topology(faces: NDArray[np.int64], n_vertices: int) -> SurfaceTopolo
     # the two faces of each manifold edge, smaller index first; built in blocks to bound memory
     pair_index = np.int32 if 2 * (m // 3) < 2**31 else np.int64  # half the memory of every later pass over the pairs
     edge_faces = np.empty((len(first), 2), dtype=pair_index)
-    for start in range(0, len(first), BLOCK):
-        at = first[start : start + BLOCK]
-        face_a = order[at]
-        at += 1
-        face_b = order[at]
-        face_a //= 3
-        face_b //= 3
-        np.minimum(face_a, face_b, out=edge_faces[start : start + BLOCK, 0])
-        np.maximum(face_a, face_b, out=edge_faces[start : start + BLOCK, 1])
+    for_each_block(functools.partial(_face_pairs, first, order, edge_faces), range(0, len(first), BLOCK))
     del first, order
     return SurfaceTopology(
         open_edges=open_edges,
@@ -307,6 +304,19 @@ def surface_topology(faces: NDArray[np.int64], n_vertices: int) -> SurfaceTopolo
         edge_faces=edge_faces,
         edge_same_direction=same,
     )
+
+
+def _face_pairs(
+    first: NDArray[np.signedinteger], order: NDArray[np.signedinteger], out: NDArray[np.signedinteger], start: int
+) -> None:
+    """The two faces of the edges whose runs start at ``first[start:start + BLOCK]``, smaller first."""
+    at = first[start : start + BLOCK]
+    face_a = order[at]
+    face_b = order[at + 1]
+    face_a //= 3
+    face_b //= 3
+    np.minimum(face_a, face_b, out=out[start : start + BLOCK, 0])
+    np.maximum(face_a, face_b, out=out[start : start + BLOCK, 1])
 
 
 def _edge_keys(faces: NDArray[np.int64], n_vertices: int) -> tuple[NDArray[np.uint64], NDArray[np.bool_]]:
@@ -319,20 +329,23 @@ def _edge_keys(faces: NDArray[np.int64], n_vertices: int) -> tuple[NDArray[np.ui
     key = np.empty((n, 3), dtype=np.uint64)
     forward = np.empty((n, 3), dtype=bool)
     step = max(1, BLOCK // 3)
-    lo = np.empty(min(n, step), dtype=np.int64)
-    hi = np.empty(min(n, step), dtype=np.int64)
-    for start in range(0, n, step):
-        block = faces[start : start + step]
-        m = len(block)
+
+    def block(start: int) -> None:
+        faces_b = faces[start : start + step]
+        m = len(faces_b)
+        lo = np.empty(m, dtype=np.int64)
+        hi = np.empty(m, dtype=np.int64)
         for k in range(3):
-            u, v = block[:, k], block[:, (k + 1) % 3]
+            u, v = faces_b[:, k], faces_b[:, (k + 1) % 3]
             np.less(u, v, out=forward[start : start + m, k])
-            np.minimum(u, v, out=lo[:m])
-            np.maximum(u, v, out=hi[:m])
-            lk = lo[:m].view(np.uint64)
+            np.minimum(u, v, out=lo)
+            np.maximum(u, v, out=hi)
+            lk = lo.view(np.uint64)
             lk *= np.uint64(n_vertices)
-            lk += hi[:m].view(np.uint64)
+            lk += hi.view(np.uint64)
             key[start : start + m, k] = lk
+
+    for_each_block(block, range(0, n, step))
     return key.reshape(-1), forward.reshape(-1)
 
 
