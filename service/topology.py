@@ -178,12 +178,27 @@ def _packed_sort(key: NDArray[np.uint64], index_bits: int, shift: bool = False) 
     same = np.empty(max(n - 1, 0), dtype=bool)
 
     # the comparisons read key[stop], the first key of the next block: compare every block, then unpack
-    for_each_block(lambda start: _compare(key, low, same, start, n), range(0, n - 1, BLOCK))
-    for_each_block(lambda start: _unpack(key, low, start), range(0, n, BLOCK))
+    for_each_block(functools.partial(_compare, key, low, same, n), range(0, n - 1, BLOCK))
+    for_each_block(functools.partial(_unpack, key, low), range(0, n, BLOCK))
     return key.view(np.int64), same
 
 
-def _compare(key: NDArray[np.uint64], low: np.uint64, same: NDArray[np.bool_], start: int, n: int) -> None:
+def _pack_bucket(
+    part: NDArray[np.uint64],
+    key: NDArray[np.uint64],
+    sub: NDArray[np.signedinteger],
+    low: np.uint64,
+    index_bits: np.uint64,
+    start: int,
+) -> None:
+    block = part[start : start + BLOCK]
+    block[...] = key[sub[start : start + BLOCK]]
+    block &= low
+    block <<= index_bits
+    block |= sub[start : start + BLOCK].view(np.uint64)
+
+
+def _compare(key: NDArray[np.uint64], low: np.uint64, same: NDArray[np.bool_], n: int, start: int) -> None:
     stop = min(n - 1, start + BLOCK)
     t = np.bitwise_xor(key[start + 1 : stop + 1], key[start:stop])
     np.less_equal(t, low, out=same[start:stop])  # equal above the index bits
@@ -385,23 +400,16 @@ def _edge_order(key: NDArray[np.uint64], key_bits: int) -> tuple[NDArray[np.sign
             continue
         sub = np.flatnonzero(bucket == b) if by_bucket is None else by_bucket[b0:b1]  # ascending either way
         part = np.empty(b1 - b0, dtype=np.uint64)
-        for start in range(0, len(part), BLOCK):  # the low key bits and the index, packed in blocks
-            block = part[start : start + BLOCK]
-            block[...] = key[sub[start : start + BLOCK]]
-            block &= low
-            block <<= np.uint64(index_bits)
-            block |= sub[start : start + BLOCK].view(np.uint64)
+        # the low key bits and the index, packed in blocks
+        for_each_block(functools.partial(_pack_bucket, part, key, sub, low, np.uint64(index_bits)), range(0, len(part), BLOCK))
         del sub
         part.sort()
         same = np.empty(len(part) - 1, dtype=bool)
-        for start in range(0, len(part) - 1, BLOCK):
-            stop = min(len(part) - 1, start + BLOCK)
-            np.less_equal(part[start + 1 : stop + 1] ^ part[start:stop], index_mask, out=same[start:stop])
+        for_each_block(functools.partial(_compare, part, index_mask, same, len(part)), range(0, len(part) - 1, BLOCK))
         first: NDArray[np.signedinteger] = np.flatnonzero(np.r_[True, ~same]).astype(small)
         first += b0
         starts.append(first)
-        for start in range(0, len(part), BLOCK):
-            part[start : start + BLOCK] &= index_mask
+        for_each_block(functools.partial(_unpack, part, index_mask), range(0, len(part), BLOCK))
         order[b0:b1] = part
     return order, np.concatenate(starts)
 
@@ -415,7 +423,7 @@ def _components(n: int, a: NDArray[np.signedinteger], b: NDArray[np.signedintege
     of each component, as a breadth-first search from node 0 upwards would.
     """
     index = np.int32 if n < 2**31 else np.int64  # half the memory of every temporary below
-    parent = np.arange(n, dtype=index)
+    parent: NDArray[np.signedinteger] = np.arange(n, dtype=index)
     while True:  # the first round reads the given (a, b) in place; later rounds keep compact copies
         ra, rb = parent[a], parent[b]
         join = ra != rb
@@ -428,11 +436,8 @@ def _components(n: int, a: NDArray[np.signedinteger], b: NDArray[np.signedintege
         del rb
         np.minimum.at(parent, hi, ra)
         del hi, ra
-        while True:
-            grand = parent[parent]
-            if np.array_equal(grand, parent):
-                break
-            parent = grand
+        while _jump(parent):  # until every node points at its root
+            pass
         a, b = a[join].astype(index, copy=False), b[join].astype(index, copy=False)
     roots = parent == np.arange(n, dtype=index)
     rank: NDArray[np.signedinteger] = np.cumsum(roots, dtype=index)
@@ -440,6 +445,27 @@ def _components(n: int, a: NDArray[np.signedinteger], b: NDArray[np.signedintege
     rank -= 1
     label: NDArray[np.int64] = rank[parent].astype(np.int64)
     return int(rank[-1] + 1) if n else 0, label
+
+
+def _jump(parent: NDArray[np.signedinteger]) -> bool:
+    """One step of pointer jumping in place, ``parent = parent[parent]``, in blocks; whether any entry moved.
+
+    In place is safe although blocks read entries other blocks write: an
+    entry only ever moves to an ancestor of the same tree, so a read of a
+    block's new value still gives an ancestor, and the loop ends only once
+    a whole pass moved nothing, when every entry is its root.
+    """
+    starts = range(0, len(parent), BLOCK)
+    moved = np.zeros(len(starts), dtype=bool)
+
+    def block(start: int) -> None:
+        own = parent[start : start + BLOCK]
+        grand = parent[own]
+        moved[start // BLOCK] = not np.array_equal(grand, own)
+        own[...] = grand
+
+    for_each_block(block, starts)
+    return bool(moved.any())
 
 
 def orient_consistently(faces: NDArray[np.int64], topo: SurfaceTopology) -> tuple[NDArray[np.int64], int]:

@@ -114,3 +114,24 @@ def test_one_heap_for_every_thread_where_the_c_library_is_glibc() -> None:
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True, timeout=60).stdout
     if platform.libc_ver()[0] == "glibc":
         assert out.strip() == "True"
+
+
+@pytest.mark.parametrize("n_threads", [1, 3])
+def test_components_on_threads_match_scipy_on_long_chains(threads: object, n_threads: int) -> None:
+    """Paths of 50,000 nodes in shuffled order need many pointer jumps, each in blocks on the threads."""
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    from inertia import topology
+
+    rng = np.random.default_rng(5)
+    n = 300_000
+    perm = rng.permutation(n)
+    ends = np.arange(n - 1)
+    ends = ends[(ends + 1) % 50_000 != 0]  # six chains
+    a, b = perm[ends], perm[ends + 1]
+    blocks.set_block_threads(n_threads)
+    count, label = topology._components(n, a, b)
+    ref_count, ref_label = connected_components(coo_matrix((np.ones(len(a)), (a, b)), shape=(n, n)), directed=False)
+    assert count == ref_count == 6
+    np.testing.assert_array_equal(label, ref_label)
