@@ -174,7 +174,21 @@ def _check_resolution(
     """
     x = geometry.points
     delta = geometry.coordinate_eps * float(np.abs(x).max())
-    y = x - com
+    y = np.empty_like(x)
+    rows = range(0, len(x), _AREA_BLOCK)
+    reach_rows = np.empty((len(rows), 3))
+
+    def reach_block(start: int) -> None:
+        # row by row, as on the whole array: y, its principal-frame coordinates (columns of rotation are
+        # the axes), and each point's largest squared distance from each axis
+        block = np.subtract(x[start : start + _AREA_BLOCK], com, out=y[start : start + _AREA_BLOCK])
+        along = block @ rotation
+        sq = along * along
+        total = sq.sum(axis=1)  # once, not once per axis
+        reach_rows[start // _AREA_BLOCK] = [np.max(total - sq[:, k]) for k in range(3)]
+
+    for_each_block(reach_block, rows)
+    reach = reach_rows.max(axis=0)
     records = point_records(y)  # one gather of 24 bytes per corner, not numpy's slower 2-D fancy indexing
     starts = range(0, len(geometry.cells), _AREA_BLOCK)
     block_area = np.empty(len(starts))
@@ -189,10 +203,6 @@ def _check_resolution(
     weight = 1.0 if geometry.weight is None else float(np.max(geometry.weight))
     moved = math.sqrt(3.0) * delta * area  # volume the resolution can move
     volume = abs(s.measure)
-    along = y @ rotation  # principal-frame coordinates (columns of rotation are the axes)
-    sq = along * along
-    total = sq.sum(axis=1)  # once, not once per axis
-    reach = np.array([float(np.max(total - sq[:, k])) for k in range(3)])
     ratio_v = moved / volume if volume > 0 else math.inf
     ratio_i = float(np.max(moved * weight * reach / values))
     ratio = max(ratio_v, ratio_i)
