@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import os
 import platform
 import subprocess
 import sys
@@ -135,3 +136,38 @@ def test_components_on_threads_match_scipy_on_long_chains(threads: object, n_thr
     ref_count, ref_label = connected_components(coo_matrix((np.ones(len(a)), (a, b)), shape=(n, n)), directed=False)
     assert count == ref_count == 6
     np.testing.assert_array_equal(label, ref_label)
+
+
+def _stl_file(tmp_path: Path) -> tuple[Path, bytes]:
+    v, f = torus(30, 20, 3.0, 1.0)
+    data = triangles_stl_bytes(v.astype("<f4")[f], b"pread".ljust(80, b" "))
+    path = tmp_path / "torus.stl"
+    path.write_bytes(data)
+    return path, data
+
+
+def test_binary_stl_read_in_blocks_at_their_offsets_equals_the_whole_read(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, threads: object
+) -> None:
+    from inertia.load import stl
+
+    path, data = _stl_file(tmp_path)
+    monkeypatch.setattr(stl, "_READ_BLOCK", 7)  # 1,200 faces: 172 blocks, the last one short
+    real_pread = os.pread
+    monkeypatch.setattr(stl.os, "pread", lambda fd, n, at: real_pread(fd, max(1, n // 3), at))  # short reads
+    blocks.set_block_threads(3)
+    with path.open("rb") as fh:
+        vertices, faces = stl.read_stl_file(fh, len(data))
+    ref_vertices, ref_faces = stl.read_stl(data)
+    np.testing.assert_array_equal(vertices, ref_vertices)
+    np.testing.assert_array_equal(faces, ref_faces)
+
+
+def test_binary_stl_that_shrinks_while_read_is_refused(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    from inertia.errors import UnreadableFileError
+    from inertia.load import stl
+
+    path, data = _stl_file(tmp_path)
+    monkeypatch.setattr(stl.os, "pread", lambda fd, n, at: b"")  # the file's end came early
+    with path.open("rb") as fh, pytest.raises(UnreadableFileError, match="truncated"):
+        stl.read_stl_file(fh, len(data))

@@ -14,6 +14,7 @@ vertices come back welded, so ``solid.closed_surface`` need not weld again.
 
 from __future__ import annotations
 
+import os
 from typing import BinaryIO
 
 import numpy as np
@@ -49,7 +50,8 @@ def read_stl_file(fh: BinaryIO, size: int) -> tuple[NDArray[np.float64], NDArray
     """Like ``read_stl`` for an open file of ``size`` bytes.
 
     A binary file is read in blocks of records straight into the corner
-    array, so the file's bytes are never all in memory next to it.
+    array, so the file's bytes are never all in memory next to it; each
+    block is read at its own offset (``os.pread``), on the block threads.
     """
     header = fh.read(84)
     if len(header) == 84:
@@ -58,9 +60,19 @@ def read_stl_file(fh: BinaryIO, size: int) -> tuple[NDArray[np.float64], NDArray
             if count == 0:
                 raise EmptyGeometryError("the STL file holds no triangles")
             corners = np.empty((count, 3, 3), dtype=np.float32)
-            for start in range(0, count, _READ_BLOCK):
-                block = np.fromfile(fh, dtype=_RECORD, count=min(_READ_BLOCK, count - start))
-                corners[start : start + len(block)] = block["vertices"]
+            fd = fh.fileno()
+
+            def read_block(start: int) -> None:
+                n = min(_READ_BLOCK, count - start)
+                raw = os.pread(fd, 50 * n, 84 + 50 * start)
+                while len(raw) < 50 * n:  # pread may return less; at the end of the file it returns nothing
+                    more = os.pread(fd, 50 * n - len(raw), 84 + 50 * start + len(raw))
+                    if not more:
+                        raise UnreadableFileError("the STL file ended before its last triangle; it may be truncated")
+                    raw += more
+                corners[start : start + n] = np.frombuffer(raw, dtype=_RECORD)["vertices"]
+
+            for_each_block(read_block, range(0, count, _READ_BLOCK))
             return _welded(corners)
     fh.seek(0)
     return read_stl(fh.read())
