@@ -154,7 +154,7 @@ def test_binary_stl_read_in_blocks_at_their_offsets_equals_the_whole_read(
     path, data = _stl_file(tmp_path)
     monkeypatch.setattr(stl, "_READ_BLOCK", 7)  # 1,200 faces: 172 blocks, the last one short
     real_pread = os.pread
-    monkeypatch.setattr(stl.os, "pread", lambda fd, n, at: real_pread(fd, max(1, n // 3), at))  # short reads
+    monkeypatch.setattr(os, "pread", lambda fd, n, at: real_pread(fd, max(1, n // 3), at))  # short reads
     blocks.set_block_threads(3)
     with path.open("rb") as fh:
         vertices, faces = stl.read_stl_file(fh, len(data))
@@ -168,6 +168,6 @@ def test_binary_stl_that_shrinks_while_read_is_refused(tmp_path: Path, monkeypat
     from inertia.load import stl
 
     path, data = _stl_file(tmp_path)
-    monkeypatch.setattr(stl.os, "pread", lambda fd, n, at: b"")  # the file's end came early
+    monkeypatch.setattr(os, "pread", lambda fd, n, at: b"")  # the file's end came early
     with path.open("rb") as fh, pytest.raises(UnreadableFileError, match="truncated"):
         stl.read_stl_file(fh, len(data))
