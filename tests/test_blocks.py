@@ -8,6 +8,7 @@ import platform
 import subprocess
 import sys
 import threading
+import time
 from pathlib import Path
 
 import numpy as np
@@ -73,8 +74,30 @@ def test_a_block_inside_a_block_runs_on_its_own_thread(threads: object) -> None:
 def test_few_blocks_run_on_the_calling_thread(threads: object) -> None:
     blocks.set_block_threads(4)
     idents: set[int] = set()
-    blocks.for_each_block(lambda _s: idents.add(threading.get_ident()), range(7))  # fewer than 2 per thread
+    blocks.for_each_block(lambda _s: idents.add(threading.get_ident()), range(3))  # fewer than 2 for each of 2
     assert idents == {threading.get_ident()}
+
+
+@pytest.mark.parametrize(("count", "most"), [(7, 2), (35, 2), (36, 3), (1000, 8)])
+def test_threads_beyond_two_need_blocks_enough(threads: object, count: int, most: int) -> None:
+    """One more thread per 12 blocks: the temporaries of the blocks in flight stay small next to the data."""
+    blocks.set_block_threads(8)
+    running: set[int] = set()
+    peak = [0]
+    lock = threading.Lock()
+
+    def work(_start: int) -> None:
+        with lock:
+            running.add(threading.get_ident())
+            peak[0] = max(peak[0], len(running))
+        time.sleep(0.002)  # long enough for every thread taking part to hold a block at once
+        with lock:
+            running.discard(threading.get_ident())
+
+    blocks.for_each_block(work, range(count))
+    assert peak[0] <= most
+    if count >= 1000:
+        assert peak[0] >= 2
 
 
 @pytest.mark.parametrize(
