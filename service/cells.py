@@ -55,7 +55,8 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import NDArray
 
-from .integrals import Sums
+from .blocks import for_each_block
+from .integrals import IJ, ROWS, Sums, sums_from_rows
 
 __all__ = ["CELL_NODES", "CellRule", "cell_rule", "cell_sums", "combined", "tangled_cells", "VOXEL_TO_HEXAHEDRON"]
 
@@ -390,31 +391,19 @@ def cell_sums(x: NDArray[np.float64], name: str, cells: NDArray[np.int64], weigh
     xyz = [np.ascontiguousarray(x[:, k]) for k in range(3)]
     n = rule.shape.shape[1]
     step = max(1, _BLOCK_POINTS // len(rule.weights))
-    rows: list[tuple[NDArray[np.float64], NDArray[np.float64]]] = []
-    for start in range(0, len(cells), step):
+    starts = range(0, len(cells), step)
+    rows: list[tuple[NDArray[np.float64], NDArray[np.float64]]] = [(np.empty(0), np.empty(0))] * len(starts)
+
+    def block(start: int) -> None:  # on the block threads; each block fills its own entry
         w = None if weight is None else weight[start : start + step]
-        rows.append(_block_rows(xyz, cells[start : start + step], rule, w, n))
-    total = np.sum([r[0] for r in rows], axis=0) if rows else np.zeros(15)
-    total_abs = np.sum([r[1] for r in rows], axis=0) if rows else np.zeros(15)
-    m2, a2 = np.empty((3, 3)), np.empty((3, 3))
-    for row, (i, j) in enumerate(_IJ, start=4):
-        m2[i, j] = m2[j, i] = total[row]
-        a2[i, j] = a2[j, i] = total_abs[row]
-    return Sums(
-        float(total[0]),
-        total[1:4].copy(),
-        m2,
-        float(total_abs[0]),
-        a2,
-        float(total[10]),
-        total[11:14].copy(),
-        float(total[14]),
-        len(cells) * len(rule.weights),
-        max(len(rows), 1),
-    )
+        rows[start // step] = _block_rows(xyz, cells[start : start + step], rule, w, n)
+
+    for_each_block(block, starts)
+    total = np.sum([r[0] for r in rows], axis=0) if rows else np.zeros(ROWS)  # in block order
+    total_abs = np.sum([r[1] for r in rows], axis=0) if rows else np.zeros(ROWS)
+    return sums_from_rows(total, total_abs, len(cells) * len(rule.weights), max(len(rows), 1))
 
 
-_IJ = ((0, 0), (1, 1), (2, 2), (0, 1), (0, 2), (1, 2))
 
 
 def _block_rows(
@@ -426,7 +415,7 @@ def _block_rows(
     dv = det * rule.weights * sign[:, None]
     noise = cond * rule.weights  # rounding scale of dv: its error is below (n + 6) u times this
     dm, dm_noise = (dv, noise) if weight is None else (dv * weight[:, None], noise * np.abs(weight)[:, None])
-    terms = [dm, *(dm * p for p in pos), *(dm * pos[i] * pos[j] for i, j in _IJ)]
+    terms = [dm, *(dm * p for p in pos), *(dm * pos[i] * pos[j] for i, j in IJ)]
     total = np.array([float(t.sum()) for t in terms] + [0.0] * 5)
     total_abs = np.array([float(np.abs(t).sum()) for t in terms] + [0.0] * 5)
     total[10] = total_abs[10] = float(dm_noise.sum() * (n + 6) / 8)  # as the tetrahedra's determinant scale

@@ -27,7 +27,7 @@ from numpy.typing import NDArray
 
 from .blocks import for_each_block
 
-__all__ = ["Sums", "simplex_sums", "point_sums", "local_origin", "CHUNK", "point_records", "gather_corners"]
+__all__ = ["Sums", "simplex_sums", "sums_from_rows", "point_sums", "local_origin", "CHUNK", "point_records", "gather_corners", "IJ"]
 
 CHUNK = 1 << 15  # elements per vectorised block: its (n,) temporaries (256 KB each) stay in cache
 
@@ -55,7 +55,8 @@ class Sums:
     blocks: int
 
 
-_IJ = ((0, 0), (1, 1), (2, 2), (0, 1), (0, 2), (1, 2))
+IJ = ((0, 0), (1, 1), (2, 2), (0, 1), (0, 2), (1, 2))  # the rows of a symmetric 3 x 3 tensor's six entries
+_IJ = IJ
 # rows of a block's sums: m0, m1 (x y z), m2 (xx yy zz xy xz yz), det noise, error scale of xx yy zz
 ROWS = 15
 _NOISE, _ERR, _MEASURE = 10, 11, 14
@@ -180,10 +181,11 @@ def simplex_sums(
 
     for_each_block(block, starts)  # blocks on several threads; each fills its own column
     total, total_abs = per_block.sum(axis=2)  # pairwise over the blocks too, in block order
-    return _sums_from_rows(total, total_abs, len(cells), len(starts))
+    return sums_from_rows(total, total_abs, len(cells), len(starts))
 
 
-def _sums_from_rows(total: NDArray[np.float64], total_abs: NDArray[np.float64], n: int, blocks: int) -> Sums:
+def sums_from_rows(total: NDArray[np.float64], total_abs: NDArray[np.float64], n: int, blocks: int) -> Sums:
+    """``Sums`` from its ``ROWS`` rows of totals and of absolute totals, over ``n`` terms in ``blocks`` blocks."""
     m2 = np.empty((3, 3))
     a2 = np.empty((3, 3))
     for row, (i, j) in enumerate(_IJ, start=4):

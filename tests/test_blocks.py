@@ -194,3 +194,25 @@ def test_binary_stl_that_shrinks_while_read_is_refused(tmp_path: Path, monkeypat
     monkeypatch.setattr(os, "pread", lambda fd, n, at: b"")  # the file's end came early
     with path.open("rb") as fh, pytest.raises(UnreadableFileError, match="truncated"):
         stl.read_stl_file(fh, len(data))
+
+
+def test_volume_cell_sums_on_threads_are_bit_identical_to_one(threads: object) -> None:
+    """Trilinear hexahedra of a sheared grid: the quadrature runs in many blocks, summed in block order."""
+    from inertia.cells import cell_sums
+
+    k = 24
+    g = np.arange(k + 1, dtype=np.float64)
+    x, y, z = np.meshgrid(g, g, g, indexing="ij")
+    points = np.stack([x + 0.1 * y * z, y + 0.05 * x, z - 0.02 * x * y], axis=-1).reshape(-1, 3) / k
+    node = np.arange((k + 1) ** 3).reshape(k + 1, k + 1, k + 1)
+    corners = [node[i : k + i, j : k + j, m : k + m] for i, j, m in ((0, 0, 0), (1, 0, 0), (1, 1, 0), (0, 1, 0))]
+    corners += [node[i : k + i, j : k + j, 1:] for i, j in ((0, 0), (1, 0), (1, 1), (0, 1))]
+    hexes = np.stack([c.reshape(-1) for c in corners], axis=1)  # 13,824 cells
+    weight = 1.0 + (np.arange(len(hexes)) % 7) / 7.0
+    results = []
+    for n in (1, 3):
+        blocks.set_block_threads(n)
+        s = cell_sums(points, "hexahedron", hexes, weight)
+        results.append((s.m0, s.m1.tolist(), s.m2.tolist(), s.abs_m2.tolist(), s.noise, s.blocks))
+    assert results[0] == results[1]
+    assert results[0][5] >= 6  # enough blocks for the threads to share them
