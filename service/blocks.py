@@ -84,10 +84,11 @@ def for_each_block(work: Callable[[int], None], starts: Sequence[int]) -> None:
     Two threads take part from four blocks on, and one more for every
     ``BLOCKS_PER_EXTRA_THREAD`` blocks.  The calling thread takes blocks
     too, beside threads of a pool kept for the process; blocks are handed
-    out one at a time, in order.  Each call must write only its own block's slice of the
-    results.  After an exception no further block starts, and the first
-    exception is raised here once the blocks running have ended.  A block
-    that itself calls ``for_each_block`` runs that pass on its own thread.
+    out one at a time, in order.  Each call must write only its own
+    block's slice of the results.  After an exception no further block
+    starts, and the first exception is raised here once the blocks running
+    have ended.  A block that itself calls ``for_each_block`` runs that
+    pass on its own thread.
     """
     few = len(starts) < 2 * MIN_BLOCKS_PER_THREAD  # decided first: most meshes are one block
     threads = 1 if few or getattr(_in_block, "active", False) else block_threads()
