@@ -404,8 +404,6 @@ def cell_sums(x: NDArray[np.float64], name: str, cells: NDArray[np.int64], weigh
     return sums_from_rows(total, total_abs, len(cells) * len(rule.weights), max(len(rows), 1))
 
 
-
-
 def _block_rows(
     xyz: list[NDArray[np.float64]], cells: NDArray[np.int64], rule: CellRule, weight: NDArray[np.float64] | None, n: int
 ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
