@@ -160,7 +160,9 @@ print(len(files))
 
 ANALYZE_SCRIPT = """\
 import sys
+from inertia.blocks import set_block_threads
 from inertia.pipeline import analyze
+set_block_threads(1)  # the serial reference: one core, as each batch worker has
 files = open(sys.argv[1], encoding="utf-8").read().splitlines()
 for path in files:
     analyze(path).as_dict()

@@ -10,8 +10,9 @@ best of each contender is kept; every run's output is checked):
 
 - ``trimesh loop``: a fresh ``python -c`` that imports trimesh and reads
   ``trimesh.load(path).mass_properties`` for every file, one after the other;
-- ``analyze loop``: the same with ``inertia.pipeline.analyze(path)``: our
-  serial pipeline, the reference of the speed-ups;
+- ``analyze loop``: the same with ``inertia.pipeline.analyze(path)`` on one
+  thread (no block threads, as in each batch worker): our serial pipeline,
+  the reference of the speed-ups;
 - ``inertia batch --workers N``: the real command on the local default engine
   (a process pool), from launch to exit, start-up included;
 - ``inertia batch --scheduler ADDRESS``: the real command against a running
