@@ -424,8 +424,11 @@ def _components(n: int, a: NDArray[np.signedinteger], b: NDArray[np.signedintege
     """
     index = np.int32 if n < 2**31 else np.int64  # half the memory of every temporary below
     parent: NDArray[np.signedinteger] = np.arange(n, dtype=index)
+    first = True
     while True:  # the first round reads the given (a, b) in place; later rounds keep compact copies
-        ra, rb = parent[a], parent[b]
+        # every node is its own root before the first round: its roots are the ends themselves
+        ra, rb = (a.astype(index), b.astype(index)) if first else (parent[a], parent[b])
+        first = False
         join = ra != rb
         if not np.any(join):
             break
