@@ -275,3 +275,20 @@ def test_polyhedron_that_is_not_star_shaped_is_refused() -> None:
     with pytest.raises(UnsupportedFormatError) as info:
         load_body(text.encode(), filename="L.vtk")
     assert "star-shaped" in info.value.message
+
+
+def test_gltf_primitives_have_the_same_part_names_on_every_read() -> None:
+    """trimesh names a mesh's primitives with random hex digits; the parts, their names and order must not vary."""
+    import random
+
+    from inertia.pipeline import analyze
+
+    path = REAL / "gltf_multi" / "rgb_cube_with_primitives.gltf"
+    analyze(str(path))  # a module trimesh imports on first use draws from ``random`` as it is imported
+    before = random.getstate()
+    first = analyze(str(path)).as_dict()
+    assert random.getstate() == before  # the caller's random numbers are left as they were
+    random.random()  # whatever the state of ``random`` when the file is read
+    second = analyze(str(path)).as_dict()
+    assert first["warnings"] == second["warnings"]
+    assert re.findall(r"Cube_\w+", " ".join(first["warnings"]))  # the primitives' parts are named in a warning

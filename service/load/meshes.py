@@ -13,7 +13,8 @@ from __future__ import annotations
 
 import io
 import json
-from collections.abc import Mapping
+import random
+from collections.abc import Callable, Mapping
 from dataclasses import replace
 from typing import Any
 
@@ -100,8 +101,10 @@ def read_trimesh_parts(
     if companions:
         kwargs["resolver"] = trimesh.resolvers.ZipResolver(dict(companions))
     scene = guarded_read(
-        lambda: trimesh.load_scene(
-            io.BytesIO(data), file_type=fmt, process=False, skip_materials=True, merge_primitives=False, **kwargs
+        lambda: _same_names_every_read(
+            lambda: trimesh.load_scene(
+                io.BytesIO(data), file_type=fmt, process=False, skip_materials=True, merge_primitives=False, **kwargs
+            )
         ),
         fmt,
     )
@@ -216,6 +219,26 @@ def _ply_face_lists(raw: Any) -> list[Any] | None:
         return None
     except (KeyError, TypeError, IndexError, ValueError):
         return None
+
+
+_NAME_SEED = 0x1E27
+
+
+def _same_names_every_read(read: Callable[[], Any]) -> Any:
+    """``read()`` with Python's ``random`` seeded, its state restored after.
+
+    trimesh names the node of each primitive of a glTF mesh with several
+    primitives ``<node>_<6 random hex digits>`` (``util.unique_id``, drawn
+    from ``random``): the same file gave other part names, and parts sorted
+    by name in another order, on every read.  With a fixed seed a file's
+    parts have the same names, in the same order, every time.
+    """
+    state = random.getstate()
+    random.seed(_NAME_SEED)
+    try:
+        return read()
+    finally:
+        random.setstate(state)
 
 
 def _gltf_document(data: bytes, fmt: str) -> Any:
