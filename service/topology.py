@@ -293,10 +293,9 @@ def surface_topology(faces: NDArray[np.int64], n_vertices: int) -> SurfaceTopolo
     np.subtract(starts[1:], starts[:-1], out=counts[:-1])
     if len(starts):
         counts[-1] = m - starts[-1]
-    fwd = forward[order]
+    balance = np.empty(len(starts), dtype=small)  # half-edges of each run that go lo -> hi
+    for_each_block(functools.partial(_forward_counts, forward, order, starts, counts, balance), range(0, len(starts), BLOCK))
     del forward
-    balance = np.add.reduceat(fwd, starts, dtype=small)
-    del fwd
     balance *= 2
     balance -= counts
     pair = counts == 2
@@ -319,6 +318,36 @@ def surface_topology(faces: NDArray[np.int64], n_vertices: int) -> SurfaceTopolo
         edge_faces=edge_faces,
         edge_same_direction=same,
     )
+
+
+def _forward_counts(
+    forward: NDArray[np.bool_],
+    order: NDArray[np.signedinteger],
+    starts: NDArray[np.signedinteger],
+    counts: NDArray[np.signedinteger],
+    out: NDArray[np.signedinteger],
+    start: int,
+) -> None:
+    """For the runs ``start:start + BLOCK`` of equal edges, how many of their half-edges go lo -> hi.
+
+    A run's half-edges are consecutive in ``order``, so a block of runs
+    gathers one slice of the flags.  Nearly every run is a pair (a manifold
+    edge): its first and second flags are added for all runs at once, and
+    only runs of three or more (non-manifold edges) are visited again;
+    ``np.add.reduceat`` took three times as long over millions of pairs.
+    """
+    s, c = starts[start : start + BLOCK], counts[start : start + BLOCK]
+    first = int(s[0])
+    fwd = forward[order[first : int(s[-1] + c[-1])]]
+    local = s - first
+    total = fwd[local].astype(out.dtype)
+    second = fwd[np.minimum(local + 1, len(fwd) - 1)]
+    second &= c > 1
+    total += second
+    for k in range(2, int(c.max())):
+        more = np.flatnonzero(c > k)
+        total[more] += fwd[local[more] + k]
+    out[start : start + BLOCK] = total
 
 
 def _face_pairs(

@@ -216,3 +216,31 @@ def test_volume_cell_sums_on_threads_are_bit_identical_to_one(threads: object) -
         results.append((s.m0, s.m1.tolist(), s.m2.tolist(), s.abs_m2.tolist(), s.noise, s.blocks))
     assert results[0] == results[1]
     assert results[0][5] >= 6  # enough blocks for the threads to share them
+
+
+@pytest.mark.parametrize("n_threads", [1, 3])
+def test_edge_counts_in_blocks_match_a_count_of_every_edge(threads: object, n_threads: int) -> None:
+    """Random faces on few vertices: runs of one to many half-edges, over several blocks of runs."""
+    from collections import Counter
+
+    from inertia import topology
+
+    rng = np.random.default_rng(11)
+    n_vertices = 600
+    faces = np.array([rng.choice(n_vertices, 3, replace=False) for _ in range(60_000)], dtype=np.int64)
+    count: Counter[tuple[int, int]] = Counter()
+    forward: Counter[tuple[int, int]] = Counter()
+    for face in faces.tolist():
+        for u, v in zip(face, face[1:] + face[:1], strict=True):
+            edge = (min(u, v), max(u, v))
+            count[edge] += 1
+            forward[edge] += u < v
+    blocks.set_block_threads(n_threads)
+    topo = topology.surface_topology(faces, n_vertices)
+    assert len(count) > 2 * topology.BLOCK  # several blocks of runs
+    assert topo.open_edges == sum(1 for c in count.values() if c == 1)
+    assert topo.nonmanifold_edges == sum(1 for c in count.values() if c > 2)
+    assert topo.unbalanced_edges == sum(1 for e, c in count.items() if 2 * forward[e] != c)
+    pairs = {e for e, c in count.items() if c == 2}
+    assert len(topo.edge_faces) == len(pairs)
+    assert int(np.count_nonzero(topo.edge_same_direction)) == sum(1 for e in pairs if forward[e] != 1)
