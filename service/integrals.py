@@ -56,7 +56,6 @@ class Sums:
 
 
 IJ = ((0, 0), (1, 1), (2, 2), (0, 1), (0, 2), (1, 2))  # the rows of a symmetric 3 x 3 tensor's six entries
-_IJ = IJ
 # rows of a block's sums: m0, m1 (x y z), m2 (xx yy zz xy xz yz), det noise, error scale of xx yy zz
 ROWS = 15
 _NOISE, _ERR, _MEASURE = 10, 11, 14
@@ -146,7 +145,7 @@ def _block_sums(
     f2_dm = f2 * dm
     # an element's diagonal term f2 dm acc errs by ~eps (|f2 dm| + f2 noise) acc: acc >= 0 is exact to a few eps
     err_factor = f2 * (np.abs(dm) + noise)
-    for row, (i, j) in enumerate(_IJ, start=4):
+    for row, (i, j) in enumerate(IJ, start=4):
         acc = s[i] * s[j]
         for c in corners:
             acc += c[i] * c[j]
@@ -188,7 +187,7 @@ def sums_from_rows(total: NDArray[np.float64], total_abs: NDArray[np.float64], n
     """``Sums`` from its ``ROWS`` rows of totals and of absolute totals, over ``n`` terms in ``blocks`` blocks."""
     m2 = np.empty((3, 3))
     a2 = np.empty((3, 3))
-    for row, (i, j) in enumerate(_IJ, start=4):
+    for row, (i, j) in enumerate(IJ, start=4):
         m2[i, j] = m2[j, i] = total[row]
         a2[i, j] = a2[j, i] = total_abs[row]
     return Sums(
@@ -208,7 +207,7 @@ def sums_from_rows(total: NDArray[np.float64], total_abs: NDArray[np.float64], n
 def point_sums(masses: NDArray[np.float64], x: NDArray[np.float64]) -> Sums:
     m1 = (masses[:, None] * x).sum(axis=0)
     m2 = np.empty((3, 3))
-    for i, j in _IJ:
+    for i, j in IJ:
         m2[i, j] = m2[j, i] = float((masses * x[:, i] * x[:, j]).sum())
     diag_scale = np.array([float((masses * x[:, i] ** 2).sum()) for i in range(3)])
     return Sums(float(masses.sum()), m1, m2, float(masses.sum()), np.abs(m2), 0.0, diag_scale, float(len(masses)), len(masses), 1)

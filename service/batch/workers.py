@@ -68,8 +68,7 @@ def start_forkserver(preload: list[str] | None = None) -> bool:
     from multiprocessing import forkserver
 
     multiprocessing.get_context("forkserver").set_forkserver_preload(WORKER_PRELOAD if preload is None else preload)
-    added = [k for k in WORKER_THREAD_LIMITS if k not in os.environ]
-    os.environ.update(dict.fromkeys(added, "1"))  # the forkserver inherits this environment
+    added = limit_numeric_threads()  # the forkserver inherits this environment
     try:
         forkserver.ensure_running()
     finally:

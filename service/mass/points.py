@@ -25,14 +25,12 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..ddouble import two_prod
-from ..integrals import Sums
+from ..integrals import IJ, Sums
 
 __all__ = ["SMALL_POINTS", "small_point_sums"]
 
 SMALL_POINTS = 16
 """Point sets up to this size are summed here (numpy wins above a few dozen points)."""
-
-_IJ = ((0, 0), (1, 1), (2, 2), (0, 1), (0, 2), (1, 2))  # as in ``integrals``
 
 
 def _pairwise(a: list[float]) -> float:
@@ -106,7 +104,7 @@ def small_point_sums(
         m1[1] += m * xi[1]
         m1[2] += m * xi[2]
     m2 = [[0.0] * 3 for _ in range(3)]
-    for i, j in _IJ:
+    for i, j in IJ:
         m2[i][j] = m2[j][i] = _pairwise([m * xi[i] * xi[j] for m, xi in zip(masses, x)])
     diag = [_pairwise([m * (xi[i] * xi[i]) for m, xi in zip(masses, x)]) for i in range(3)]
     total = _pairwise(masses)

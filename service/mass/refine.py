@@ -154,7 +154,7 @@ def _physical_moments(
 _RESOLUTION_REFUSE = 1.0
 """Refuse a surface whose volume or a moment could change by this fraction of itself when every
 stored coordinate moves by its resolution: the file does not determine the body."""
-_AREA_BLOCK = 1 << 16  # triangles per block of the surface area
+_BLOCK = 1 << 16  # points (the reach) or triangles (the area) per block of the resolution check
 _RESOLUTION_WARN = 1e-3
 """Warn (naming the resolution) above this fraction: the stored polyhedron is computed exactly,
 but it may differ that much from the part it was exported from."""
@@ -175,26 +175,26 @@ def _check_resolution(
     x = geometry.points
     delta = geometry.coordinate_eps * float(np.abs(x).max())
     y = np.empty_like(x)
-    rows = range(0, len(x), _AREA_BLOCK)
+    rows = range(0, len(x), _BLOCK)
     reach_rows = np.empty((len(rows), 3))
 
     def reach_block(start: int) -> None:
         # row by row, as on the whole array: y, its principal-frame coordinates (columns of rotation are
         # the axes), and each point's largest squared distance from each axis
-        block = np.subtract(x[start : start + _AREA_BLOCK], com, out=y[start : start + _AREA_BLOCK])
+        block = np.subtract(x[start : start + _BLOCK], com, out=y[start : start + _BLOCK])
         along = block @ rotation
         sq = along * along
         total = sq.sum(axis=1)  # once, not once per axis
-        reach_rows[start // _AREA_BLOCK] = [np.max(total - sq[:, k]) for k in range(3)]
+        reach_rows[start // _BLOCK] = [np.max(total - sq[:, k]) for k in range(3)]
 
     for_each_block(reach_block, rows)
     reach = reach_rows.max(axis=0)
     records = point_records(y)  # one gather of 24 bytes per corner, not numpy's slower 2-D fancy indexing
-    starts = range(0, len(geometry.cells), _AREA_BLOCK)
+    starts = range(0, len(geometry.cells), _BLOCK)
     block_area = np.empty(len(starts))
 
     def block(start: int) -> None:  # rows of np.cross + np.linalg.norm's rounding, per block
-        block_area[start // _AREA_BLOCK] = twice_areas(records, geometry.cells[start : start + _AREA_BLOCK]).sum()
+        block_area[start // _BLOCK] = twice_areas(records, geometry.cells[start : start + _BLOCK]).sum()
 
     for_each_block(block, starts)
     area = 0.0
