@@ -244,3 +244,19 @@ def test_edge_counts_in_blocks_match_a_count_of_every_edge(threads: object, n_th
     pairs = {e for e, c in count.items() if c == 2}
     assert len(topo.edge_faces) == len(pairs)
     assert int(np.count_nonzero(topo.edge_same_direction)) == sum(1 for e in pairs if forward[e] != 1)
+
+
+def test_binary_stl_that_fails_to_read_is_refused_with_the_reason(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    import errno
+
+    from inertia.errors import UnreadableFileError
+    from inertia.load import stl
+
+    path, data = _stl_file(tmp_path)
+
+    def failing(fd: int, n: int, at: int) -> bytes:
+        raise OSError(errno.EIO, os.strerror(errno.EIO))
+
+    monkeypatch.setattr(os, "pread", failing)
+    with path.open("rb") as fh, pytest.raises(UnreadableFileError, match="could not be read: Input/output error"):
+        stl.read_stl_file(fh, len(data))

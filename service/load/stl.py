@@ -64,9 +64,12 @@ def read_stl_file(fh: BinaryIO, size: int) -> tuple[NDArray[np.float64], NDArray
 
             def read_block(start: int) -> None:
                 n = min(_READ_BLOCK, count - start)
-                raw = os.pread(fd, 50 * n, 84 + 50 * start)
+                raw = b""
                 while len(raw) < 50 * n:  # pread may return less; at the end of the file it returns nothing
-                    more = os.pread(fd, 50 * n - len(raw), 84 + 50 * start + len(raw))
+                    try:
+                        more = os.pread(fd, 50 * n - len(raw), 84 + 50 * start + len(raw))
+                    except OSError as exc:
+                        raise UnreadableFileError(f"the STL file could not be read: {exc.strerror}") from exc
                     if not more:
                         raise UnreadableFileError("the STL file ended before its last triangle; it may be truncated")
                     raw += more
