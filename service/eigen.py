@@ -30,20 +30,24 @@ def jacobi_eigh(
 
     Cyclic Jacobi with the rotation formulas of Rutishauser (Numer. Math. 9,
     1966): t = sgn(theta) / (|theta| + sqrt(theta^2 + 1)), which keeps |angle|
-    <= pi/4 so that nearly diagonal input is barely rotated.
+    <= pi/4 so that nearly diagonal input is barely rotated, and the updates
+    a_pp - t a_pq, a_qq + t a_pq, which change a diagonal entry by exactly the
+    amount the rotation moves between the two.
     """
-    a = np.array(matrix, dtype=np.float64)
-    a = 0.5 * (a + a.T)
+    m = np.asarray(matrix, dtype=np.float64).tolist()
+    # Python floats: the same IEEE binary64 operations as numpy's, without its overhead per call on a 3x3
+    a = [[0.5 * (m[i][j] + m[j][i]) for j in range(3)] for i in range(3)]
     exponent = _safe_exponent(a)
     if exponent:
-        a = np.ldexp(a, -exponent)
-    v = np.eye(3)
+        a = [[math.ldexp(x, -exponent) for x in row] for row in a]
+    v = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]
     for _ in range(tolerances.jacobi_max_sweeps):
         if _off_diagonal_negligible(a, tolerances.jacobi_rel):
             break
         for p, q in _PAIRS:
             _rotate(a, v, p, q)
-    return np.ldexp(np.diag(a), exponent), v.T.copy()
+    values = [math.ldexp(a[i][i], exponent) for i in range(3)]
+    return np.array(values), np.array(v).T.copy()
 
 
 # The negligibility test multiplies two diagonal entries: entries beyond 2**±480 would overflow to inf (every
@@ -52,38 +56,43 @@ def jacobi_eigh(
 _EXPONENT_RANGE = 480
 
 
-def _safe_exponent(a: NDArray[np.float64]) -> int:
-    largest = float(np.max(np.abs(a)))
+def _safe_exponent(a: list[list[float]]) -> int:
+    largest = max(map(abs, a[0] + a[1] + a[2]))
     if largest == 0.0 or not math.isfinite(largest):
         return 0
     exponent = math.frexp(largest)[1]
     return exponent if abs(exponent) > _EXPONENT_RANGE else 0
 
 
-def _off_diagonal_negligible(a: NDArray[np.float64], rel: float) -> bool:
-    t = a.tolist()  # Python floats: the same IEEE products and correctly rounded sqrt, without numpy's scalar overhead
+def _off_diagonal_negligible(a: list[list[float]], rel: float) -> bool:
     for p, q in _PAIRS:
-        scale = math.sqrt(abs(t[p][p] * t[q][q]))
-        if abs(t[p][q]) > rel * scale and t[p][q] != 0.0:
+        scale = math.sqrt(abs(a[p][p] * a[q][q]))
+        if abs(a[p][q]) > rel * scale and a[p][q] != 0.0:
             return False
     return True
 
 
-def _rotate(a: NDArray[np.float64], v: NDArray[np.float64], p: int, q: int) -> None:
-    apq = float(a[p, q])
+def _rotate(a: list[list[float]], v: list[list[float]], p: int, q: int) -> None:
+    """One rotation in the (p, q) plane: a <- R^T a R and v <- v R, R = [[c, s], [-s, c]] in rows and
+    columns p, q, chosen so that the new a[p][q] is zero."""
+    apq = a[p][q]
     if apq == 0.0:
         return
-    # Python floats, the same IEEE arithmetic as numpy's scalars: where a[p, q] is negligible theta * theta
-    # overflows and t goes to 0 as it should, without numpy's overflow warning
-    theta = (float(a[q, q]) - float(a[p, p])) / (2.0 * apq)
+    # where a[p][q] is negligible theta * theta overflows to inf (Python floats raise no warning for it)
+    # and t goes to 0 as it should
+    theta = (a[q][q] - a[p][p]) / (2.0 * apq)
     t = math.copysign(1.0, theta) / (abs(theta) + math.sqrt(theta * theta + 1.0))
     c = 1.0 / math.sqrt(t * t + 1.0)
     s = t * c
-    rot = np.eye(3)
-    rot[p, p] = c
-    rot[q, q] = c
-    rot[p, q] = s
-    rot[q, p] = -s
-    a[:] = rot.T @ a @ rot
-    a[p, q] = a[q, p] = 0.0
-    v[:] = v @ rot
+    tau = s / (1.0 + c)  # c = 1 - s tau: the off-plane updates below add a small correction to each entry
+    a[p][p] -= t * apq
+    a[q][q] += t * apq
+    a[p][q] = a[q][p] = 0.0
+    r = 3 - p - q  # the third index
+    arp, arq = a[r][p], a[r][q]
+    a[r][p] = a[p][r] = arp - s * (arq + tau * arp)
+    a[r][q] = a[q][r] = arq + s * (arp - tau * arq)
+    for row in v:
+        vp, vq = row[p], row[q]
+        row[p] = vp - s * (vq + tau * vp)
+        row[q] = vq + s * (vp - tau * vq)
