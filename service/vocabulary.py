@@ -9,6 +9,7 @@ No numpy here: the command line builds its parser from these before anything hea
 from __future__ import annotations
 
 import enum
+import functools
 
 __all__ = [
     "MotionMethod",
@@ -117,6 +118,7 @@ class RotorShape(enum.StrEnum):
     OBLATE = "oblate"
 
 
+@functools.cache  # a closed set never changes; options are checked against these on every request
 def values(members: type[enum.Enum]) -> tuple[str, ...]:
     """The strings of a closed set, in its order (the CLI's choices, the schema's enum)."""
     return tuple(str(m.value) for m in members)

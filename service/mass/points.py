@@ -98,6 +98,42 @@ def small_point_sums(
     """``integrals.point_sums`` of the points about ``origin`` in the frame ``rotation``; None if not finite."""
     o = origin.tolist()
     x = _shifted(points, o) if rotation is None else _rotated(points, o, rotation.tolist())
+    if len(masses) < 8:  # numpy's pairwise sum is then a plain one from 0.0: every sum in one loop
+        m1, m2, diag, total = _short_sums(masses, x)
+    else:
+        m1, m2, diag, total = _long_sums(masses, x)
+    if not all(math.isfinite(v) for v in (*m1, *m2[0], *m2[1], *m2[2], *diag, total)):
+        return None
+    m2_array = np.array(m2)
+    n = len(masses)
+    return Sums(total, np.array(m1), m2_array, total, np.abs(m2_array), 0.0, np.array(diag), float(n), n, 1)
+
+
+_Moments = tuple[list[float], list[list[float]], list[float], float]
+
+
+def _short_sums(masses: list[float], x: list[list[float]]) -> _Moments:
+    """The sums of fewer than eight points, each accumulated in point order from 0.0 (``_pairwise``)."""
+    a0 = a1 = a2 = s00 = s11 = s22 = s01 = s02 = s12 = d0 = d1 = d2 = total = 0.0
+    for m, (x0, x1, x2) in zip(masses, x):
+        mx0, mx1, mx2 = m * x0, m * x1, m * x2
+        a0 += mx0
+        a1 += mx1
+        a2 += mx2
+        s00 += mx0 * x0
+        s11 += mx1 * x1
+        s22 += mx2 * x2
+        s01 += mx0 * x1
+        s02 += mx0 * x2
+        s12 += mx1 * x2
+        d0 += m * (x0 * x0)
+        d1 += m * (x1 * x1)
+        d2 += m * (x2 * x2)
+        total += m
+    return [a0, a1, a2], [[s00, s01, s02], [s01, s11, s12], [s02, s12, s22]], [d0, d1, d2], total
+
+
+def _long_sums(masses: list[float], x: list[list[float]]) -> _Moments:
     m1 = [0.0, 0.0, 0.0]
     for m, xi in zip(masses, x):
         m1[0] += m * xi[0]
@@ -107,9 +143,4 @@ def small_point_sums(
     for i, j in IJ:
         m2[i][j] = m2[j][i] = _pairwise([m * xi[i] * xi[j] for m, xi in zip(masses, x)])
     diag = [_pairwise([m * (xi[i] * xi[i]) for m, xi in zip(masses, x)]) for i in range(3)]
-    total = _pairwise(masses)
-    if not all(math.isfinite(v) for v in (*m1, *m2[0], *m2[1], *m2[2], *diag, total)):
-        return None
-    m2_array = np.array(m2)
-    n = len(masses)
-    return Sums(total, np.array(m1), m2_array, total, np.abs(m2_array), 0.0, np.array(diag), float(n), n, 1)
+    return m1, m2, diag, _pairwise(masses)
