@@ -184,6 +184,40 @@ def test_3mf_mirroring_transform_keeps_the_part_outward() -> None:
     assert not any("winding" in w for w in doc["warnings"])
 
 
+def test_3mf_rotation_written_to_six_digits_is_placed_as_that_rotation() -> None:
+    # a turn of 72 degrees about z as CAD exporters write it: cos 0.309017, sin 0.951057, so that the
+    # determinant is 0.309017**2 + 0.951057**2 = 1.000000923538 (exact in decimal); the box is 1 x 2 x 3
+    c, s = "0.309017", "0.951057"
+    data = package(
+        model(
+            f'<object id="2" type="model">{mesh_xml(*box(1.0, 2.0, 3.0))}</object>'
+            f'<object id="1" type="model"><components><component objectid="2" '
+            f'transform="{c} {s} 0 -{s} {c} 0 0 0 1 10 0 0"/></components></object>',
+            '<item objectid="1"/>',
+        )
+    )
+    doc = analyze(data, filename="r.3mf", options=AnalysisOptions(units="m", density=1.0)).as_dict()
+    # placed rigidly: the box's own volume and moments (as written it would be 6 x 1.000000923538)
+    assert doc["mass"] == pytest.approx(6.0, rel=1e-14)
+    moments = sorted(doc["principal"]["moments"])
+    np.testing.assert_allclose(moments, [6 * (1 + 4) / 12, 6 * (1 + 9) / 12, 6 * (4 + 9) / 12], rtol=1e-13)
+    notes = [w for w in doc["warnings"] if "rotations written to few digits" in w]
+    assert len(notes) == 1 and "9.2e-07" in notes[0] and "1.00000092" in notes[0]
+
+
+def test_3mf_real_scale_is_applied_as_written() -> None:
+    # a uniform scale of 1.001 is 2e-3 from orthonormal: a scale, not a rounded rotation
+    data = package(
+        model(
+            f'<object id="1" type="model">{mesh_xml(*box(1.0, 2.0, 3.0))}</object>',
+            '<item objectid="1" transform="1.001 0 0 0 1.001 0 0 0 1.001 0 0 0"/>',
+        )
+    )
+    doc = analyze(data, filename="s.3mf", options=AnalysisOptions(units="m", density=1.0)).as_dict()
+    assert doc["mass"] == pytest.approx(6.0 * 1.001**3, rel=1e-14)
+    assert not any("rotations written" in w for w in doc["warnings"])
+
+
 @pytest.mark.parametrize(
     "resources, build, words",
     [

@@ -36,7 +36,8 @@ What is checked, with the specification's chapter:
 - Build (ch. 3.4): items name existing objects, never of type ``other``;
   transforms are 12 finite numbers with a non-zero determinant.  A mirroring
   transform (negative determinant) reverses the triangles' winding so a part
-  stays wound outward.
+  stays wound outward.  A placement within 1e-5 of a rotation is that rotation
+  written to few digits and is placed by it, with a warning (``_ROTATION_DIGITS``).
 
 Paths are only ever looked up inside the zip: nothing on disk or the network
 is opened.
@@ -228,7 +229,10 @@ class _Reader:
                     "(only objects of type 'model' are the part)"
                 )
                 continue
-            pieces = list(self.meshes(path, obj, transform, 0))
+            placed: list[tuple[float, float]] = []  # rotations written to few digits, taken as rotations
+            pieces = list(self.meshes(path, obj, transform, 0, placed))
+            if placed:
+                notes.append(_rotation_note(name, placed))
             if not pieces:
                 raise EmptyGeometryError(f"the 3MF object {name!r} holds no triangles", format="3mf")
             verts = [v for v, _ in pieces]
@@ -245,17 +249,50 @@ class _Reader:
         return ThreeMF(parts, root.unit, notes)
 
     def meshes(
-        self, path: str, obj: _Object, transform: NDArray[np.float64], depth: int
+        self, path: str, obj: _Object, transform: NDArray[np.float64], depth: int, placed: list[tuple[float, float]]
     ) -> Iterator[tuple[NDArray[np.float64], NDArray[np.int64]]]:
+        """Each mesh under ``obj`` in build coordinates; ``placed`` collects (departure, determinant) of
+        each placement taken as the rotation its digits round."""
         if depth > _MAX_DEPTH:
             raise _invalid("components nest more than 32 deep (a cycle?)", "chapter 4.2")
         if obj.vertices is not None and obj.triangles is not None:
-            v = obj.vertices @ transform[:3, :3].T + transform[:3, 3]
-            f = obj.triangles if np.linalg.det(transform[:3, :3]) > 0 else obj.triangles[:, [0, 2, 1]]
+            m, off = _rigid(transform[:3, :3])
+            if off:
+                placed.append((off, float(np.linalg.det(transform[:3, :3]))))
+            v = obj.vertices @ m.T + transform[:3, 3]
+            f = obj.triangles if np.linalg.det(m) > 0 else obj.triangles[:, [0, 2, 1]]
             yield v, f
         for sub_path, sub_id, sub_transform in obj.components:
             sub = self.object(sub_path or path, sub_id, f"a component of object {obj.id}")
-            yield from self.meshes(sub_path or path, sub, transform @ sub_transform, depth + 1)
+            yield from self.meshes(sub_path or path, sub, transform @ sub_transform, depth + 1, placed)
+
+
+_ROTATION_DIGITS = 1e-5
+"""A placement whose 3x3 part is within this of orthonormal (largest entry of M M^T - I) is a rotation written
+to a few digits: CAD exporters write 0.309017 0.951057 for a turn of 72 degrees, whose determinant is
+1.0000009.  It is placed by the nearest rotation (the polar factor U V^T of its SVD), as the exporter meant and
+as trimesh's scene graph reads it (``repair_rigid``, the same threshold); a placement further off is a real
+scale or shear and is applied as written."""
+
+
+def _rigid(m: NDArray[np.float64]) -> tuple[NDArray[np.float64], float]:
+    """The nearest rotation (or mirror) to ``m`` and how far ``m`` was from it, where ``m`` is a rotation written
+    to few digits; else ``m`` itself and 0."""
+    off = float(np.abs(m @ m.T - np.eye(3)).max())
+    if not 1e-13 < off < _ROTATION_DIGITS:
+        return m, 0.0
+    u, _, vt = np.linalg.svd(m)
+    return u @ vt, off
+
+
+def _rotation_note(name: str, placed: list[tuple[float, float]]) -> str:
+    off = max(o for o, _ in placed)
+    scale = max((d for _, d in placed), key=lambda d: abs(abs(d) - 1.0))
+    return (
+        f"3MF object {name!r}: {len(placed)} placement(s) are rotations written to few digits (up to {off:.2g} from "
+        f"orthonormal); each was placed by the nearest rotation, as its exporter meant (as written, the digits "
+        f"would also scale a piece's volume by up to {abs(scale):.9g})"
+    )
 
 
 def _absolute(target: str, base: str) -> str:
