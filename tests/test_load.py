@@ -263,3 +263,20 @@ def test_assembly_far_from_the_origin_keeps_every_moment() -> None:
     errors = np.abs(np.array(doc["principal"]["moments"]) - exact) / np.array(exact)
     assert doc["diagnostics"]["relative_error_estimate"] <= 1e-12
     assert np.all(errors <= doc["diagnostics"]["relative_error_estimate"])
+
+
+_LFS = (
+    b"version https://git-lfs.github.com/spec/v1\n"
+    b"oid sha256:4d7a214614ab2935c943f9e0ff69d22eadbb8f32b1258daaa5e2ca24d17e2393\nsize 12345\n"
+)
+
+
+@pytest.mark.parametrize("name", ["part.stl", "grid.vtk", "model.3mf", "mesh.msh", "m.obj"])
+def test_a_git_lfs_pointer_is_named_as_one(name: str, tmp_path: Path) -> None:
+    # what a clone without git-lfs holds in place of the file: named as such, whatever the format says
+    with pytest.raises(UnreadableFileError, match="Git LFS pointer"):
+        analyze(_LFS, filename=name)
+    path = tmp_path / name
+    path.write_bytes(_LFS)
+    with pytest.raises(UnreadableFileError, match="git lfs pull"):
+        analyze(str(path))

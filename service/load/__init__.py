@@ -105,6 +105,7 @@ def _load_path(path: str, filename: str, format: str | None, units: str | None, 
         raise UnreadableFileError(f"cannot open {path!r}: {exc.strerror}") from exc
     with fh:
         head = fh.read(512)
+        _refuse_lfs_pointer(head, filename)
         fmt = sniff_format(filename, format, head) if head else None
         if fmt != "stl":
             fh.seek(0)
@@ -119,6 +120,20 @@ def _load_path(path: str, filename: str, format: str | None, units: str | None, 
     return Loaded(parts, filename, "stl", SourceKind.MESH, units or "m", UnitsFrom.REQUEST if units else UnitsFrom.DEFAULT)
 
 
+_LFS_POINTER = b"version https://git-lfs.github.com/spec/"
+
+
+def _refuse_lfs_pointer(head: bytes, filename: str | None) -> None:
+    """A Git LFS pointer (what a clone without git-lfs holds in place of a large file) is named as such."""
+    if head.startswith(_LFS_POINTER):
+        raise UnreadableFileError(
+            "the file is a Git LFS pointer (a few lines naming the real file's hash), not the mesh itself: "
+            "the repository it came from stores the file with Git LFS; fetch it (git lfs pull) and send that",
+            filename=filename,
+            reason="git-lfs pointer",
+        )
+
+
 def _load_bytes(
     data: bytes,
     filename: str | None,
@@ -129,6 +144,7 @@ def _load_bytes(
 ) -> Loaded:
     if not len(data):
         raise EmptyGeometryError("the file is empty; send a mesh with geometry", filename=filename)
+    _refuse_lfs_pointer(bytes(data[:64]), filename)
     fmt = sniff_format(filename, format, bytes(data[:512]))
     # includes, external references, inflation bounds: before any reader
     check_upload(data, fmt, companions=tuple(companions or ()))
