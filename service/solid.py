@@ -122,6 +122,11 @@ def _orient_outward(
         if total < 0:
             return faces[:, [0, 2, 1]], ["inverted winding corrected (all faces pointed inward)"]
         return faces, []
+    if bool(np.all((vol > 0) | flat)):
+        # every shell encloses positive volume as the file winds it: the file says each is a solid (one inside
+        # another is a second body there, not a cavity), as when all its faces see the local origin from outside;
+        # nesting decides only where the file's windings disagree with each other
+        return faces, []
     depth = _nesting_depth(vertices - local_origin(vertices), faces, label, count)  # formed again: not held above
     if isinstance(depth, str):  # nesting undecidable: keep the file's orientation
         if total < 0 and np.all(vol <= 0):

@@ -132,6 +132,18 @@ def test_a_shell_inside_another_without_a_bounding_box_hint_is_a_cavity() -> Non
     assert any("winding corrected" in w for w in fixed.warnings)
 
 
+@pytest.mark.parametrize("centre", [(0.0, 0.0, 0.0), (1.2, 0.9, -1.1)])
+def test_shells_all_wound_outward_are_each_a_solid_wherever_they_lie(centre: tuple[float, float, float]) -> None:
+    # the file says two solids (both wound outward); whether the box's middle lies inside the sphere or not (the
+    # local origin, which once decided between keeping the winding and re-winding the sphere as a cavity) must
+    # not change that: trimesh, VTK's vtkMassProperties and the stored winding all give box + sphere
+    bv, bf = box(4.0, 4.0, 4.0, origin=(-2.0, -2.0, -2.0))
+    sv, sf = sphere_shell(0.5, centre)
+    props = mass_properties(MeshBody(np.vstack([bv, sv]), np.vstack([bf, sf + 8])), density=1.0)
+    assert props.mass == pytest.approx(64 + float(exact_solid(sv, sf)[0]), rel=1e-14)
+    assert not any("winding corrected" in w for w in props.warnings)
+
+
 def test_zero_stored_volume_is_never_turned_into_a_body() -> None:
     # one box stored twice, the copy inverted and coincident: the stored polyhedron encloses nothing
     v, f = box(1.0, 2.0, 3.0)
