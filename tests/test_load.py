@@ -280,3 +280,22 @@ def test_a_git_lfs_pointer_is_named_as_one(name: str, tmp_path: Path) -> None:
     path.write_bytes(_LFS)
     with pytest.raises(UnreadableFileError, match="git lfs pull"):
         analyze(str(path))
+
+
+_XDMF = b"""<?xml version="1.0"?>
+<Xdmf Version="3.0"><Domain><Grid Name="g" GridType="Uniform">
+<Topology TopologyType="Tetrahedron" NumberOfElements="1"><DataItem Dimensions="1 4" NumberType="Int" Format="XML">0 1 2 3
+</DataItem></Topology>
+<Geometry GeometryType="XYZ"><DataItem Dimensions="4 3" Format="XML">0 0 0 1 0 0 0 1 0 0 0 1</DataItem></Geometry>
+</Grid></Domain></Xdmf>
+"""
+
+
+def test_xdmf_without_h5py_names_the_extra_or_is_read() -> None:
+    import importlib.util
+
+    if importlib.util.find_spec("h5py") is not None:  # with the 'hdf5' extra: the unit corner tetrahedron
+        assert analyze(_XDMF, filename="t.xdmf", options=AnalysisOptions(units="m", density=1.0)).props.mass == pytest.approx(1 / 6)
+        return
+    with pytest.raises(UnsupportedFormatError, match=r"inertia-service\[hdf5\]"):
+        analyze(_XDMF, filename="t.xdmf")

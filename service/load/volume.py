@@ -626,6 +626,15 @@ def _read_meshio(data: bytes, fmt: str, label: str, filename: str | None, compan
             mesh = meshio.read(path, file_format=VOLUME_FORMATS[fmt])
         except KeyboardInterrupt:
             raise
+        except ImportError as exc:  # meshio imports h5py for XDMF and MED only when such a file is read
+            if exc.name != "h5py":
+                raise
+            raise UnsupportedFormatError(
+                f"reading {label} needs h5py (HDF5), the optional extra 'hdf5': install it with "
+                "pip install 'inertia-service[hdf5]', or convert the mesh to Gmsh (.msh) or VTK (.vtu)",
+                format=fmt,
+                extra="hdf5",
+            ) from exc
         except BaseException as exc:  # meshio calls sys.exit(1) and raises KeyError, ValueError, ...
             raise UnreadableFileError(_meshio_failure(exc, printed.getvalue(), path, fmt, label, companions), format=fmt) from exc
     out = _mesh_from_meshio(mesh, label)
