@@ -13,6 +13,7 @@ import trimesh
 
 from benchmarks.cases import box
 from inertia.errors import EmptyGeometryError, UnreadableFileError, UnsupportedFormatError
+from inertia.load import load_body
 from inertia.mass import parallel_axis
 from inertia.pipeline import AnalysisOptions, analyze
 
@@ -282,6 +283,17 @@ def test_a_git_lfs_pointer_is_named_as_one(name: str, tmp_path: Path) -> None:
         analyze(str(path))
 
 
+def test_a_git_lfs_pointer_as_a_zip_or_a_companion_is_named_as_one(tmp_path: Path) -> None:
+    with pytest.raises(UnreadableFileError, match="Git LFS pointer"):
+        analyze(_LFS, filename="meshes.zip")
+    (tmp_path / "meshes.zip").write_bytes(_LFS)
+    with pytest.raises(UnreadableFileError, match="Git LFS pointer"):
+        analyze(str(tmp_path / "meshes.zip"))
+    gltf = b'{"asset": {"version": "2.0"}, "buffers": [{"uri": "model.bin", "byteLength": 12345}]}'
+    with pytest.raises(UnreadableFileError, match=r"Git LFS pointer"):
+        load_body([("model.gltf", gltf), ("model.bin", _LFS)])
+
+
 _XDMF = b"""<?xml version="1.0"?>
 <Xdmf Version="3.0"><Domain><Grid Name="g" GridType="Uniform">
 <Topology TopologyType="Tetrahedron" NumberOfElements="1"><DataItem Dimensions="1 4" NumberType="Int" Format="XML">0 1 2 3
@@ -298,4 +310,22 @@ def test_xdmf_without_h5py_names_the_extra_or_is_read() -> None:
         assert analyze(_XDMF, filename="t.xdmf", options=AnalysisOptions(units="m", density=1.0)).props.mass == pytest.approx(1 / 6)
         return
     with pytest.raises(UnsupportedFormatError, match=r"inertia-service\[hdf5\]"):
+        analyze(_XDMF, filename="t.xdmf")
+
+
+@pytest.mark.parametrize(
+    ("missing", "error", "words"),
+    [
+        ("h5py._errors", UnsupportedFormatError, "cannot be imported"),  # installed, its library broken
+        ("lzma", UnreadableFileError, "could not read"),  # any other import a reader makes: the file's failure
+    ],
+)
+def test_an_import_failure_inside_meshio_is_an_answer_not_a_crash(
+    missing: str, error: type[Exception], words: str, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    def broken(*args: Any, **kwargs: Any) -> None:
+        raise ImportError(f"No module named {missing!r}", name=missing)
+
+    monkeypatch.setattr(meshio, "read", broken)
+    with pytest.raises(error, match=words):
         analyze(_XDMF, filename="t.xdmf")

@@ -82,16 +82,20 @@ def load_body(
                     raw = fh.read()
             except OSError as exc:
                 raise UnreadableFileError(f"cannot open {path!r}: {exc.strerror}") from exc
+            _refuse_lfs_pointer(raw[:64], filename)
             return _load_files(unpack_zip(raw), inner_format, units, isotopes)
         return _load_path(path, filename, format, units, isotopes)
     data = source if isinstance(source, bytes) else bytes(source)  # bytearray, memoryview
     if (filename or "").lower().endswith(".zip") or zipped:
+        _refuse_lfs_pointer(data[:64], filename)
         return _load_files(unpack_zip(data), inner_format, units, isotopes)
     return _load_bytes(data, filename, format, units, isotopes)
 
 
 def _load_files(files: list[tuple[str, bytes]], format: str | None, units: str | None, isotopes: str = Isotopes.STANDARD) -> Loaded:
     """The model file of a multi-file upload, read with the others as its companions."""
+    for name, content in files:  # a companion (a glTF's .bin) left behind by git-lfs is named, not misread
+        _refuse_lfs_pointer(bytes(content[:64]), os.path.basename(name))
     main, companions = pick_model_file(files, format)
     data = dict(files)[main]
     return _load_bytes(bytes(data), os.path.basename(main), format, units, isotopes, companions)

@@ -626,16 +626,9 @@ def _read_meshio(data: bytes, fmt: str, label: str, filename: str | None, compan
             mesh = meshio.read(path, file_format=VOLUME_FORMATS[fmt])
         except KeyboardInterrupt:
             raise
-        except ImportError as exc:  # meshio imports h5py for XDMF and MED only when such a file is read
-            if exc.name != "h5py":
-                raise
-            raise UnsupportedFormatError(
-                f"reading {label} needs h5py (HDF5), the optional extra 'hdf5': install it with "
-                "pip install 'inertia-service[hdf5]', or convert the mesh to Gmsh (.msh) or VTK (.vtu)",
-                format=fmt,
-                extra="hdf5",
-            ) from exc
         except BaseException as exc:  # meshio calls sys.exit(1) and raises KeyError, ValueError, ...
+            if isinstance(exc, ImportError) and (exc.name or "").partition(".")[0] == "h5py":
+                raise _hdf5_missing(label, fmt, exc) from exc
             raise UnreadableFileError(_meshio_failure(exc, printed.getvalue(), path, fmt, label, companions), format=fmt) from exc
     out = _mesh_from_meshio(mesh, label)
     if fmt == "inp" and out.blocks and out.other:  # Abaqus shells, beams, trusses have mass through their sections
@@ -645,6 +638,17 @@ def _read_meshio(data: bytes, fmt: str, label: str, filename: str | None, compan
             "section properties; they were not weighed: the result is the solid elements alone"
         )
     return out
+
+
+def _hdf5_missing(label: str, fmt: str, exc: ImportError) -> UnsupportedFormatError:
+    """meshio imports h5py for XDMF and MED only when such a file is read: absent, or installed but broken."""
+    state = "is not installed" if exc.name == "h5py" else f"cannot be imported here ({exc})"
+    return UnsupportedFormatError(
+        f"reading {label} needs h5py (HDF5), which {state}: install the optional extra 'hdf5' with "
+        "pip install 'inertia-service[hdf5]', or convert the mesh to Gmsh (.msh) or VTK (.vtu)",
+        format=fmt,
+        extra="hdf5",
+    )
 
 
 # Abaqus solid elements by node count: C3D<n> with any suffix (R reduced, H hybrid, I incompatible modes,
