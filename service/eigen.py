@@ -35,8 +35,10 @@ def jacobi_eigh(
     amount the rotation moves between the two.
     """
     m = np.asarray(matrix, dtype=np.float64).tolist()
-    # Python floats: the same IEEE binary64 operations as numpy's, without its overhead per call on a 3x3
-    a = [[0.5 * (m[i][j] + m[j][i]) for j in range(3)] for i in range(3)]
+    # Python floats: the same IEEE binary64 operations as numpy's, without its overhead per call on a 3x3.
+    # Symmetrised without overflow: an entry equal to its mirror stays itself (even above 9e307, where x + x
+    # is inf); otherwise 0.5 x + 0.5 y is the rounded mean, as 0.5 (x + y) is wherever that does not overflow
+    a = [[_mean(m[i][j], m[j][i]) for j in range(3)] for i in range(3)]
     exponent = _safe_exponent(a)
     if exponent:
         a = [[math.ldexp(x, -exponent) for x in row] for row in a]
@@ -56,9 +58,16 @@ def jacobi_eigh(
 _EXPONENT_RANGE = 480
 
 
+def _mean(x: float, y: float) -> float:
+    return x if x == y else 0.5 * x + 0.5 * y
+
+
 def _safe_exponent(a: list[list[float]]) -> int:
-    largest = max(map(abs, a[0] + a[1] + a[2]))
-    if largest == 0.0 or not math.isfinite(largest):
+    entries = a[0] + a[1] + a[2]
+    if not all(map(math.isfinite, entries)):  # NaN or inf: nothing to rescale (max would skip a NaN)
+        return 0
+    largest = max(map(abs, entries))
+    if largest == 0.0:
         return 0
     exponent = math.frexp(largest)[1]
     return exponent if abs(exponent) > _EXPONENT_RANGE else 0

@@ -104,7 +104,7 @@ def _check_physical(moments: NDArray[np.float64], tolerance: float, rounding: fl
         raise InvalidParameterError(
             f"the tensor has a negative principal moment ({moments[0]:.6g} kg m^2); it is not an inertia tensor"
         )
-    if moments[0] + moments[1] < moments[2] * (1 - tolerance):
+    if 0.5 * float(moments[0]) + 0.5 * float(moments[1]) < 0.5 * float(moments[2]) * (1 - tolerance):  # halves: no overflow
         raise InvalidParameterError("principal moments break the triangle inequality I1 + I2 >= I3; no body has this tensor")
 
 

@@ -91,3 +91,16 @@ def test_mesh_whose_moments_underflow_is_refused_with_its_size(tmp_path: Path, s
     with pytest.raises(InvalidParameterError, match="underflow float64") as caught:
         analyze(str(path))
     assert f"{3.5 * size:.2g}"[:3] in str(caught.value)  # the part's size, in the message
+
+
+def test_a_tensor_near_the_top_of_float64_is_diagonalised_without_overflow() -> None:
+    # symmetrising (x + y) / 2 and the triangle inequality I1 + I2 >= I3 both summed entries near 1e308;
+    # the eigenvalues of a diagonal tensor are its diagonal, exactly, and no step may overflow on the way
+    import warnings
+
+    from inertia.principal import PrincipalFrame
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        frame = PrincipalFrame.from_tensor(np.diag([1e308, 1.5e308, 1.7e308]))
+    assert frame.moments.tolist() == [1e308, 1.5e308, 1.7e308]
