@@ -4,11 +4,18 @@ Never a silently wrong tensor: seams (one point written twice with different
 rounding) are merged first (``seams.merge_seams``), an open surface is refused
 (``not_watertight`` with the count of open edges and the part's name),
 inconsistent winding is repaired where the surface is orientable, and shells
-are oriented by nesting, each with a warning.
+whose windings disagree are oriented by nesting, each with a warning.
 
-Orientation by nesting.  A shell inside an odd number of other shells bounds
-a cavity and must wind inward; one inside an even number (zero included)
-bounds material and must wind outward.  Whether a shell is inside another is
+Shells all wound outward are each a solid: the file says so, as trimesh and
+VTK's vtkMassProperties read it, and a shell inside another then adds its
+material to the other's (a cavity wound outward by a tool that turned every
+shell outward counts as material; its file has to wind it inward).  Where
+that holds for every shell nothing is re-wound, wherever the shells lie.
+
+Orientation by nesting.  Where some shells enclose negative volume as wound,
+the file's orientation is unreliable.  A shell inside an odd number of other
+shells bounds a cavity and must wind inward; one inside an even number (zero
+included) bounds material and must wind outward.  Whether a shell is inside another is
 decided by the generalised winding number of the other shell at a point of
 the first (the solid angle it subtends, van Oosterom & Strackee, IEEE Trans.
 Biomed. Eng. 30(2), 1983), which is exact for closed shells and does not
@@ -104,7 +111,8 @@ def _signed_volumes(x: NDArray[np.float64], faces: NDArray[np.int64]) -> NDArray
 def _orient_outward(
     vertices: NDArray[np.float64], faces: NDArray[np.int64], topo: SurfaceTopology
 ) -> tuple[NDArray[np.int64], list[str]]:
-    """Orient every shell by its nesting depth: material outward, cavities inward."""
+    """Keep shells that all wind outward; otherwise orient every shell by its nesting depth: material outward,
+    cavities inward."""
     det = _signed_volumes(vertices - local_origin(vertices), faces)
     if np.all(det >= 0):  # every face sees the local origin from outside: outward already
         return faces, []

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import io
 import json
+import math
 import zipfile
 from collections.abc import Callable
 from pathlib import Path
@@ -184,15 +185,17 @@ def test_3mf_mirroring_transform_keeps_the_part_outward() -> None:
     assert not any("winding" in w for w in doc["warnings"])
 
 
-def test_3mf_rotation_written_to_six_digits_is_placed_as_that_rotation() -> None:
+@pytest.mark.parametrize("mirror", [False, True])
+def test_3mf_rotation_written_to_six_digits_is_placed_as_that_rotation(mirror: bool) -> None:
     # a turn of 72 degrees about z as CAD exporters write it: cos 0.309017, sin 0.951057, so that the
-    # determinant is 0.309017**2 + 0.951057**2 = 1.000000923538 (exact in decimal); the box is 1 x 2 x 3
-    c, s = "0.309017", "0.951057"
+    # determinant is +-(0.309017**2 + 0.951057**2) = +-1.000000923538 (exact in decimal); the box is 1 x 2 x 3
+    c, s = 0.309017, 0.951057
+    rows = f"{c} {s} 0 {s} -{c} 0" if mirror else f"{c} {s} 0 -{s} {c} 0"
     data = package(
         model(
             f'<object id="2" type="model">{mesh_xml(*box(1.0, 2.0, 3.0))}</object>'
             f'<object id="1" type="model"><components><component objectid="2" '
-            f'transform="{c} {s} 0 -{s} {c} 0 0 0 1 10 0 0"/></components></object>',
+            f'transform="{rows} 0 0 1 10 0 0"/></components></object>',
             '<item objectid="1"/>',
         )
     )
@@ -201,8 +204,14 @@ def test_3mf_rotation_written_to_six_digits_is_placed_as_that_rotation() -> None
     assert doc["mass"] == pytest.approx(6.0, rel=1e-14)
     moments = sorted(doc["principal"]["moments"])
     np.testing.assert_allclose(moments, [6 * (1 + 4) / 12, 6 * (1 + 9) / 12, 6 * (4 + 9) / 12], rtol=1e-13)
+    # the centre (0.5, 1, 1.5) of the box, carried by the rotation c/r, s/r (r = sqrt(c^2 + s^2)) as a row vector
+    r = math.hypot(c, s)
+    x, y = 0.5, 1.0
+    centre = [x * c / r + y * s / r, x * s / r - y * c / r] if mirror else [x * c / r - y * s / r, x * s / r + y * c / r]
+    np.testing.assert_allclose(doc["center_of_mass"], [10 + centre[0], centre[1], 1.5], rtol=1e-14, atol=1e-14)
     notes = [w for w in doc["warnings"] if "rotations written to few digits" in w]
     assert len(notes) == 1 and "9.2e-07" in notes[0] and "1.00000092" in notes[0]
+    assert not any("winding" in w for w in doc["warnings"])
 
 
 def test_3mf_real_scale_is_applied_as_written() -> None:

@@ -275,11 +275,15 @@ as trimesh's scene graph reads it (``repair_rigid``, the same threshold); a plac
 scale or shear and is applied as written."""
 
 
+_ORTHONORMAL = 1e-13
+"""Below this departure a matrix is a rotation to its own rounding (full-precision entries): left as written."""
+
+
 def _rigid(m: NDArray[np.float64]) -> tuple[NDArray[np.float64], float]:
     """The nearest rotation (or mirror) to ``m`` and how far ``m`` was from it, where ``m`` is a rotation written
     to few digits; else ``m`` itself and 0."""
     off = float(np.abs(m @ m.T - np.eye(3)).max())
-    if not 1e-13 < off < _ROTATION_DIGITS:
+    if not _ORTHONORMAL < off < _ROTATION_DIGITS:
         return m, 0.0
     u, _, vt = np.linalg.svd(m)
     return u @ vt, off
