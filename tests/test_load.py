@@ -329,3 +329,73 @@ def test_an_import_failure_inside_meshio_is_an_answer_not_a_crash(
     monkeypatch.setattr(meshio, "read", broken)
     with pytest.raises(error, match=words):
         analyze(_XDMF, filename="t.xdmf")
+
+
+# --- volume formats holding only a surface ------------------------------------------------------------
+
+_BOX_QUADS = [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]]  # outward
+
+
+def _polydata(keyword: str, cells: list[list[int]], sides: tuple[float, float, float]) -> bytes:
+    v, _ = box(*sides)
+    points = "\n".join(" ".join(repr(float(c)) for c in p) for p in v)
+    listed = "\n".join(f"{len(c)} " + " ".join(map(str, c)) for c in cells)
+    size = sum(len(c) + 1 for c in cells)
+    return (
+        f"# vtk DataFile Version 3.0\nbox\nASCII\nDATASET POLYDATA\nPOINTS 8 double\n{points}\n"
+        f"{keyword} {len(cells)} {size}\n{listed}\n"
+    ).encode()
+
+
+@pytest.mark.parametrize(
+    ("keyword", "cells"),
+    [
+        ("POLYGONS", _BOX_QUADS),
+        # a strip a b d c is the quad a b c d: triangles (a, b, d) and, turned as every odd one is, (d, b, c)
+        ("TRIANGLE_STRIPS", [[a, b, d, c] for a, b, c, d in _BOX_QUADS]),
+    ],
+)
+def test_a_closed_vtk_polydata_surface_is_weighed_as_a_solid(keyword: str, cells: list[list[int]]) -> None:
+    doc = analyze(_polydata(keyword, cells, (1.0, 2.0, 3.0)), filename="box.vtk", options=AnalysisOptions(density=1.0)).as_dict()
+    assert doc["mass"] == pytest.approx(6.0, rel=1e-15)
+    assert sorted(doc["principal"]["moments"]) == pytest.approx(BOX_MOMENTS_6, rel=1e-14)
+    assert doc["source"]["kind"] == "mesh" and doc["source"]["watertight"] is True
+    assert any("no 3-D cells" in w and "read as a triangle surface" in w for w in doc["warnings"])
+    assert not any("winding" in w for w in doc["warnings"])
+
+
+BOX_MOMENTS_6 = sorted([6 * (4 + 9) / 12, 6 * (1 + 9) / 12, 6 * (1 + 4) / 12])
+
+
+@pytest.mark.parametrize("fmt", ["vtu", "gmsh22"])
+def test_a_closed_triangle_surface_in_a_volume_format_is_weighed_as_a_solid(fmt: str, tmp_path: Path) -> None:
+    v, f = box(1.0, 2.0, 3.0)
+    name = "box.vtu" if fmt == "vtu" else "box.msh"
+    meshio.write(tmp_path / name, meshio.Mesh(v, [("triangle", f)]), file_format=fmt)
+    doc = analyze(str(tmp_path / name), options=AnalysisOptions(density=1.0)).as_dict()
+    assert doc["mass"] == pytest.approx(6.0, rel=1e-15)
+    assert sorted(doc["principal"]["moments"]) == pytest.approx(BOX_MOMENTS_6, rel=1e-14)
+
+
+def test_an_open_surface_in_a_volume_format_is_not_watertight_and_weighs_as_a_shell() -> None:
+    from inertia.errors import NotWatertightError
+
+    data = _polydata("POLYGONS", _BOX_QUADS[1:], (1.0, 2.0, 3.0))  # the bottom left open
+    with pytest.raises(NotWatertightError):
+        analyze(data, filename="open.vtk")
+    shell = analyze(data, filename="open.vtk", options=AnalysisOptions(model="shell", thickness=0.01, density=1.0)).as_dict()
+    assert shell["mass"] == pytest.approx((1 * 2 + 2 * 1 * 3 + 2 * 2 * 3) * 0.01, rel=1e-12)  # top, front/back, sides
+
+
+def test_vtk_pixels_closing_a_box_are_weighed_as_its_solid() -> None:
+    # a pixel lists its corners row by row (a b d c of the face a b c d): VTK's cell type 8
+    v, _ = box(1.0, 2.0, 3.0)
+    points = "\n".join(" ".join(repr(float(c)) for c in p) for p in v)
+    cells = "\n".join(f"4 {a} {b} {d} {c}" for a, b, c, d in _BOX_QUADS)
+    data = (
+        f"# vtk DataFile Version 3.0\nbox\nASCII\nDATASET UNSTRUCTURED_GRID\nPOINTS 8 double\n{points}\n"
+        f"CELLS 6 30\n{cells}\nCELL_TYPES 6\n" + "8\n" * 6
+    ).encode()
+    doc = analyze(data, filename="pixels.vtk", options=AnalysisOptions(density=1.0)).as_dict()
+    assert doc["mass"] == pytest.approx(6.0, rel=1e-15)
+    assert not any("winding" in w for w in doc["warnings"])

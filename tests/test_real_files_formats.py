@@ -13,7 +13,6 @@ from typing import Any
 
 import pytest
 
-from inertia.errors import EmptyGeometryError
 from inertia.load import load_body
 
 REAL = Path(__file__).resolve().parent / "data" / "real"
@@ -25,17 +24,22 @@ def test_avs_ucd_inp_is_read_as_avs_ucd_not_taken_for_abaqus(name: str) -> None:
 
     Read as Abaqus, the ASCII file was said to hold "no points" and the binary one
     failed on UTF-8 decoding; the file's own reader (VTK's vtkAVSucdReader) finds
-    its 12 surface cells, so the refusal must say there is no 3-D cell among them.
+    its 12 surface cells, which are read as a surface (8 triangles and 4 quads split
+    in two: 16 triangles) and refused as open.
     """
+    from inertia.errors import NotWatertightError
+    from inertia.pipeline import AnalysisOptions, analyze_loaded
+
     pytest.importorskip("vtkmodules")
     ascii_text = (REAL / "inp" / "cellsnd.ascii.inp").read_text()
     cell_lines = [ln.split() for ln in ascii_text.splitlines() if len(ln.split()) > 2 and ln.split()[2] in ("tri", "quad")]
     assert sum(f[2] == "tri" for f in cell_lines) == 8 and sum(f[2] == "quad" for f in cell_lines) == 4
-    with pytest.raises(EmptyGeometryError) as info:
-        load_body((REAL / "inp" / name).read_bytes(), filename=name)
-    message = info.value.message
-    assert "AVS UCD" in message and "4 quad, 8 triangle" in message and "no 3-D cells" in message
-    assert "Abaqus" not in message and "utf-8" not in message.lower()
+    loaded = load_body((REAL / "inp" / name).read_bytes(), filename=name)
+    note = loaded.parts[0].body.warnings[0]
+    assert "AVS UCD" in note and "12 surface cells (16 triangles)" in note
+    assert "Abaqus" not in note and "utf-8" not in note.lower()
+    with pytest.raises(NotWatertightError):
+        analyze_loaded(loaded, AnalysisOptions())
 
 
 def test_avs_ucd_tetrahedron_is_weighed() -> None:

@@ -182,7 +182,8 @@ def _load_bytes(
         from .volume import read_volume_parts
 
         parts = read_volume_parts(data, fmt, scale, filename=filename, companions=companions)
-        kind = SourceKind.VOLUME
+        # a file of 2-D cells only is read as a surface (``volume._surface_part``): weighed as a mesh
+        kind = SourceKind.MESH if all(isinstance(p.body, MeshBody) for p in parts) else SourceKind.VOLUME
     else:
         from .meshes import read_surface_parts
 

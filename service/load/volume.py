@@ -63,7 +63,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from ..body import CellBlock, Part, VolumeBody
+from ..body import CellBlock, MeshBody, Part, VolumeBody
 from ..cells import CELL_NODES, VOXEL_TO_HEXAHEDRON
 from ..errors import EmptyGeometryError, UnreadableFileError, UnsupportedFormatError
 from .polygons import fan_split_note
@@ -164,6 +164,32 @@ class _Mesh:
     density: NDArray[np.float64] | None  # one value per cell of the file (all cells, in file order)
     other: dict[str, int]  # cells that are not 3-D: type -> count (ignored, reported if nothing else)
     warnings: list[str] = field(default_factory=list)
+    surface: _Surface | None = None  # the linear 2-D cells, kept where the file has no 3-D cells
+
+
+@dataclass
+class _Surface:
+    """Linear 2-D cells as polygons (triangles, quads, pixels reordered, polygons) and triangle strips."""
+
+    corners: NDArray[np.int64]  # every polygon's node ids, one polygon after another
+    counts: NDArray[np.int64]  # corners per polygon
+    strips: list[NDArray[np.int64]]  # each strip's node ids
+    cells: int  # the file's surface cells
+
+    def triangles(self) -> NDArray[np.int64]:
+        """Polygons split as fans from their first corner; strips as VTK orders them (every other one turned)."""
+        fans = np.maximum(self.counts - 2, 0)
+        face = np.repeat(np.arange(len(self.counts)), fans)
+        step = np.arange(len(face)) - np.repeat(np.cumsum(fans) - fans, fans)
+        first = (np.cumsum(self.counts) - self.counts)[face]
+        c = self.corners
+        out = [np.stack([c[first], c[first + 1 + step], c[first + 2 + step]], axis=1)]
+        for strip in self.strips:
+            i = np.arange(max(len(strip) - 2, 0))
+            odd = i % 2 == 1
+            a, b = np.where(odd, strip[i + 1], strip[i]), np.where(odd, strip[i], strip[i + 1])
+            out.append(np.stack([a, b, strip[i + 2]], axis=1))
+        return np.concatenate(out).astype(np.int64)
 
 
 def read_volume_parts(
@@ -388,7 +414,33 @@ def _mesh_from_grid(grid: Any, to_numpy: Any, label: str) -> _Mesh:
         if name == "voxel":
             nodes, name = nodes[:, VOXEL_TO_HEXAHEDRON], "hexahedron"
         mesh.blocks.append(_Block(name, nodes, ids, f"{VTK_CELL_TYPES[vtk_type]}_{len(mesh.blocks)}"))
+    if not mesh.blocks:
+        mesh.surface = _vtk_surface(types, conn, offsets)
     return mesh
+
+
+_VTK_POLYGONS = (5, 7, 9)  # triangle, polygon, quad: corners in order around the face
+_VTK_PIXEL, _VTK_STRIP = 8, 6
+_PIXEL_ORDER = [0, 1, 3, 2]  # a pixel's corners go row by row; around the face they are 0 1 3 2
+
+
+def _vtk_surface(types: NDArray[np.int64], conn: NDArray[np.int64], offsets: NDArray[np.int64]) -> _Surface | None:
+    """The linear 2-D cells of a VTK data set, or None when it has none."""
+    polygons = np.flatnonzero(np.isin(types, _VTK_POLYGONS))
+    pixels = np.flatnonzero(types == _VTK_PIXEL)
+    strips = np.flatnonzero(types == _VTK_STRIP)
+    if not (len(polygons) or len(pixels) or len(strips)):
+        return None
+    counts = offsets[polygons + 1] - offsets[polygons]
+    owner = np.repeat(np.arange(len(polygons)), counts)
+    corners = conn[offsets[polygons][owner] + np.arange(len(owner)) - np.repeat(np.cumsum(counts) - counts, counts)]
+    pixel_corners = np.stack([conn[offsets[pixels] + k] for k in _PIXEL_ORDER], axis=1).ravel()
+    return _Surface(
+        np.concatenate([corners, pixel_corners]).astype(np.int64),
+        np.concatenate([counts, np.full(len(pixels), 4)]).astype(np.int64),
+        [conn[offsets[i] : offsets[i + 1]].astype(np.int64) for i in strips],
+        len(polygons) + len(pixels) + len(strips),
+    )
 
 
 def _polyhedron_faces(grid: Any, cells: NDArray[np.int64]) -> tuple[list[list[int]], list[int]]:
@@ -763,12 +815,21 @@ def _mesh_from_meshio(mesh: Any, label: str) -> _Mesh:
             out.blocks.append(_Block(ctype, nodes, ids, names[i]))
     if unsupported:
         raise UnsupportedFormatError(_unsupported_cells(label, unsupported), cell_types=sorted(unsupported))
+    if not out.blocks:
+        faces = [np.asarray(b.data, dtype=np.int64) for b in mesh.cells if b.type in _MESHIO_POLYGONS]
+        faces = [f for f in faces if f.ndim == 2 and f.shape[1] >= 3 and len(f)]
+        if faces:
+            counts = np.concatenate([np.full(len(f), f.shape[1]) for f in faces])
+            out.surface = _Surface(np.concatenate([f.ravel() for f in faces]), counts, [], len(counts))
     if densities is not None:
         values = np.concatenate(per_cell) if per_cell else np.empty(0)
         if len(values) != start:
             raise UnreadableFileError(f"{label} has a 'density' cell array that does not give one value per cell", field="density")
         out.density = values
     return out
+
+
+_MESHIO_POLYGONS = ("triangle", "quad", "polygon")  # linear faces, corners in order around each
 
 
 def _block_names(mesh: Any) -> list[str]:
@@ -787,6 +848,42 @@ def _block_names(mesh: Any) -> list[str]:
 # Parts
 
 
+def _surface_part(mesh: _Mesh, surface: _Surface, label: str, length_scale: float) -> Part:
+    """A file without 3-D cells whose linear 2-D cells may close a solid: read as its surface, as STL is.
+
+    The solid path then decides: a closed surface is weighed (its winding made outward, with the
+    usual warnings), an open one is refused as ``not_watertight`` (or weighed with ``model=shell``).
+    """
+    tris = surface.triangles()
+    if len(tris) == 0:
+        raise EmptyGeometryError(f"{label} has no 3-D cells and its surface cells have fewer than three corners each")
+    if tris.min() < 0 or tris.max() >= len(mesh.points):
+        raise UnreadableFileError(f"{label} has a surface cell that refers to a point that does not exist; the file is corrupt")
+    if not np.all(np.isfinite(mesh.points)):
+        raise UnreadableFileError(f"{label} has point coordinates that are NaN or infinite; fix the mesh")
+    used, faces = np.unique(tris, return_inverse=True)  # only the surface's own points
+    vertices = mesh.points[used]
+    faces = faces.reshape(-1, 3)
+    rest = ", ".join(f"{n} {t}" for t, n in sorted(mesh.other.items()) if t not in _SURFACE_CELL_NAMES)
+    notes = [
+        f"{label} has no 3-D cells: its {_count(surface.cells, 'surface cell')} ({_count(len(faces), 'triangle')}) "
+        "were read as a triangle surface, as an STL file is"
+        + (f"; its other cells ({rest}) carry no volume and were left out" if rest else "")
+    ]
+    if mesh.density is not None:
+        notes.append(f"{label} has a 'density' cell array: a surface has no cells of its own, so it was not used")
+    split = fan_split_note(mesh.points, surface.corners, surface.counts, "surface")
+    notes += [split] if split else []
+    return Part("surface", MeshBody(vertices, faces, length_scale, "surface", (*notes, *mesh.warnings)))
+
+
+_SURFACE_CELL_NAMES = frozenset({"triangle", "quad", "polygon", "pixel", "triangle strip"})
+
+
+def _count(n: int, noun: str) -> str:
+    return f"{n} {noun}" + ("" if n == 1 else "s")
+
+
 def _unsupported_cells(label: str, counts: Mapping[str, int]) -> str:
     listed = ", ".join(f"{n} {t}" for t, n in sorted(counts.items()))
     return (
@@ -796,6 +893,8 @@ def _unsupported_cells(label: str, counts: Mapping[str, int]) -> str:
 
 
 def _parts(mesh: _Mesh, label: str, length_scale: float) -> list[Part]:
+    if not mesh.blocks and mesh.surface is not None:
+        return [_surface_part(mesh, mesh.surface, label, length_scale)]
     if not mesh.blocks:
         found = ", ".join(f"{n} {t}" for t, n in sorted(mesh.other.items())) or "no cells at all"
         raise EmptyGeometryError(

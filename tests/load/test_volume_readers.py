@@ -20,10 +20,10 @@ import numpy as np
 import pytest
 
 from inertia import load_body
-from inertia.errors import EmptyGeometryError, LoadError, UnreadableFileError, UnsupportedFormatError
+from inertia.errors import EmptyGeometryError, LoadError, NotWatertightError, UnreadableFileError, UnsupportedFormatError
 from inertia.load.volume import VTK_CELL_TYPES
 from inertia.mass import assembly_properties, mass_properties
-from inertia.pipeline import AnalysisOptions, analyze
+from inertia.pipeline import AnalysisOptions, analyze, analyze_loaded
 from tests.support.bodies import meshed
 
 vtk = pytest.importorskip("vtk")
@@ -241,10 +241,17 @@ def test_cell_density_arrays_apply_to_every_cell_kind(tmp_path: Path) -> None:
 
 def test_surface_only_vtk_file_says_what_it_holds(tmp_path: Path) -> None:
     pts = np.array([(0, 0, 0), (1, 0, 0), (0, 1, 0)], float)
+    # 2-D cells are read as a surface (refused when open, as an STL is), and the note says what the file held
     data = write_vtu(grid([(5, [0, 1, 2])], pts), tmp_path / "tri.vtu")
+    loaded = load_body(data, filename="tri.vtu")
+    assert "its 1 surface cell (1 triangle)" in loaded.parts[0].body.warnings[0]
+    with pytest.raises(NotWatertightError):
+        analyze_loaded(loaded, AnalysisOptions())
+    # lines only: nothing to read as a surface either
+    lines = write_vtu(grid([(3, [0, 1]), (3, [1, 2])], pts), tmp_path / "lines.vtu")
     with pytest.raises(EmptyGeometryError) as info:
-        load_body(data, filename="tri.vtu")
-    assert "1 triangle" in info.value.message and "found: none" not in info.value.message
+        load_body(lines, filename="lines.vtu")
+    assert "2 line" in info.value.message and "found: none" not in info.value.message
 
 
 def test_cells_we_cannot_integrate_refuse_the_file_rather_than_vanish(tmp_path: Path) -> None:
