@@ -16,7 +16,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from .errors import EmptyGeometryError, InvalidParameterError
 
-__all__ = ["MeshBody", "VolumeBody", "CellBlock", "PointBody", "BrepBody", "Part", "Body"]
+__all__ = ["MeshBody", "VolumeBody", "CellBlock", "PointBody", "BrepBody", "Part", "Body", "stored_eps"]
 
 
 def _frozen(arr: ArrayLike, dtype: type[np.generic]) -> NDArray[Any]:
@@ -29,6 +29,12 @@ def _check_finite(name: str, arr: NDArray[np.float64]) -> None:
     if not np.all(np.isfinite(arr)):
         bad = int(np.count_nonzero(~np.isfinite(arr)))
         raise InvalidParameterError(f"{name} contain {bad} non-finite value(s) (NaN or infinity); fix the input", field=name)
+
+
+def stored_eps(vertices: NDArray[np.float64]) -> float:
+    """Unit roundoff of a file's stored coordinates: float32 when every coordinate is a float32 value (binary
+    STL, VTK's ``POINTS n float``, ASCII written from float32), else float64 (``MeshBody.coordinate_eps``)."""
+    return 2.0**-24 if bool(np.array_equal(vertices.astype(np.float32), vertices)) else 2.0**-53
 
 
 @dataclass(frozen=True, slots=True)

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import math
 from pathlib import Path
 from typing import Any
 
@@ -399,3 +400,50 @@ def test_vtk_pixels_closing_a_box_are_weighed_as_its_solid() -> None:
     doc = analyze(data, filename="pixels.vtk", options=AnalysisOptions(density=1.0)).as_dict()
     assert doc["mass"] == pytest.approx(6.0, rel=1e-15)
     assert not any("winding" in w for w in doc["warnings"])
+
+
+def _prism_polydata(sides_as_strip: bool) -> tuple[bytes, float]:
+    # a regular pentagonal prism (circumradius 1, height 2): two pentagons and five quads, or the five sides
+    # as one triangle strip going round; volume (5/2) sin(72 deg) x 2, exactly that of the rounded corners to 1e-15
+    ring = [(math.cos(2 * math.pi * k / 5), math.sin(2 * math.pi * k / 5)) for k in range(5)]
+    points = [(x, y, 0.0) for x, y in ring] + [(x, y, 2.0) for x, y in ring]
+    caps = [[4, 3, 2, 1, 0], [5, 6, 7, 8, 9]]
+    text = "\n".join(" ".join(repr(c) for c in p) for p in points)
+    body = f"# vtk DataFile Version 3.0\nprism\nASCII\nDATASET POLYDATA\nPOINTS 10 double\n{text}\n"
+    if sides_as_strip:
+        strip = [i for k in range(5) for i in (5 + k, k)] + [5, 0]
+        body += "POLYGONS 2 12\n" + "\n".join("5 " + " ".join(map(str, c)) for c in caps) + "\n"
+        body += f"TRIANGLE_STRIPS 1 {len(strip) + 1}\n{len(strip)} " + " ".join(map(str, strip)) + "\n"
+    else:
+        quads = [[k, (k + 1) % 5, 5 + (k + 1) % 5, 5 + k] for k in range(5)]
+        cells = caps + quads
+        listed = "\n".join(f"{len(c)} " + " ".join(map(str, c)) for c in cells)
+        body += f"POLYGONS 7 {sum(len(c) + 1 for c in cells)}\n{listed}\n"
+    return body.encode(), 2.5 * math.sin(2 * math.pi / 5) * 2.0
+
+
+@pytest.mark.parametrize("sides_as_strip", [False, True])
+def test_a_closed_prism_of_mixed_polygons_or_a_long_strip_is_weighed(sides_as_strip: bool) -> None:
+    data, volume = _prism_polydata(sides_as_strip)
+    doc = analyze(data, filename="prism.vtk", options=AnalysisOptions(density=1.0)).as_dict()
+    assert doc["mass"] == pytest.approx(volume, rel=1e-14)
+    assert not any("winding" in w for w in doc["warnings"])
+
+
+def test_a_pixel_listing_three_ids_is_refused_not_misread() -> None:
+    data = (
+        b"# vtk DataFile Version 3.0\nbad\nASCII\nDATASET UNSTRUCTURED_GRID\nPOINTS 3 double\n0 0 0\n1 0 0\n0 1 0\n"
+        b"CELLS 2 8\n3 0 1 2\n3 0 1 2\nCELL_TYPES 2\n5\n8\n"
+    )
+    with pytest.raises(UnreadableFileError, match="pixel but lists 3 node ids"):
+        analyze(data, filename="bad.vtk")
+
+
+def test_an_abaqus_deck_of_shell_elements_is_not_weighed_as_a_solid() -> None:
+    # S4R shells closing a box: their mass is their section's thickness, not the box's volume
+    v, _ = box(1.0, 2.0, 3.0)
+    nodes = "\n".join(f"{i + 1}, {x!r}, {y!r}, {z!r}" for i, (x, y, z) in enumerate(v.tolist()))
+    elements = "\n".join(f"{k + 1}, " + ", ".join(str(i + 1) for i in q) for k, q in enumerate(_BOX_QUADS))
+    deck = f"*NODE\n{nodes}\n*ELEMENT, TYPE=S4R, ELSET=SKIN\n{elements}\n".encode()
+    with pytest.raises((EmptyGeometryError, UnsupportedFormatError)):
+        analyze(deck, filename="skin.inp")

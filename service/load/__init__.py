@@ -6,10 +6,7 @@ import os
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, replace
 
-import numpy as np
-from numpy.typing import NDArray
-
-from ..body import Body, BrepBody, MeshBody, Part, PointBody, VolumeBody
+from ..body import Body, BrepBody, MeshBody, Part, PointBody, VolumeBody, stored_eps
 from ..conventions import length_scale
 from ..errors import EmptyGeometryError, UnreadableFileError
 from ..vocabulary import Isotopes, MassUnit, SourceKind, UnitsFrom
@@ -120,7 +117,7 @@ def _load_path(path: str, filename: str, format: str | None, units: str | None, 
         vertices, faces = read_stl_file(fh, os.fstat(fh.fileno()).st_size)
     scale = 1.0 if units is None else length_scale(units)
     name = _stem(filename)
-    parts = (Part(name, MeshBody(vertices, faces, scale, name, welded=True, coordinate_eps=stl_eps(vertices))),)
+    parts = (Part(name, MeshBody(vertices, faces, scale, name, welded=True, coordinate_eps=stored_eps(vertices))),)
     return Loaded(parts, filename, "stl", SourceKind.MESH, units or "m", UnitsFrom.REQUEST if units else UnitsFrom.DEFAULT)
 
 
@@ -168,9 +165,8 @@ def _load_bytes(
         from .stl import read_stl
 
         vertices, faces = read_stl(data)
-        parts = [
-            Part(_stem(filename), MeshBody(vertices, faces, scale, _stem(filename), welded=True, coordinate_eps=stl_eps(vertices)))
-        ]
+        name = _stem(filename)
+        parts = [Part(name, MeshBody(vertices, faces, scale, name, welded=True, coordinate_eps=stored_eps(vertices)))]
         kind = SourceKind.MESH
     elif fmt in POINT_FORMATS:
         from .points import read_points_document
@@ -229,12 +225,6 @@ def _rescaled(part: Part, scale: float) -> Part:
         assert isinstance(body, PointBody)
         new = PointBody(body.masses, body.positions, scale, body.name, body.warnings)
     return Part(part.name, new, part.extras)
-
-
-def stl_eps(vertices: NDArray[np.float64]) -> float:
-    """Unit roundoff of an STL file's coordinates: float32 (binary STL, or ASCII written from
-    float32) when every coordinate is a float32 value, else float64 (decimal text)."""
-    return 2.0**-24 if bool(np.array_equal(vertices.astype(np.float32), vertices)) else 2.0**-53
 
 
 def _stem(filename: str | None) -> str:

@@ -45,6 +45,13 @@ corner when their faces close them with one winding and they are
 star-shaped from there (else the file is refused, naming the cell); bent
 faces are said in a warning with the volume they put in doubt.  A 3-D cell
 type we cannot integrate refuses the file (it is never dropped).
+
+A file with no 3-D cells whose linear 2-D cells (triangles, quads, polygons,
+VTK pixels and triangle strips: VTK polydata, a Gmsh surface mesh) may close
+a solid is one surface part, read as an STL is (``_surface_part``), with a
+warning saying so; the solid path weighs it when closed and refuses it as
+``not_watertight`` when open.  Not for Abaqus: its 2-D elements are shells
+and membranes, whose mass is their sections'.
 """
 
 from __future__ import annotations
@@ -63,7 +70,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from ..body import CellBlock, MeshBody, Part, VolumeBody
+from ..body import CellBlock, MeshBody, Part, VolumeBody, stored_eps
 from ..cells import CELL_NODES, VOXEL_TO_HEXAHEDRON
 from ..errors import EmptyGeometryError, UnreadableFileError, UnsupportedFormatError
 from .polygons import fan_split_note
@@ -91,8 +98,16 @@ VTK_CELL_TYPES = {
 _VTK_POLYHEDRA = {15: "pentagonal prism", 16: "hexagonal prism", 42: "polyhedron"}
 # 3-D VTK cells we cannot integrate (refused, never dropped)
 _VTK_OTHER_3D = {
+    31: "12-node wedge",
     33: "24-node hexahedron",
     37: "19-node pyramid",
+    41: "convex point set",
+    55: "parametric tetrahedral region",
+    56: "parametric hexahedral region",
+    64: "higher-order tetrahedron",
+    65: "higher-order wedge",
+    66: "higher-order pyramid",
+    67: "higher-order hexahedron",
     71: "Lagrange tetrahedron",
     72: "Lagrange hexahedron",
     73: "Lagrange wedge",
@@ -195,7 +210,7 @@ class _Surface:
 def read_volume_parts(
     data: bytes, fmt: str, length_scale: float, *, filename: str | None = None, companions: Mapping[str, bytes] | None = None
 ) -> list[Part]:
-    """Parts of a volume mesh: one per block of 3-D cells.
+    """Parts of a volume mesh: one per block of 3-D cells; a file of linear 2-D cells only is one surface part.
 
     companions : other files of the same upload by name (a TetGen ``.node``
         beside its ``.ele``, an XDMF's HDF5 file), written beside it for the reader.
@@ -415,32 +430,35 @@ def _mesh_from_grid(grid: Any, to_numpy: Any, label: str) -> _Mesh:
             nodes, name = nodes[:, VOXEL_TO_HEXAHEDRON], "hexahedron"
         mesh.blocks.append(_Block(name, nodes, ids, f"{VTK_CELL_TYPES[vtk_type]}_{len(mesh.blocks)}"))
     if not mesh.blocks:
-        mesh.surface = _vtk_surface(types, conn, offsets)
+        mesh.surface = _vtk_surface(types, conn, offsets, label, mesh.warnings)
     return mesh
 
 
-_VTK_POLYGONS = (5, 7, 9)  # triangle, polygon, quad: corners in order around the face
-_VTK_PIXEL, _VTK_STRIP = 8, 6
-_PIXEL_ORDER = [0, 1, 3, 2]  # a pixel's corners go row by row; around the face they are 0 1 3 2
+# linear 2-D VTK cells of a fixed size: corners in order around the face (a pixel's go row by row: 0 1 3 2)
+_VTK_FIXED_FACES = {5: ("triangle", 3, [0, 1, 2]), 9: ("quad", 4, [0, 1, 2, 3]), 8: ("pixel", 4, [0, 1, 3, 2])}
+_VTK_POLYGON, _VTK_STRIP = 7, 6  # any number of corners
 
 
-def _vtk_surface(types: NDArray[np.int64], conn: NDArray[np.int64], offsets: NDArray[np.int64]) -> _Surface | None:
+def _vtk_surface(
+    types: NDArray[np.int64], conn: NDArray[np.int64], offsets: NDArray[np.int64], label: str, notes: list[str]
+) -> _Surface | None:
     """The linear 2-D cells of a VTK data set, or None when it has none."""
-    polygons = np.flatnonzero(np.isin(types, _VTK_POLYGONS))
-    pixels = np.flatnonzero(types == _VTK_PIXEL)
-    strips = np.flatnonzero(types == _VTK_STRIP)
-    if not (len(polygons) or len(pixels) or len(strips)):
-        return None
+    faces: list[NDArray[np.int64]] = []
+    for vtk_type, (name, width, order) in _VTK_FIXED_FACES.items():
+        ids = np.flatnonzero(types == vtk_type)
+        if len(ids):  # the first ``width`` ids of each list, as VTK reads them; a shorter list is refused
+            faces.append(_fixed_width(conn, offsets, ids, width, name, label, notes)[:, order].ravel())
+    polygons = np.flatnonzero(types == _VTK_POLYGON)
     counts = offsets[polygons + 1] - offsets[polygons]
     owner = np.repeat(np.arange(len(polygons)), counts)
-    corners = conn[offsets[polygons][owner] + np.arange(len(owner)) - np.repeat(np.cumsum(counts) - counts, counts)]
-    pixel_corners = np.stack([conn[offsets[pixels] + k] for k in _PIXEL_ORDER], axis=1).ravel()
-    return _Surface(
-        np.concatenate([corners, pixel_corners]).astype(np.int64),
-        np.concatenate([counts, np.full(len(pixels), 4)]).astype(np.int64),
-        [conn[offsets[i] : offsets[i + 1]].astype(np.int64) for i in strips],
-        len(polygons) + len(pixels) + len(strips),
-    )
+    faces.append(conn[offsets[polygons][owner] + np.arange(len(owner)) - np.repeat(np.cumsum(counts) - counts, counts)])
+    strips = [conn[offsets[i] : offsets[i + 1]].astype(np.int64) for i in np.flatnonzero(types == _VTK_STRIP)]
+    widths = [np.full(int(np.count_nonzero(types == t)), _VTK_FIXED_FACES[t][1]) for t in _VTK_FIXED_FACES]
+    all_counts = np.concatenate([*widths, counts]).astype(np.int64)
+    if not len(all_counts) and not strips:
+        return None
+    cells = int(np.count_nonzero(all_counts >= 3)) + sum(len(s) >= 3 for s in strips)
+    return _Surface(np.concatenate(faces).astype(np.int64), all_counts, strips, cells)
 
 
 def _polyhedron_faces(grid: Any, cells: NDArray[np.int64]) -> tuple[list[list[int]], list[int]]:
@@ -683,6 +701,8 @@ def _read_meshio(data: bytes, fmt: str, label: str, filename: str | None, compan
                 raise _hdf5_missing(label, fmt, exc) from exc
             raise UnreadableFileError(_meshio_failure(exc, printed.getvalue(), path, fmt, label, companions), format=fmt) from exc
     out = _mesh_from_meshio(mesh, label)
+    if fmt == "inp":  # Abaqus's 2-D elements are shells and membranes: their mass is their sections', not a solid's
+        out.surface = None
     if fmt == "inp" and out.blocks and out.other:  # Abaqus shells, beams, trusses have mass through their sections
         listed = ", ".join(f"{n} {t}" for t, n in sorted(out.other.items()))
         out.warnings.append(
@@ -867,14 +887,18 @@ def _surface_part(mesh: _Mesh, surface: _Surface, label: str, length_scale: floa
     rest = ", ".join(f"{n} {t}" for t, n in sorted(mesh.other.items()) if t not in _SURFACE_CELL_NAMES)
     notes = [
         f"{label} has no 3-D cells: its {_count(surface.cells, 'surface cell')} ({_count(len(faces), 'triangle')}) "
-        "were read as a triangle surface, as an STL file is"
-        + (f"; its other cells ({rest}) carry no volume and were left out" if rest else "")
+        f"{'was' if surface.cells == 1 else 'were'} read as a triangle surface, as an STL file is"
+        + (f"; its other cells ({rest}) were left out" if rest else "")
     ]
     if mesh.density is not None:
         notes.append(f"{label} has a 'density' cell array: a surface has no cells of its own, so it was not used")
-    split = fan_split_note(mesh.points, surface.corners, surface.counts, "surface")
+    x = vertices - vertices.mean(axis=0)
+    volume = abs(float(np.einsum("ij,ij->", x[faces[:, 0]], np.cross(x[faces[:, 1]], x[faces[:, 2]])))) / 6
+    split = fan_split_note(mesh.points, surface.corners, surface.counts, "surface", volume=volume)
     notes += [split] if split else []
-    return Part("surface", MeshBody(vertices, faces, length_scale, "surface", (*notes, *mesh.warnings)))
+    # float32 points (VTK's "POINTS n float") resolve the body only so finely: the solid path checks it
+    body = MeshBody(vertices, faces, length_scale, "surface", (*notes, *mesh.warnings), coordinate_eps=stored_eps(vertices))
+    return Part("surface", body)
 
 
 _SURFACE_CELL_NAMES = frozenset({"triangle", "quad", "polygon", "pixel", "triangle strip"})
@@ -899,7 +923,7 @@ def _parts(mesh: _Mesh, label: str, length_scale: float) -> list[Part]:
         found = ", ".join(f"{n} {t}" for t, n in sorted(mesh.other.items())) or "no cells at all"
         raise EmptyGeometryError(
             f"{label} has no 3-D cells (it holds {found}); send tetrahedra, hexahedra, wedges or pyramids, "
-            "or a closed surface mesh in a surface format (STL, OBJ, PLY, ...)"
+            "or a closed surface of linear triangles or polygons (here, or in STL, OBJ, PLY, ...)"
         )
     if not np.all(np.isfinite(mesh.points)):
         raise UnreadableFileError(f"{label} has point coordinates that are NaN or infinite; fix the mesh")
