@@ -34,7 +34,9 @@ def _check_finite(name: str, arr: NDArray[np.float64]) -> None:
 def stored_eps(vertices: NDArray[np.float64]) -> float:
     """Unit roundoff of a file's stored coordinates: float32 when every coordinate is a float32 value (binary
     STL, VTK's ``POINTS n float``, ASCII written from float32), else float64 (``MeshBody.coordinate_eps``)."""
-    return 2.0**-24 if bool(np.array_equal(vertices.astype(np.float32), vertices)) else 2.0**-53
+    with np.errstate(over="ignore"):  # a value beyond float32's range is no float32: it casts to inf, unequal
+        single = vertices.astype(np.float32)
+    return 2.0**-24 if bool(np.array_equal(single, vertices)) else 2.0**-53
 
 
 @dataclass(frozen=True, slots=True)

@@ -447,3 +447,20 @@ def test_an_abaqus_deck_of_shell_elements_is_not_weighed_as_a_solid() -> None:
     deck = f"*NODE\n{nodes}\n*ELEMENT, TYPE=S4R, ELSET=SKIN\n{elements}\n".encode()
     with pytest.raises((EmptyGeometryError, UnsupportedFormatError)):
         analyze(deck, filename="skin.inp")
+
+
+def test_bent_polygons_near_the_top_of_float64_are_an_overflow_not_an_unreadable_file() -> None:
+    # a box 1e110 across with one corner pulled out (so its quads are bent): the split note cubed the size in
+    # Python floats (OverflowError, reported as a file that "does not follow the format"); the integrals
+    # overflow, which is said as such
+    import warnings
+
+    from inertia.errors import InvalidParameterError
+
+    v = np.array([[(k & 1), (k >> 1) & 1, (k >> 2) & 1] for k in range(8)], float) * 1e110
+    v[7, 2] += 0.5e110
+    lines = [f"v {x!r} {y!r} {z!r}" for x, y, z in v.tolist()]
+    lines += ["f " + " ".join(str(i + 1) for i in q) for q in _BOX_QUADS]
+    with pytest.raises(InvalidParameterError, match="overflow"), warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)  # numpy says so on the way; the answer is the error
+        analyze(("\n".join(lines) + "\n").encode(), filename="big.obj")

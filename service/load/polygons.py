@@ -62,7 +62,7 @@ def fan_split_note(
     d1, d2, d3 = (x[corners[first + 1 + step + j]] - c0 for j in range(3))
     tet = np.abs(np.einsum("ij,ij->i", d1, np.cross(d2, d3))) / 6
     size = float(np.ptp(x, axis=0).max()) if len(x) else 0.0
-    bent = tet > 1e-12 * size**3  # beyond float64 rounding of a planar face
+    bent = tet > 1e-12 * (size * size * size)  # beyond float64 rounding of a planar face (inf, never OverflowError)
     change = float(tet[bent].sum())
     if volume == 0.0 or change <= NOTE_REL * volume:
         return None

@@ -892,9 +892,10 @@ def _surface_part(mesh: _Mesh, surface: _Surface, label: str, length_scale: floa
     ]
     if mesh.density is not None:
         notes.append(f"{label} has a 'density' cell array: a surface has no cells of its own, so it was not used")
-    x = vertices - vertices.mean(axis=0)
-    volume = abs(float(np.einsum("ij,ij->", x[faces[:, 0]], np.cross(x[faces[:, 1]], x[faces[:, 2]])))) / 6
-    split = fan_split_note(mesh.points, surface.corners, surface.counts, "surface", volume=volume)
+    with np.errstate(all="ignore"):  # coordinates near float64's limits: the solid path refuses them by name
+        x = vertices - vertices.mean(axis=0)
+        volume = abs(float(np.einsum("ij,ij->", x[faces[:, 0]], np.cross(x[faces[:, 1]], x[faces[:, 2]])))) / 6
+        split = fan_split_note(mesh.points, surface.corners, surface.counts, "surface", volume=volume)
     notes += [split] if split else []
     # float32 points (VTK's "POINTS n float") resolve the body only so finely: the solid path checks it
     body = MeshBody(vertices, faces, length_scale, "surface", (*notes, *mesh.warnings), coordinate_eps=stored_eps(vertices))
