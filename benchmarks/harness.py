@@ -33,6 +33,7 @@ Nothing here imports the service or the tests.
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import math
 import os
 import platform
@@ -223,6 +224,10 @@ class TreeLog:
         for pid in _tree(roots):
             got = proc_stat(pid)
             if got is not None:
+                before = self.seen.get(pid)
+                if before is not None and before.peak_rss_bytes > got.peak_rss_bytes:
+                    # an exited process not yet reaped (a zombie) lists no VmHWM: keep the peak seen alive
+                    got = dataclasses.replace(got, peak_rss_bytes=before.peak_rss_bytes)
                 self.seen[pid] = got
                 self.start_cpu.setdefault(pid, got.cpu_s)
 

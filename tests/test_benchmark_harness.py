@@ -141,3 +141,14 @@ def test_byte_compiled_writes_each_modules_bytecode_without_importing_it(tmp_pat
 
 def test_byte_compiled_says_when_the_package_is_missing() -> None:
     assert "was not found" in harness.byte_compiled("no_such_package_for_bytecode_xyz")
+
+
+def test_a_process_seen_as_a_zombie_keeps_the_peak_it_had_alive(monkeypatch: pytest.MonkeyPatch) -> None:
+    # /proc/<pid>/status of an exited, unreaped process lists no VmHWM: the last sample reads a peak of 0
+    stats = iter([harness.ProcStat(0.1, 100 * 2**20, "python"), harness.ProcStat(0.4, 0, "python")])
+    monkeypatch.setattr(harness, "_tree", lambda roots: list(roots))
+    monkeypatch.setattr(harness, "proc_stat", lambda pid: next(stats))
+    log = harness.TreeLog()
+    log.sample([7])
+    log.sample([7])
+    assert log.peak() == 100 * 2**20 and log.cpu() == pytest.approx(0.3)
