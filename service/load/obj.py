@@ -27,7 +27,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..errors import EmptyGeometryError, UnreadableFileError
-from .polygons import fan_split_note
+from .polygons import fan_split_note, fan_triangles
 
 __all__ = ["read_obj"]
 
@@ -164,12 +164,7 @@ def _faces(
             lines[line_nos[i] - 1].strip(),
             f"refers to vertex {int(refs[bad[0]])}, but only {seen[i]} vertices come before it",
         )
-    starts = np.concatenate([[0], np.cumsum(corners)[:-1]])
-    fans = corners - 2  # triangles per face
-    tri_face = np.repeat(np.arange(len(rows)), fans)
-    k = np.arange(len(tri_face)) - np.repeat(np.cumsum(fans) - fans, fans)  # fan step within its face
-    first = starts[tri_face]
-    triangles = np.stack([idx[first], idx[first + 1 + k], idx[first + 2 + k]], axis=1)
+    triangles, tri_face = fan_triangles(idx, corners)
     return triangles, np.asarray(part, dtype=np.int64)[tri_face], idx, corners
 
 

@@ -18,9 +18,23 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ["NOTE_REL", "fan_split_note"]
+__all__ = ["NOTE_REL", "fan_split_note", "fan_triangles"]
 
 NOTE_REL = 1e-9  # below this share of the volume, the split is lost in the file's own rounding
+
+
+def fan_triangles(corners: NDArray[np.int64], counts: NDArray[np.int64]) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
+    """Every face split as a fan from its first corner: (k, 3) corner values, and the face of each triangle.
+
+    corners : every face's values (vertex numbers, or positions in another array), one face after
+    another; counts : corners per face (a face of fewer than three gives no triangle).
+    """
+    counts = np.asarray(counts, dtype=np.int64)
+    fans = np.maximum(counts - 2, 0)
+    face = np.repeat(np.arange(len(counts)), fans)
+    step = np.arange(len(face)) - np.repeat(np.cumsum(fans) - fans, fans)
+    first = (np.cumsum(counts) - counts)[face]
+    return np.stack([corners[first], corners[first + 1 + step], corners[first + 2 + step]], axis=1), face
 
 
 def fan_split_note(
@@ -46,11 +60,8 @@ def fan_split_note(
     x = x - x.mean(axis=0) if len(x) else x
     starts = np.concatenate([[0], np.cumsum(counts)[:-1]])
     # the fan's volume, to weigh the difference against: sum of det(c0, ci, ci+1) / 6 over every face
-    fans = np.maximum(counts - 2, 0)
-    face = np.repeat(np.arange(len(counts)), fans)
-    step = np.arange(len(face)) - np.repeat(np.cumsum(fans) - fans, fans)
-    first = starts[face]
-    a, b, c = x[corners[first]], x[corners[first + 1 + step]], x[corners[first + 2 + step]]
+    tri, _ = fan_triangles(corners, counts)
+    a, b, c = x[tri[:, 0]], x[tri[:, 1]], x[tri[:, 2]]
     if volume is None:
         volume = abs(float(np.einsum("ij,ij->", a, np.cross(b, c)))) / 6
     # each inner diagonal of a fan flipped: the tetrahedron (c0, ci+1, ci+2, ci+3)

@@ -73,7 +73,7 @@ from numpy.typing import NDArray
 from ..body import CellBlock, MeshBody, Part, VolumeBody, stored_eps
 from ..cells import CELL_NODES, VOXEL_TO_HEXAHEDRON
 from ..errors import EmptyGeometryError, UnreadableFileError, UnsupportedFormatError
-from .polygons import fan_split_note
+from .polygons import fan_split_note, fan_triangles
 from .sniff import VOLUME_FORMATS
 
 __all__ = ["read_volume_parts", "VTK_FORMATS", "VTK_CELL_TYPES"]
@@ -193,12 +193,7 @@ class _Surface:
 
     def triangles(self) -> NDArray[np.int64]:
         """Polygons split as fans from their first corner; strips as VTK orders them (every other one turned)."""
-        fans = np.maximum(self.counts - 2, 0)
-        face = np.repeat(np.arange(len(self.counts)), fans)
-        step = np.arange(len(face)) - np.repeat(np.cumsum(fans) - fans, fans)
-        first = (np.cumsum(self.counts) - self.counts)[face]
-        c = self.corners
-        out = [np.stack([c[first], c[first + 1 + step], c[first + 2 + step]], axis=1)]
+        out = [fan_triangles(self.corners, self.counts)[0]]
         for strip in self.strips:
             i = np.arange(max(len(strip) - 2, 0))
             odd = i % 2 == 1
@@ -555,11 +550,7 @@ def _polyhedra(
     if np.any(unbalanced):
         raise refuse(int(cell[order][runs[np.argmax(unbalanced)]]), "its faces do not close it with one winding")
     # fan triangles of every face, from its first corner
-    fans = counts - 2
-    tri_face = np.repeat(np.arange(len(counts)), fans)
-    step = np.arange(len(tri_face)) - np.repeat(np.cumsum(fans) - fans, fans)
-    first = starts[tri_face]
-    tri = np.stack([flat[first], flat[first + 1 + step], flat[first + 2 + step]], axis=1)
+    tri, tri_face = fan_triangles(flat, counts)
     x = points[tri]
     area2 = np.zeros((len(counts), 3))
     np.add.at(area2, tri_face, np.cross(x[:, 1] - x[:, 0], x[:, 2] - x[:, 0]))
