@@ -187,7 +187,12 @@ def machine_info() -> dict[str, str]:
         mem = f"{kb / 2**20:.1f} GiB"
     except (OSError, ValueError, IndexError):
         pass
-    versions = {name: importlib.metadata.version(name) for name in ("numpy", "trimesh", "numpy-stl")}
+    versions = {}
+    for name in ("numpy", "trimesh", "numpy-stl"):
+        try:
+            versions[name] = importlib.metadata.version(name)
+        except importlib.metadata.PackageNotFoundError:  # numpy-stl is only needed below 1e6 triangles
+            versions[name] = "not installed"
     return {
         "CPU": cpu,
         "cores (os.cpu_count)": str(os.cpu_count()),

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import sys
+import time
 from pathlib import Path
 
 import pytest
@@ -152,3 +153,46 @@ def test_a_process_seen_as_a_zombie_keeps_the_peak_it_had_alive(monkeypatch: pyt
     log.sample([7])
     log.sample([7])
     assert log.peak() == 100 * 2**20 and log.cpu() == pytest.approx(0.3)
+
+
+# the benchmark forks warm processes on purpose; Python 3.12 warns of fork() when other tests left threads running
+_FORK_OK = pytest.mark.filterwarnings("ignore:This process .* is multi-threaded:DeprecationWarning")
+
+
+@_FORK_OK
+def test_ceiling_times_every_process_from_its_release_to_the_end_of_the_last_job() -> None:
+    from benchmarks import ceiling
+
+    def job() -> None:
+        time.sleep(0.05)
+
+    got = ceiling.timed(job, 2, rounds=1)
+    assert got.wall_s >= 0.05 and got.own_s >= 0.05  # the job ran in each process after the release
+    assert got.wall_s >= got.own_s  # the last job ends no earlier than any process's own time
+
+
+@_FORK_OK
+def test_ceiling_refuses_a_run_where_a_process_failed() -> None:
+    from benchmarks import ceiling
+
+    def job() -> None:
+        raise SystemExit(3)
+
+    with pytest.raises(RuntimeError, match="exit codes"):
+        ceiling.timed(job, 1, rounds=1)
+
+
+def test_mass_report_names_a_missing_peer_instead_of_failing(monkeypatch: pytest.MonkeyPatch) -> None:
+    import importlib.metadata
+
+    from benchmarks import mass
+
+    real = importlib.metadata.version
+
+    def version(name: str) -> str:
+        if name == "numpy-stl":
+            raise importlib.metadata.PackageNotFoundError(name)
+        return real(name)
+
+    monkeypatch.setattr(importlib.metadata, "version", version)
+    assert mass.machine_info()["numpy-stl"] == "not installed"
