@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
+import gc
 import json
+import os
 import subprocess
 import sys
 
@@ -89,3 +91,34 @@ def test_result_holds_only_requested_sections() -> None:
 
     doc = analyze(SAMPLES / "box.stl").as_dict()
     assert not {"reference_inertia", "precession", "parts"} & set(doc)
+
+
+def test_the_command_runs_blas_on_one_thread_unless_the_user_chose(monkeypatch: pytest.MonkeyPatch) -> None:
+    from inertia import cli
+
+    seen: list[list[str | None]] = []
+
+    def fake_main() -> int:
+        seen.append([os.environ.get(k) for k in ("OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "OMP_NUM_THREADS")])
+        return 0
+
+    monkeypatch.setattr(cli, "main", fake_main)
+    monkeypatch.setattr(gc, "freeze", lambda: None)  # console_main ends a process; this one goes on
+    for key in ("OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "OMP_NUM_THREADS"):
+        monkeypatch.delenv(key, raising=False)
+    cli.console_main()
+    monkeypatch.setenv("OPENBLAS_NUM_THREADS", "4")
+    cli.console_main()
+    # OMP_NUM_THREADS stays unset: the block threads of a large mesh read it
+    assert seen == [["1", "1", None], ["4", "1", None]]
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="counts the threads in /proc")
+def test_numpy_imported_after_the_setting_starts_no_blas_threads() -> None:
+    script = (
+        "import os\nfrom inertia.cli import one_blas_thread\none_blas_thread()\nimport numpy\n"
+        "numpy.ones((300, 300)) @ numpy.ones((300, 300))\nprint(len(os.listdir('/proc/self/task')))"
+    )
+    env = {k: v for k, v in os.environ.items() if k not in ("OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "OMP_NUM_THREADS")}
+    out = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, cwd=ROOT, env=env, check=True)
+    assert out.stdout.split() == ["1"]
