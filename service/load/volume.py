@@ -58,6 +58,7 @@ from __future__ import annotations
 
 import contextlib
 import io
+import itertools
 import os
 import re
 import tempfile
@@ -681,6 +682,8 @@ def _read_meshio(data: bytes, fmt: str, label: str, filename: str | None, compan
 
     if fmt == "inp":
         _admit_abaqus_types([data, *(companions or {}).values()], label)
+        data = abaqus_one_node_block(data, label)
+        companions = {k: abaqus_one_node_block(v, k) if k.lower().endswith(".inp") else v for k, v in (companions or {}).items()}
 
     with _upload_dir(data, fmt, filename, companions) as path, _quiet() as printed:
         try:
@@ -776,6 +779,103 @@ def _admit_abaqus_types(texts: list[bytes], label: str) -> None:
             "connectors or user elements would be left out although some carry mass; export the solid mesh alone",
             element_types=unknown,
         )
+
+
+# keywords that make or move nodes or elements from others (generation, copies, mappings, placed instances):
+# meshio reads none of them, and the mesh it returned without them was the wrong body, silently
+_ABAQUS_GENERATED = {
+    b"NGEN": "generates nodes",
+    b"NFILL": "generates nodes",
+    b"NCOPY": "copies nodes",
+    b"NMAP": "maps node coordinates",
+    b"ELGEN": "generates elements",
+    b"ELCOPY": "copies elements",
+}
+_ABAQUS_SYSTEM = re.compile(rb"(?:^|,)[ \t]*SYSTEM[ \t]*=[ \t]*(?P<system>[^,\s]+)", re.IGNORECASE)
+
+
+def _abaqus_keyword(line: bytes) -> bytes | None:
+    """The keyword of an Abaqus keyword line (``*Node, nset=A`` -> ``NODE``); None for data and comment lines."""
+    if not line.startswith(b"*") or line.startswith(b"**"):
+        return None
+    return line.partition(b",")[0].strip().lstrip(b"*").replace(b" ", b"").upper()
+
+
+def abaqus_one_node_block(data: bytes, label: str) -> bytes:
+    """The deck with every ``*NODE`` block's data in its first one, as meshio needs; refuse what it would misread.
+
+    meshio 5.3.5 starts its node table afresh at each ``*NODE``: the elements
+    of a deck that lists its nodes in two blocks pointed into the wrong block
+    (two tetrahedra came back as the second one twice), or the read failed on
+    a node id.  Node ids are the deck's own names, so the blocks are joined
+    (ids repeated across blocks, as the parts of an assembly number theirs,
+    are refused).  Also refused: node coordinates in a cylindrical or
+    spherical system, nodes or elements generated or copied from others,
+    and more than one part instance or a placed one, none of which meshio
+    applies.
+    """
+    lines = data.splitlines(keepends=True)
+    keywords = [_abaqus_keyword(line) for line in lines]
+    starts = [i for i, k in enumerate(keywords) if k is not None] + [len(lines)]
+    spans = list(itertools.pairwise(starts))  # each keyword line and the end of its data lines
+    blocks = [(i, j) for i, j in spans if keywords[i] == b"NODE"]
+    for i, j in spans:
+        _refuse_unapplied(keywords[i] or b"", lines[i], lines[i + 1 : j], label)
+    if sum(k == b"INSTANCE" for k in keywords) > 1:
+        raise UnsupportedFormatError(
+            f"{label} places more than one part instance (*INSTANCE), which this reader does not do; export the "
+            "assembly flattened (without *PART and *INSTANCE)",
+            keyword="INSTANCE",
+        )
+    if len(blocks) < 2:
+        return data
+    rows = [line for start, end in blocks for line in lines[start + 1 : end] if line.strip() and not line.startswith(b"**")]
+    seen: set[bytes] = set()
+    for row in rows:
+        node = row.partition(b",")[0].strip()
+        if node in seen:
+            raise UnsupportedFormatError(
+                f"{label} defines node {node.decode('latin-1')[:20]} in two *NODE blocks (as the parts of an assembly "
+                "number their nodes each from 1); export the model flattened, with one numbering",
+                keyword="NODE",
+            )
+        seen.add(node)
+    if rows and not rows[-1].endswith((b"\n", b"\r")):
+        rows[-1] += b"\n"
+    first = blocks[0][0]
+    dropped = {i for start, end in blocks for i in range(start, end)}
+    return b"".join([*lines[: first + 1], *rows, *(line for i, line in enumerate(lines) if i > first and i not in dropped)])
+
+
+def _refuse_unapplied(keyword: bytes, line: bytes, data: list[bytes], label: str) -> None:
+    """Refuse a keyword that makes, copies or moves nodes or elements, which meshio ignores."""
+    if keyword in _ABAQUS_GENERATED:
+        raise UnsupportedFormatError(
+            f"{label} {_ABAQUS_GENERATED[keyword]} with *{keyword.decode()}, which this reader does not apply; "
+            "export the deck with every node and element written out (*NODE and *ELEMENT data)",
+            keyword=keyword.decode(),
+        )
+    if keyword == b"NODE":
+        system = _ABAQUS_SYSTEM.search(line.partition(b",")[2])
+        if system and system.group("system").upper() != b"R":
+            raise UnsupportedFormatError(
+                f"{label} gives node coordinates in another system than Cartesian (*NODE, SYSTEM="
+                f"{system.group('system').decode('latin-1')[:8]}), which this reader does not convert; "
+                "export them in Cartesian coordinates",
+                keyword="NODE",
+            )
+    if keyword == b"INSTANCE":
+        placement = [row for row in data if row.strip() and not row.startswith(b"**")]
+        try:
+            still = len(placement) <= 1 and all(float(v) == 0.0 for row in placement for v in row.split(b",") if v.strip())
+        except ValueError:
+            still = False
+        if not still:
+            raise UnsupportedFormatError(
+                f"{label} places a part instance (a translation or rotation under *INSTANCE), which this reader "
+                "does not apply; export the assembly flattened (without *PART and *INSTANCE)",
+                keyword="INSTANCE",
+            )
 
 
 def _meshio_failure(
