@@ -64,7 +64,14 @@ def analyze(
     if isinstance(source, (bytearray, memoryview)):
         source = bytes(source)
     if isinstance(source, (bytes, str, os.PathLike)):
-        loaded = load_body(source, filename=filename, format=options.format, units=options.units, isotopes=options.isotopes)
+        loaded = load_body(
+            source,
+            filename=filename,
+            format=options.format,
+            units=options.units,
+            isotopes=options.isotopes,
+            companions_beside=not isinstance(source, bytes),  # a path on the caller's own disk: its .bin, .h5, includes
+        )
     else:
         loaded = _loaded_from_arrays(source, filename, options.units)
     return analyze_loaded(loaded, options, start)

@@ -5,12 +5,13 @@ from __future__ import annotations
 import os
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, replace
+from urllib.parse import unquote
 
 from ..body import Body, BrepBody, MeshBody, Part, PointBody, VolumeBody, stored_eps
 from ..conventions import length_scale
-from ..errors import EmptyGeometryError, UnreadableFileError
+from ..errors import EmptyGeometryError, ExternalReferenceError, UnreadableFileError
 from ..vocabulary import Isotopes, MassUnit, SourceKind, UnitsFrom
-from .guard import check_upload
+from .guard import check_upload, plain_name
 from .sniff import CAD_FORMATS, FORMATS, POINT_FORMATS, SCENE_FORMATS, SURFACE_FORMATS, VOLUME_FORMATS, sniff_format
 from .upload import pick_model_file, unpack_zip
 
@@ -53,6 +54,7 @@ def load_body(
     format: str | None = None,
     units: str | None = None,
     isotopes: str = Isotopes.STANDARD,
+    companions_beside: bool = False,
 ) -> Loaded:
     """Read a mesh or points file into bodies in file units.
 
@@ -65,6 +67,11 @@ def load_body(
         and nothing outside the upload is ever opened.
     isotopes : masses of atoms named by element (XYZ, points files): "standard"
         atomic weights or the most "abundant" isotope.
+    companions_beside : for a path, also read the files the model names (a
+        glTF's buffers, an XDMF's HDF5 file, an Abaqus include) from the
+        model's own folder, where they are named by a plain file name: what a
+        user's own files on their own disk need.  Off by default, and never
+        set by the server, whose uploads name nothing outside themselves.
     """
     if not isinstance(source, (bytes, bytearray, memoryview, str, os.PathLike)):
         return _load_files(list(source), format, units, isotopes)
@@ -81,6 +88,8 @@ def load_body(
                 raise UnreadableFileError(f"cannot open {path!r}: {exc.strerror}") from exc
             _refuse_lfs_pointer(raw[:64], filename)
             return _load_files(unpack_zip(raw), inner_format, units, isotopes)
+        if companions_beside:
+            return _load_beside(path, filename, format, units, isotopes)
         return _load_path(path, filename, format, units, isotopes)
     data = source if isinstance(source, bytes) else bytes(source)  # bytearray, memoryview
     if (filename or "").lower().endswith(".zip") or zipped:
@@ -96,6 +105,64 @@ def _load_files(files: list[tuple[str, bytes]], format: str | None, units: str |
     main, companions = pick_model_file(files, format)
     data = dict(files)[main]
     return _load_bytes(bytes(data), os.path.basename(main), format, units, isotopes, companions)
+
+
+MAX_COMPANIONS_BESIDE = 256  # files one model may name from its folder (a glTF's buffers, an Abaqus deck's includes)
+
+
+def _load_beside(path: str, filename: str, format: str | None, units: str | None, isotopes: str) -> Loaded:
+    """A file on disk with the files it names, read from its own folder (plain names only).
+
+    The guard that refuses an upload's references names the first one missing; each is read from the
+    model's folder and the model read again, until nothing is missing.
+    """
+    folder = os.path.dirname(os.path.abspath(path))
+    companions: dict[str, bytes] = {}
+    while True:
+        try:
+            if not companions:
+                return _load_path(path, filename, format, units, isotopes)
+            try:
+                with open(path, "rb") as fh:
+                    data = fh.read()
+            except OSError as exc:
+                raise UnreadableFileError(f"cannot open {path!r}: {exc.strerror}") from exc
+            return _load_bytes(data, filename, format, units, isotopes, companions)
+        except ExternalReferenceError as exc:
+            name = str(exc.details.get("reference", ""))
+            found = _companion_beside(folder, name) if name not in companions else None
+            if found is None or len(companions) >= MAX_COMPANIONS_BESIDE:
+                raise _missing_beside(exc, name, filename) from None
+            companions[name] = found
+            companions.setdefault(unquote(name), found)
+
+
+def _companion_beside(folder: str, name: str) -> bytes | None:
+    """The bytes of ``name`` in ``folder`` if it is a plain file name (as written, or URI-decoded) of a file there."""
+    for candidate in dict.fromkeys((name, unquote(name))):
+        if not plain_name(candidate):
+            continue
+        try:
+            with open(os.path.join(folder, candidate), "rb") as fh:
+                return fh.read()
+        except OSError:
+            continue
+    return None
+
+
+def _missing_beside(exc: ExternalReferenceError, name: str, filename: str) -> ExternalReferenceError:
+    fmt = str(exc.details.get("format", "")) or "model"
+    where = (
+        "which is not in the file's folder: keep the files it names beside it"
+        if plain_name(unquote(name))
+        else "a path or URL: only files named by a plain file name, beside the model, are read"
+    )
+    kind = str(exc.details.get("reference_kind", "")) or "reference"
+    return ExternalReferenceError(
+        f"{filename!r}, a {fmt.upper()} file, refers to another file ({kind} {name[:120]!r}), {where} "
+        "(or send the model and its files together in one .zip)",
+        **exc.details,
+    )
 
 
 def _load_path(path: str, filename: str, format: str | None, units: str | None, isotopes: str = Isotopes.STANDARD) -> Loaded:

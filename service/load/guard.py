@@ -42,10 +42,19 @@ from collections.abc import Callable, Collection, Iterator
 from dataclasses import dataclass
 from pathlib import PurePosixPath, PureWindowsPath
 from typing import Any
+from urllib.parse import unquote
 
 from ..errors import ExternalReferenceError, InputTooLargeError, UnreadableFileError
 
-__all__ = ["check_upload", "inflate_budget", "INFLATE_RATIO", "INFLATE_FLOOR_BYTES", "MAX_INFLATED_BYTES", "MAX_JSON_DEPTH"]
+__all__ = [
+    "check_upload",
+    "plain_name",
+    "inflate_budget",
+    "INFLATE_RATIO",
+    "INFLATE_FLOOR_BYTES",
+    "MAX_INFLATED_BYTES",
+    "MAX_JSON_DEPTH",
+]
 
 MIB = 1024 * 1024
 # deflate cannot exceed ~1032:1; real mesh files (3MF XML, VTU float blocks) compress 3-20:1,
@@ -83,17 +92,19 @@ class _Context:
     def reference(self, target: str, what: str) -> None:
         """Accept a referenced file only if it is a plain name that came in the same upload."""
         name = target.strip().strip("'\"")
-        if _plain_name(name) and name in self.companions:
+        if plain_name(name) and name in self.companions:
             return
         raise ExternalReferenceError(
             f"the {self.fmt.upper()} file refers to another file ({what} {name[:120]!r}); the server never "
             "opens files named by an upload: send the referenced file in the same upload, or a self-contained file",
             format=self.fmt,
             reference=name[:200],
+            reference_kind=what,
         )
 
 
-def _plain_name(name: str) -> bool:
+def plain_name(name: str) -> bool:
+    """A file's own name: no folder (either separator), no drive or scheme, not '.' or '..'."""
     if not name or ":" in name or name in (".", ".."):
         return False
     return PurePosixPath(name).name == name and PureWindowsPath(name).name == name
@@ -382,14 +393,23 @@ def _depth_exceeds(doc: Any, limit: int) -> bool:
 
 
 def _check_gltf_uris(doc: Any, ctx: _Context) -> None:
+    """Every external buffer must have come in the upload; an image only has to be a plain file name.
+
+    Images carry no geometry: the reader skips materials, and its resolver holds only the upload's files,
+    so a texture that did not come along is neither needed nor looked for.  An image named by a path or a
+    URL is refused all the same, as any other reference out of the upload is.
+    """
     if not isinstance(doc, dict):
         raise UnreadableFileError(f"the {ctx.fmt.upper()} file's JSON is not an object", format=ctx.fmt)
     for key in ("buffers", "images"):
         entries = doc.get(key)
         for entry in entries if isinstance(entries, list) else ():
             uri = entry.get("uri") if isinstance(entry, dict) else None
-            if isinstance(uri, str) and not uri.startswith("data:"):
-                ctx.reference(uri, f"{key[:-1]} uri")
+            if not isinstance(uri, str) or uri.startswith("data:"):
+                continue
+            if key == "images" and plain_name(unquote(uri.strip())):
+                continue
+            ctx.reference(uri, f"{key[:-1]} uri")
 
 
 def _check_gltf(data: bytes, ctx: _Context) -> None:

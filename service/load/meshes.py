@@ -97,9 +97,9 @@ def read_trimesh_parts(
     import trimesh
 
     notes = _check_gltf_document(data, fmt) if fmt in ("gltf", "glb") else []
-    kwargs: dict[str, Any] = {}
-    if companions:
-        kwargs["resolver"] = trimesh.resolvers.ZipResolver(dict(companions))
+    # the upload's own files, and nothing else: a name outside them (a texture that did not come along, a path)
+    # is not found, never looked for on disk; images are not needed for the geometry (skip_materials)
+    kwargs: dict[str, Any] = {"resolver": trimesh.resolvers.ZipResolver(dict(companions or {}))}
     scene = guarded_read(
         lambda: _same_names_every_read(
             lambda: trimesh.load_scene(
