@@ -38,11 +38,11 @@ def weigh(deck: str) -> tuple[float, list[float]]:
         f"*HEADING\n*NODE\n{CORNER_TET}*ELEMENT, TYPE=C3D4, ELSET=A\n1, 1, 2, 3, 4\n"
         f"*NODE, NSET=FAR\n{FAR_TET}*ELEMENT, TYPE=C3D4, ELSET=B\n2, 5, 6, 7, 8\n",
         # both node blocks first: meshio failed on node id 1
-        f"*HEADING\n*NODE\n{CORNER_TET}** a comment between\n*Node\n{FAR_TET}"
-        "*ELEMENT, TYPE=C3D4\n1, 1, 2, 3, 4\n2, 5, 6, 7, 8\n",
+        f"*HEADING\n*NODE\n{CORNER_TET}** a comment between\n*Node\n{FAR_TET}*ELEMENT, TYPE=C3D4\n1, 1, 2, 3, 4\n2, 5, 6, 7, 8\n",
         # Windows line ends, the last line without one
-        (f"*HEADING\n*NODE\n{CORNER_TET}*ELEMENT, TYPE=C3D4\n1, 1, 2, 3, 4\n*NODE\n{FAR_TET}*ELEMENT, TYPE=C3D4\n2, 5, 6, 7, 8")
-        .replace("\n", "\r\n"),
+        (
+            f"*HEADING\n*NODE\n{CORNER_TET}*ELEMENT, TYPE=C3D4\n1, 1, 2, 3, 4\n*NODE\n{FAR_TET}*ELEMENT, TYPE=C3D4\n2, 5, 6, 7, 8"
+        ).replace("\n", "\r\n"),
     ],
     ids=["interleaved", "nodes-first", "crlf"],
 )
