@@ -54,11 +54,17 @@ def analyze(
     *,
     filename: str | None = None,
     options: AnalysisOptions = AnalysisOptions(),
+    companions_beside: bool = True,
 ) -> AnalysisResult:
     """Analyse a mesh or points file (bytes, or a path), a ``trimesh.Trimesh``, or ``(vertices, faces)`` arrays.
 
     Arrays and mesh objects are in ``options.units`` (default metres): vertices (n, 3), faces (m, 3) of
     vertex indices, a closed surface wound either way.
+
+    companions_beside : for a path, read the files the model names (a glTF's ``.bin``, an Abaqus include,
+        an XDMF's ``.h5``) from the model's own folder, by plain file name, as its own tools do.  Turn it off
+        for a file that is not your own, such as an upload saved in a shared folder: then a model reads only
+        what is inside it (``load_body``).
     """
     start = time.perf_counter()
     if isinstance(source, (bytearray, memoryview)):
@@ -70,7 +76,7 @@ def analyze(
             format=options.format,
             units=options.units,
             isotopes=options.isotopes,
-            companions_beside=not isinstance(source, bytes),  # a path on the caller's own disk: its .bin, .h5, includes
+            companions_beside=companions_beside and not isinstance(source, bytes),
         )
     else:
         loaded = _loaded_from_arrays(source, filename, options.units)

@@ -129,7 +129,9 @@ def _load_beside(path: str, filename: str, format: str | None, units: str | None
                 raise UnreadableFileError(f"cannot open {path!r}: {exc.strerror}") from exc
             return _load_bytes(data, filename, format, units, isotopes, companions)
         except ExternalReferenceError as exc:
-            name = str(exc.details.get("reference", ""))
+            if "reference" not in exc.details:  # not a file that could be beside the model (a <!DOCTYPE>, ...)
+                raise
+            name = str(exc.details["reference"])
             found = _companion_beside(folder, name) if name not in companions else None
             if found is None or len(companions) >= MAX_COMPANIONS_BESIDE:
                 raise _missing_beside(exc, name, filename) from None

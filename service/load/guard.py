@@ -49,6 +49,7 @@ from ..errors import ExternalReferenceError, InputTooLargeError, UnreadableFileE
 __all__ = [
     "check_upload",
     "plain_name",
+    "refuse_reference",
     "inflate_budget",
     "INFLATE_RATIO",
     "INFLATE_FLOOR_BYTES",
@@ -101,6 +102,18 @@ class _Context:
             reference=name[:200],
             reference_kind=what,
         )
+
+
+def refuse_reference(fmt: str, target: str, what: str, companions: Collection[str]) -> None:
+    """Refuse ``target`` unless it is a plain file name among ``companions`` (for readers that find references late)."""
+    _Context(fmt, frozenset(companions), 0).reference(target, what)
+
+
+def _relative_within(name: str) -> bool:
+    """A relative path that stays below its folder: no scheme or drive, no root, no '..' step."""
+    if not name or ":" in name or name.startswith(("/", "\\")):
+        return False
+    return ".." not in PurePosixPath(name.replace("\\", "/")).parts
 
 
 def plain_name(name: str) -> bool:
@@ -393,11 +406,12 @@ def _depth_exceeds(doc: Any, limit: int) -> bool:
 
 
 def _check_gltf_uris(doc: Any, ctx: _Context) -> None:
-    """Every external buffer must have come in the upload; an image only has to be a plain file name.
+    """Every external buffer must have come in the upload; an image only has to stay below the model's folder.
 
     Images carry no geometry: the reader skips materials, and its resolver holds only the upload's files,
-    so a texture that did not come along is neither needed nor looked for.  An image named by a path or a
-    URL is refused all the same, as any other reference out of the upload is.
+    so a texture that did not come along (``textures/wood.png``) is neither needed nor looked for.  An image
+    named by a URL, an absolute path or one that climbs out with ``..`` is refused all the same, as any
+    other reference out of the upload is.
     """
     if not isinstance(doc, dict):
         raise UnreadableFileError(f"the {ctx.fmt.upper()} file's JSON is not an object", format=ctx.fmt)
@@ -407,7 +421,7 @@ def _check_gltf_uris(doc: Any, ctx: _Context) -> None:
             uri = entry.get("uri") if isinstance(entry, dict) else None
             if not isinstance(uri, str) or uri.startswith("data:"):
                 continue
-            if key == "images" and plain_name(unquote(uri.strip())):
+            if key == "images" and _relative_within(unquote(uri.strip())):
                 continue
             ctx.reference(uri, f"{key[:-1]} uri")
 

@@ -73,7 +73,8 @@ from numpy.typing import NDArray
 
 from ..body import CellBlock, MeshBody, Part, VolumeBody, stored_eps
 from ..cells import CELL_NODES, VOXEL_TO_HEXAHEDRON
-from ..errors import EmptyGeometryError, UnreadableFileError, UnsupportedFormatError
+from ..errors import EmptyGeometryError, InputTooLargeError, UnreadableFileError, UnsupportedFormatError
+from .guard import INFLATE_RATIO, inflate_budget, refuse_reference
 from .polygons import fan_split_note, fan_triangles
 from .sniff import VOLUME_FORMATS
 
@@ -680,10 +681,11 @@ def _read_meshio(data: bytes, fmt: str, label: str, filename: str | None, compan
         for key, dim in _MESHIO_MISSING_DIMENSIONS.items():
             table.setdefault(key, dim)
 
-    if fmt == "inp":
-        _admit_abaqus_types([data, *(companions or {}).values()], label)
+    if fmt == "inp":  # one deck, as Abaqus reads it: meshio then opens no other file
+        data = abaqus_flatten(data, companions or {}, label)
+        _admit_abaqus_types([data], label)
         data = abaqus_one_node_block(data, label)
-        companions = {k: abaqus_one_node_block(v, k) if k.lower().endswith(".inp") else v for k, v in (companions or {}).items()}
+        companions = None
 
     with _upload_dir(data, fmt, filename, companions) as path, _quiet() as printed:
         try:
@@ -801,6 +803,60 @@ def _abaqus_keyword(line: bytes) -> bytes | None:
     return line.partition(b",")[0].strip().lstrip(b"*").replace(b" ", b"").upper()
 
 
+_ABAQUS_INPUT_PARAMETER = re.compile(rb",[ \t]*input[ \t]*=[ \t]*(?P<name>[^,\r\n]*)", re.IGNORECASE)
+MAX_INCLUDE_DEPTH = 16
+
+
+def abaqus_flatten(data: bytes, companions: Mapping[str, bytes], label: str) -> bytes:
+    """The deck with each file it reads written in its place, as Abaqus reads it.
+
+    ``*INCLUDE, INPUT=name`` is replaced by the named file's lines, and a
+    keyword that reads its data lines from a file (``*NODE, INPUT=name``)
+    is followed by them; includes in included files too.  meshio read an
+    included file as a mesh of its own, merged before the node table that
+    the deck's next ``*NODE`` then replaced (an included tetrahedron came
+    back as the deck's own), and looked for the file in the process's
+    working directory first.  Every name must be one of ``companions`` (the
+    upload's own files; on the caller's disk, the files beside the model,
+    see ``load_body``); the result is bounded by the upload's inflation
+    budget, so a file that includes itself or others many times is refused.
+    """
+    budget = inflate_budget(len(data) + sum(len(v) for v in companions.values()))
+    out: list[bytes] = []
+    total = 0
+
+    def expand(text: bytes, depth: int) -> None:
+        nonlocal total
+        if depth > MAX_INCLUDE_DEPTH:
+            raise UnreadableFileError(
+                f"{label}'s includes nest more than {MAX_INCLUDE_DEPTH} deep (does a file include itself?)", format="inp"
+            )
+        for line in text.splitlines(keepends=True):
+            keyword = _abaqus_keyword(line)
+            m = _ABAQUS_INPUT_PARAMETER.search(line) if keyword is not None else None
+            if m is not None:
+                name = m.group("name").strip().strip(b"'\"").decode("utf-8", "replace")
+                refuse_reference("inp", name, "INPUT=", companions)
+                if keyword != b"INCLUDE":  # the keyword stays; its data lines come from the file
+                    line = line[: m.start()] + line[m.end() :]
+                    out.append(line if line.endswith((b"\n", b"\r")) else line + b"\n")
+                content = companions[name]
+                expand(content if content.endswith((b"\n", b"\r")) else content + b"\n", depth + 1)
+                continue
+            out.append(line)
+            total += len(line)
+            if total > budget:
+                raise InputTooLargeError(
+                    f"{label}'s includes expand to more than {budget} bytes; at most {INFLATE_RATIO} times the "
+                    "size of its files is accepted",
+                    limit_bytes=budget,
+                    format="inp",
+                )
+
+    expand(data, 0)
+    return b"".join(out)
+
+
 def abaqus_one_node_block(data: bytes, label: str) -> bytes:
     """The deck with every ``*NODE`` block's data in its first one, as meshio needs; refuse what it would misread.
 
@@ -830,12 +886,15 @@ def abaqus_one_node_block(data: bytes, label: str) -> bytes:
     if len(blocks) < 2:
         return data
     rows = [line for start, end in blocks for line in lines[start + 1 : end] if line.strip() and not line.startswith(b"**")]
-    seen: set[bytes] = set()
+    seen: set[int] = set()
     for row in rows:
-        node = row.partition(b",")[0].strip()
+        try:
+            node = int(row.partition(b",")[0])  # as meshio reads it: 01 and 1 are one node
+        except ValueError:
+            continue  # not a node id: meshio says so
         if node in seen:
             raise UnsupportedFormatError(
-                f"{label} defines node {node.decode('latin-1')[:20]} in two *NODE blocks (as the parts of an assembly "
+                f"{label} defines node {node} in two *NODE blocks (as the parts of an assembly "
                 "number their nodes each from 1); export the model flattened, with one numbering",
                 keyword="NODE",
             )
@@ -845,6 +904,14 @@ def abaqus_one_node_block(data: bytes, label: str) -> bytes:
     first = blocks[0][0]
     dropped = {i for start, end in blocks for i in range(start, end)}
     return b"".join([*lines[: first + 1], *rows, *(line for i, line in enumerate(lines) if i > first and i not in dropped)])
+
+
+def _all_zero(rows: list[bytes]) -> bool:
+    """Whether every number on the data lines ``rows`` (comments aside) is zero; False if one is not a number."""
+    try:
+        return all(float(v) == 0.0 for row in rows if not row.startswith(b"**") for v in row.split(b",") if v.strip())
+    except ValueError:
+        return False
 
 
 def _refuse_unapplied(keyword: bytes, line: bytes, data: list[bytes], label: str) -> None:
@@ -864,13 +931,15 @@ def _refuse_unapplied(keyword: bytes, line: bytes, data: list[bytes], label: str
                 "export them in Cartesian coordinates",
                 keyword="NODE",
             )
+    if keyword == b"SYSTEM" and not _all_zero(data):
+        raise UnsupportedFormatError(
+            f"{label} sets a local coordinate system for the nodes after it (*SYSTEM), which this reader does not "
+            "apply; export the node coordinates in the global system",
+            keyword="SYSTEM",
+        )
     if keyword == b"INSTANCE":
         placement = [row for row in data if row.strip() and not row.startswith(b"**")]
-        try:
-            still = len(placement) <= 1 and all(float(v) == 0.0 for row in placement for v in row.split(b",") if v.strip())
-        except ValueError:
-            still = False
-        if not still:
+        if len(placement) > 1 or not _all_zero(placement):
             raise UnsupportedFormatError(
                 f"{label} places a part instance (a translation or rotation under *INSTANCE), which this reader "
                 "does not apply; export the assembly flattened (without *PART and *INSTANCE)",

@@ -10,11 +10,13 @@ centroid the mean of their corners.
 from __future__ import annotations
 
 from fractions import Fraction
+from pathlib import Path
 
 import pytest
 
-from inertia.errors import UnsupportedFormatError
-from inertia.pipeline import analyze
+from inertia.errors import ExternalReferenceError, InputTooLargeError, UnreadableFileError, UnsupportedFormatError
+from inertia.load import load_body
+from inertia.pipeline import AnalysisOptions, analyze, analyze_loaded
 
 CORNER_TET = "1, 0, 0, 0\n2, 1, 0, 0\n3, 0, 1, 0\n4, 0, 0, 1\n"  # volume 1/6, centroid (1/4, 1/4, 1/4)
 FAR_TET = "5, 10, 0, 0\n6, 12, 0, 0\n7, 10, 2, 0\n8, 10, 0, 2\n"  # volume 8/6, centroid (10.5, 0.5, 0.5)
@@ -86,3 +88,74 @@ def test_a_placed_instance_is_refused_an_unplaced_one_read() -> None:
         weigh(part + "*INSTANCE, NAME=I, PART=P\n*END INSTANCE\n*INSTANCE, NAME=J, PART=P\n*END INSTANCE\n*END ASSEMBLY\n")
     volume, centre = weigh(part + "*INSTANCE, NAME=I, PART=P\n0., 0., 0.\n*END INSTANCE\n*END ASSEMBLY\n")
     assert volume == pytest.approx(1 / 6, rel=1e-14) and centre == pytest.approx([0.25] * 3, rel=1e-14)
+
+
+BIG_TET = "1, 0, 0, 0\n2, 3, 0, 0\n3, 0, 3, 0\n4, 0, 0, 3\n*ELEMENT, TYPE=C3D4\n1, 1, 2, 3, 4\n"  # volume 27/6
+
+
+def upload(main: str, **files: str) -> tuple[float, list[float]]:
+    """The deck and its companions as one upload, read as the server reads it."""
+    parts = [("deck.inp", main.encode()), *((name.replace("_", "."), text.encode()) for name, text in files.items())]
+    doc = analyze_loaded(load_body(parts), AnalysisOptions()).as_dict()
+    return doc["mass"] / doc["density"], doc["center_of_mass"]
+
+
+def test_an_include_is_read_in_its_place_before_the_decks_own_nodes() -> None:
+    # meshio merged the included tetrahedron, then replaced the node table at the deck's own *NODE: the deck's
+    # tetrahedron came back twice (1/3 for 27/6 + 1/6)
+    volume, centre = upload(
+        f"*HEADING\n*INCLUDE, INPUT=part.inc\n*NODE\n{FAR_TET}*ELEMENT, TYPE=C3D4\n9, 5, 6, 7, 8\n", part_inc=f"*NODE\n{BIG_TET}"
+    )
+    assert volume == pytest.approx(27 / 6 + 8 / 6, rel=1e-14)
+    assert centre[0] == pytest.approx((27 / 6 * 0.75 + 8 / 6 * 10.5) / (35 / 6), rel=1e-14)
+
+
+def test_included_node_data_and_nested_includes_of_any_name() -> None:
+    # *NODE, INPUT= reads the block's data lines from the file; an include may include others; names need not end in .inp
+    volume, _ = upload(
+        "*NODE, INPUT=nodes.txt\n*INCLUDE, INPUT=more.inc\n",
+        nodes_txt=CORNER_TET,
+        more_inc="*ELEMENT, TYPE=C3D4\n1, 1, 2, 3, 4\n*INCLUDE, INPUT=far.inc\n",
+        far_inc=f"*NODE\n{FAR_TET}*ELEMENT, TYPE=C3D4\n2, 5, 6, 7, 8\n",
+    )
+    assert volume == pytest.approx(9 / 6, rel=1e-14)
+
+
+def test_a_path_named_in_an_included_file_is_refused(tmp_path: Path) -> None:
+    secret = tmp_path / "secret.inp"
+    secret.write_text(f"*NODE\n{BIG_TET}", encoding="utf-8")
+    with pytest.raises(ExternalReferenceError, match="never opens files named by an upload"):
+        upload("*HEADING\n*INCLUDE, INPUT=a_inc\n", a_inc=f"*INCLUDE, INPUT={secret}\n")
+
+
+def test_the_working_directory_does_not_shadow_an_uploaded_include(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    (tmp_path / "a.inc").write_text(f"*NODE\n{BIG_TET}", encoding="utf-8")  # meshio looked here first
+    monkeypatch.chdir(tmp_path)
+    volume, _ = upload("*HEADING\n*INCLUDE, INPUT=a.inc\n", a_inc=f"*NODE\n{CORNER_TET}*ELEMENT, TYPE=C3D4\n1, 1, 2, 3, 4\n")
+    assert volume == pytest.approx(1 / 6, rel=1e-14)
+
+
+def test_an_include_that_includes_itself_is_refused() -> None:
+    with pytest.raises((UnreadableFileError, InputTooLargeError)):
+        upload("*INCLUDE, INPUT=loop_inc\n", loop_inc="*INCLUDE, INPUT=loop_inc\n*INCLUDE, INPUT=loop_inc\n")
+
+
+def test_a_local_system_for_the_nodes_is_refused() -> None:
+    with pytest.raises(UnsupportedFormatError, match="\\*SYSTEM"):
+        weigh(f"*SYSTEM\n100., 0., 0.\n*NODE\n{CORNER_TET}*ELEMENT, TYPE=C3D4\n1, 1, 2, 3, 4\n")
+
+
+def test_node_ids_are_compared_as_numbers() -> None:
+    deck = f"*NODE\n{CORNER_TET}*ELEMENT, TYPE=C3D4\n1, 1, 2, 3, 4\n*NODE\n01, 5, 5, 5\n"
+    with pytest.raises(UnsupportedFormatError, match="node 1 in two"):
+        weigh(deck)
+
+
+def test_the_caller_reads_nested_includes_beside_the_deck(tmp_path: Path) -> None:
+    (tmp_path / "a.inp").write_text("*INCLUDE, INPUT=b.inp\n", encoding="utf-8")
+    (tmp_path / "b.inp").write_text(f"*NODE\n{CORNER_TET}*ELEMENT, TYPE=C3D4\n1, 1, 2, 3, 4\n", encoding="utf-8")
+    (tmp_path / "deck.inp").write_text("*HEADING\n*INCLUDE, INPUT=a.inp\n", encoding="utf-8")
+    doc = analyze(tmp_path / "deck.inp").as_dict()
+    assert doc["mass"] / doc["density"] == pytest.approx(1 / 6, rel=1e-14)
+    with pytest.raises(ExternalReferenceError):
+        analyze(tmp_path / "deck.inp", companions_beside=False)

@@ -120,3 +120,17 @@ def test_an_abaqus_deck_reads_the_include_beside_it(tmp_path: Path) -> None:
     assert doc["center_of_mass"] == pytest.approx([0.25, 0.25, 0.25], rel=1e-14)
     with pytest.raises(ExternalReferenceError):
         load_body(deck)  # as the server reads an upload
+
+
+def test_a_texture_in_a_subfolder_is_skipped_one_climbing_out_refused(tmp_path: Path) -> None:
+    doc = analyze(write_gltf(tmp_path, images=["textures/box%20wood.png"])).as_dict()
+    assert doc["mass"] == pytest.approx(doc["density"] * VOLUME, rel=1e-14)
+    with pytest.raises(ExternalReferenceError, match="image uri"):
+        analyze(write_gltf(tmp_path, images=["textures/../../box.png"]))
+
+
+def test_a_refusal_that_names_no_file_keeps_its_own_message(tmp_path: Path) -> None:
+    path = tmp_path / "mesh.vtu"
+    path.write_bytes(b'<?xml version="1.0"?>\n<!DOCTYPE x [<!ENTITY e SYSTEM "file:///etc/passwd">]>\n<VTKFile/>\n')
+    with pytest.raises(ExternalReferenceError, match="document type"):
+        analyze(path)
