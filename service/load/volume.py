@@ -865,7 +865,7 @@ def abaqus_one_node_block(data: bytes, label: str) -> bytes:
     (two tetrahedra came back as the second one twice), or the read failed on
     a node id.  Node ids are the deck's own names, so the blocks are joined
     (ids repeated across blocks, as the parts of an assembly number theirs,
-    are refused).  Also refused: node coordinates in a cylindrical or
+    are refused; the assembly's own reference nodes are left out).  Also refused: node coordinates in a cylindrical or
     spherical system, nodes or elements generated or copied from others,
     and more than one part instance or a placed one, none of which meshio
     applies.
@@ -874,7 +874,6 @@ def abaqus_one_node_block(data: bytes, label: str) -> bytes:
     keywords = [_abaqus_keyword(line) for line in lines]
     starts = [i for i, k in enumerate(keywords) if k is not None] + [len(lines)]
     spans = list(itertools.pairwise(starts))  # each keyword line and the end of its data lines
-    blocks = [(i, j) for i, j in spans if keywords[i] == b"NODE"]
     for i, j in spans:
         _refuse_unapplied(keywords[i] or b"", lines[i], lines[i + 1 : j], label)
     if sum(k == b"INSTANCE" for k in keywords) > 1:
@@ -883,8 +882,23 @@ def abaqus_one_node_block(data: bytes, label: str) -> bytes:
             "assembly flattened (without *PART and *INSTANCE)",
             keyword="INSTANCE",
         )
-    if len(blocks) < 2:
+    # nodes of the assembly itself (reference points, between *ASSEMBLY and *END ASSEMBLY outside an instance)
+    # are numbered apart from the parts' nodes and are no solid's corners: left out
+    blocks: list[tuple[int, int]] = []
+    reference_points: list[tuple[int, int]] = []
+    section: dict[bytes, bool] = {b"ASSEMBLY": False, b"INSTANCE": False}
+    for i, j in spans:
+        keyword = keywords[i] or b""
+        for name in section:
+            if keyword in (name, b"END" + name):
+                section[name] = keyword == name
+        if keyword == b"NODE":
+            (reference_points if section[b"ASSEMBLY"] and not section[b"INSTANCE"] else blocks).append((i, j))
+    if len(blocks) < 2 and not reference_points:
         return data
+    if len(blocks) < 2:
+        dropped = {i for start, end in reference_points for i in range(start, end)}
+        return b"".join(line for i, line in enumerate(lines) if i not in dropped)
     rows = [line for start, end in blocks for line in lines[start + 1 : end] if line.strip() and not line.startswith(b"**")]
     seen: set[int] = set()
     for row in rows:
@@ -902,7 +916,7 @@ def abaqus_one_node_block(data: bytes, label: str) -> bytes:
     if rows and not rows[-1].endswith((b"\n", b"\r")):
         rows[-1] += b"\n"
     first = blocks[0][0]
-    dropped = {i for start, end in blocks for i in range(start, end)}
+    dropped = {i for start, end in blocks + reference_points for i in range(start, end)}
     return b"".join([*lines[: first + 1], *rows, *(line for i, line in enumerate(lines) if i > first and i not in dropped)])
 
 

@@ -159,3 +159,14 @@ def test_the_caller_reads_nested_includes_beside_the_deck(tmp_path: Path) -> Non
     assert doc["mass"] / doc["density"] == pytest.approx(1 / 6, rel=1e-14)
     with pytest.raises(ExternalReferenceError):
         analyze(tmp_path / "deck.inp", companions_beside=False)
+
+
+def test_the_assemblys_reference_point_is_no_node_of_the_part() -> None:
+    # as Abaqus/CAE writes a one-part model: the assembly's reference point is numbered 1 in its own namespace
+    deck = (
+        f"*Heading\n*Part, name=P\n*Node\n{CORNER_TET}*Element, type=C3D4\n1, 1, 2, 3, 4\n*End Part\n"
+        "*Assembly, name=A\n*Instance, name=P-1, part=P\n*End Instance\n"
+        "*Node\n      1,   5.,   5.,   5.\n*Nset, nset=RP, internal\n1,\n*End Assembly\n"
+    )
+    volume, centre = weigh(deck)
+    assert volume == pytest.approx(1 / 6, rel=1e-14) and centre == pytest.approx([0.25] * 3, rel=1e-14)
