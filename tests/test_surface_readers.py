@@ -310,12 +310,23 @@ def test_gltf_mirrored_node_is_read_outward() -> None:
     assert not any("winding" in w for w in res["warnings"])
 
 
+def _draco_without_fallback(doc: dict[str, Any]) -> None:
+    """Draco used but not required, and no uncompressed positions: read without it, every corner is at 0."""
+    doc["extensionsUsed"] = ["KHR_draco_mesh_compression"]
+    prim = doc["meshes"][0]["primitives"][0]
+    doc["meshes"][0]["name"] = "box"
+    prim["extensions"] = {"KHR_draco_mesh_compression": {"bufferView": 0, "attributes": {"POSITION": 0}}}
+    doc["accessors"][prim["attributes"]["POSITION"]].pop("bufferView")
+
+
 @pytest.mark.parametrize(
     "change, words",
     [
         (lambda d: d["accessors"][d["meshes"][0]["primitives"][0]["attributes"]["POSITION"]].update(sparse={"count": 1}), "sparse"),
         (lambda d: d["meshes"][0]["primitives"][0].update(mode=6), "triangle fan"),
-        (lambda d: d.update(extensionsRequired=["KHR_draco_mesh_compression"]), "KHR_draco_mesh_compression"),
+        (lambda d: d.update(extensionsRequired=["KHR_draco_mesh_compression"]), "(Draco mesh compression)"),
+        (lambda d: d.update(extensionsRequired=["ACME_gizmo"]), "ACME_gizmo, which this service does not decode;"),
+        (_draco_without_fallback, "mesh 'box' only with KHR_draco_mesh_compression"),
         (lambda d: d["meshes"][0].update(weights=[0.5]), "morph"),
         (lambda d: [n.update(skin=0) for n in d["nodes"] if "mesh" in n], "skinned"),
     ],

@@ -28,6 +28,13 @@ from .safe import guarded_read
 __all__ = ["read_trimesh_parts", "read_surface_parts", "mesh_part"]
 
 # glTF extensions that change nothing in the geometry we read (materials, textures, lights, metadata)
+# extensions that store the geometry itself in another form (glTF extension registry)
+_GEOMETRY_EXTENSIONS = {
+    "KHR_draco_mesh_compression": "Draco mesh compression",
+    "EXT_meshopt_compression": "meshopt compression",
+    "KHR_meshopt_compression": "meshopt compression",
+    "KHR_mesh_quantization": "quantized geometry",
+}
 _HARMLESS_GLTF_EXTENSIONS = ("KHR_materials_", "KHR_texture_", "KHR_lights_", "KHR_xmp", "KHR_animation_pointer", "EXT_texture_")
 
 
@@ -276,9 +283,11 @@ def _check_gltf_document(data: bytes, fmt: str) -> list[str]:
         else []
     )
     if unknown:
+        kinds = sorted({_GEOMETRY_EXTENSIONS[e] for e in unknown if e in _GEOMETRY_EXTENSIONS})
         raise refuse(
-            f"requires the extension(s) {', '.join(unknown)}, which this service does not decode "
-            "(compressed or quantized geometry); export it without mesh compression",
+            f"requires the extension(s) {', '.join(unknown)}, which this service does not decode"
+            + (f" ({', '.join(kinds)})" if kinds else "")
+            + "; export it without them",
             extensions=unknown,
         )
     accessors: list[Any] = doc["accessors"] if isinstance(doc.get("accessors"), list) else []
@@ -308,7 +317,24 @@ def _check_gltf_document(data: bytes, fmt: str) -> list[str]:
                     f"stores mesh {label!r} as a triangle fan (mode 6), which this service does not read; export it as triangles"
                 )
             attrs: dict[str, Any] = prim["attributes"] if isinstance(prim.get("attributes"), dict) else {}
-            for key in (attrs.get("POSITION"), prim.get("indices")):
+            position = attrs.get("POSITION")
+            compressed = [e for e in (prim.get("extensions") or {}) if e in _GEOMETRY_EXTENSIONS]
+            if (
+                compressed
+                and isinstance(position, int)
+                and 0 <= position < len(accessors)
+                and isinstance(accessors[position], dict)
+                and "bufferView" not in accessors[position]
+            ):
+                # an optional extension whose uncompressed fallback is absent: read without it, the positions are
+                # all zero (an accessor without a buffer view, section 3.6.2.3), and the mesh would seem flat
+                raise refuse(
+                    f"stores mesh {label!r} only with {', '.join(compressed)} "
+                    f"({', '.join(sorted({_GEOMETRY_EXTENSIONS[e] for e in compressed}))}), which this service does "
+                    "not decode; export it without mesh compression",
+                    extensions=compressed,
+                )
+            for key in (position, prim.get("indices")):
                 if (
                     isinstance(key, int)
                     and 0 <= key < len(accessors)
