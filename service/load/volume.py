@@ -212,6 +212,13 @@ def read_volume_parts(
     companions : other files of the same upload by name (a TetGen ``.node``
         beside its ``.ele``, an XDMF's HDF5 file), written beside it for the reader.
     """
+    if fmt == "mesh" and data.lstrip()[:4].upper() == b"MFEM":  # the other format named .mesh: not Medit's
+        raise UnsupportedFormatError(
+            f"{repr(os.path.basename(filename)) if filename else 'the file'} is an MFEM mesh (its first line says so), "
+            "not a Medit one, and this service "
+            "does not read MFEM's format; convert it to VTK (.vtu) or Gmsh (.msh), e.g. with MFEM's own mesh tools",
+            format=fmt,
+        )
     if fmt == "inp" and is_avs_ucd(data):  # the other format named .inp: VTK reads it, meshio would take it for Abaqus
         label = _label(filename, "ucd")
         mesh = _read_vtk(data, "ucd", label)

@@ -440,3 +440,10 @@ def test_alternating_cell_types_make_one_part_per_type(tmp_path: Path) -> None:
     assert [p.name for p in loaded.parts] == ["tetra_0", "hexahedron_1"]
     expected = sum(rho * (1.0 if ctype == 12 else 1 / 6) for (ctype, _), rho in zip(cells, density))
     assert assembly_properties([(meshed(p.body), None) for p in loaded.parts]).mass == pytest.approx(expected, rel=1e-14)
+
+
+def test_an_mfem_mesh_is_named_as_such_not_misread_as_medit() -> None:
+    # MFEM's format shares the .mesh extension with Medit's; meshio answered "Unknown keyword 'MFEM'"
+    data = b"MFEM mesh v1.0\n\ndimension\n3\n\nelements\n1\n1 4 0 1 2 3\n"
+    with pytest.raises(UnsupportedFormatError, match="is an MFEM mesh"):
+        analyze(data, filename="beam-tet.mesh")
