@@ -23,7 +23,7 @@ from numpy.typing import NDArray
 from .body import BrepBody
 from .classification import Classification, classify
 from .conventions import length_scale
-from .errors import InvalidParameterError
+from .errors import DegenerateBodyError, InvalidParameterError
 from .load import Loaded, load_body, load_points
 from .mass import InertiaTensor, MassProperties, Model, assembly_properties, mass_properties
 from .options import METHODS, AnalysisOptions
@@ -373,9 +373,15 @@ def _part(name: str, body: Any, options: AnalysisOptions, single: bool) -> PartR
 
         props = brep_mass_properties(body, density=None if mass is not None else density, mass=mass, model=options.model)
     else:
-        props = mass_properties(
-            body, density=None if mass is not None else density, mass=mass, model=options.model, thickness=options.thickness
-        )
+        try:
+            props = mass_properties(
+                body, density=None if mass is not None else density, mass=mass, model=options.model, thickness=options.thickness
+            )
+        except DegenerateBodyError as exc:
+            if single or "part" in exc.details:
+                raise
+            # one part of several: say which, or "the mesh encloses no volume" reads as the whole file's fault
+            raise type(exc)(f"part {name!r}: {exc.message}", **exc.details, part=name) from exc
     frame = principal_frame(props, options.tolerance)
     return PartResult(name, props, frame, classify(frame))
 

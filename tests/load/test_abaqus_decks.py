@@ -14,7 +14,13 @@ from pathlib import Path
 
 import pytest
 
-from inertia.errors import ExternalReferenceError, InputTooLargeError, UnreadableFileError, UnsupportedFormatError
+from inertia.errors import (
+    ExternalReferenceError,
+    InputTooLargeError,
+    UnreadableFileError,
+    UnsupportedFormatError,
+    ZeroVolumeError,
+)
 from inertia.load import load_body
 from inertia.pipeline import AnalysisOptions, analyze, analyze_loaded
 
@@ -170,3 +176,16 @@ def test_the_assemblys_reference_point_is_no_node_of_the_part() -> None:
     )
     volume, centre = weigh(deck)
     assert volume == pytest.approx(1 / 6, rel=1e-14) and centre == pytest.approx([0.25] * 3, rel=1e-14)
+
+
+def test_a_flat_element_set_is_named_in_the_refusal() -> None:
+    # an element block whose only element is flat: the deck's other block has volume, so the message names the
+    # part (each element block is one, named by its cell type and position)
+    flat = "9, 10, 0, 0\n10, 11, 0, 0\n11, 10, 1, 0\n12, 11, 1, 0\n"
+    deck = (
+        f"*NODE\n{CORNER_TET}{flat}*ELEMENT, TYPE=C3D4, ELSET=SOLID\n1, 1, 2, 3, 4\n"
+        "*ELEMENT, TYPE=C3D4, ELSET=FLAT\n2, 9, 10, 11, 12\n"
+    )
+    with pytest.raises(ZeroVolumeError, match="part 'tetra_1': the mesh encloses no volume") as err:
+        weigh(deck)
+    assert err.value.details["part"] == "tetra_1"
