@@ -13,6 +13,7 @@ from pathlib import Path
 from typing import Any
 
 import pytest
+import trimesh
 
 from inertia.batch import runner, workers
 from inertia.batch.rows import Row
@@ -337,3 +338,13 @@ def test_the_batch_command_runs_its_own_numeric_libraries_on_one_thread(tmp_path
     code, numpy_loaded, limits = json.loads(done.stdout.splitlines()[-1])
     assert code == 0 and numpy_loaded  # numpy was imported after the limits were set
     assert limits == ["1", "4", "1"]
+
+
+def test_a_gltf_in_a_folder_is_read_with_its_buffers_beside_it(tmp_path: Path) -> None:
+    files = trimesh.creation.box(extents=(1.0, 2.0, 3.0)).export(file_type="gltf")
+    for name, content in files.items():
+        (tmp_path / ("box.gltf" if name == "model.gltf" else name)).write_bytes(content)
+    (src,) = list_sources([str(tmp_path)])  # the .bin files are companions, not inputs
+    (row,) = analyze_sources([src], AnalysisOptions())
+    assert row["source"]["filename"] == "box.gltf", json.dumps(row)[:300]
+    assert row["mass"] == pytest.approx(row["density"] * 6.0, rel=1e-14)
