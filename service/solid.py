@@ -78,10 +78,17 @@ def closed_surface(body: MeshBody) -> tuple[NDArray[np.float64], NDArray[np.int6
         faces, flipped = orient_consistently(faces, topo)
         topo = surface_topology(faces, len(vertices))
         if not topo.closed:
+            shared = (
+                f"; {topo.nonmanifold_edges} edges are shared by more than two faces (non-manifold), "
+                "so the faces do not bound one solid"
+                if topo.nonmanifold_edges
+                else ""
+            )
             raise NotWatertightError(
-                f"mesh winding cannot be made consistent ({topo.unbalanced_edges} edges disagree); "
+                f"mesh winding cannot be made consistent ({topo.unbalanced_edges} edges disagree{shared}); "
                 "repair the mesh or use model=shell",
                 unbalanced_edges=topo.unbalanced_edges,
+                **({"nonmanifold_edges": topo.nonmanifold_edges} if topo.nonmanifold_edges else {}),
             )
         warnings.append(f"inconsistent winding repaired ({flipped} of {len(faces)} faces flipped)")
     faces, more = _orient_outward(vertices, faces, topo)

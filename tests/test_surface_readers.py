@@ -375,3 +375,44 @@ def test_a_zip_needing_a_newer_extractor_is_unreadable_not_a_crash() -> None:
     for name in ("box.3mf", "upload.zip"):
         with pytest.raises(UnreadableFileError):
             load_body(bytes(data), filename=name)
+
+
+@pytest.mark.parametrize("encoding", ["utf-16-be", "utf-16-le", "utf-32-le", "utf-32-be"])
+def test_an_obj_written_as_utf16_or_utf32_text_is_read(encoding: str) -> None:
+    # Windows editors save "Unicode" text as UTF-16 with a byte-order mark (assimp's box_UTF16BE.obj)
+    v, f = box(1.0, 2.0, 3.0)
+    text = obj_text(v, f).decode("ascii")
+    bom = {"utf-16-be": b"\xfe\xff", "utf-16-le": b"\xff\xfe", "utf-32-le": b"\xff\xfe\x00\x00", "utf-32-be": b"\x00\x00\xfe\xff"}
+    res = analyze(bom[encoding] + text.encode(encoding), filename="box.obj", options=AnalysisOptions(density=1.0)).as_dict()
+    assert res["mass"] == pytest.approx(6.0, rel=1e-14)
+
+
+def test_an_obj_with_a_byte_order_mark_that_lies_is_refused() -> None:
+    with pytest.raises(UnreadableFileError, match="UTF-16-BE byte-order mark"):
+        analyze(b"\xfe\xff" + b"v 0 0", filename="box.obj")  # an odd number of bytes: no UTF-16 text
+
+
+def test_gltf_1_is_named_as_such() -> None:
+    doc = {"asset": {"version": "1.0"}, "meshes": {"box": {"primitives": []}}}
+    with pytest.raises(UnsupportedFormatError, match=r"is glTF 1\.0"):
+        analyze(json.dumps(doc).encode(), filename="old.gltf")
+    glb = b"glTF" + (1).to_bytes(4, "little") + (20).to_bytes(4, "little") + (0).to_bytes(4, "little") * 2
+    with pytest.raises(UnsupportedFormatError, match=r"binary glTF 1\.0"):
+        analyze(glb, filename="old.glb")
+
+
+def test_a_required_material_extension_does_not_refuse_the_geometry() -> None:
+    doc = gltf_box_doc()
+    doc["extensionsRequired"] = doc["extensionsUsed"] = ["KHR_techniques_webgl"]
+    res = analyze(json.dumps(doc).encode(), filename="shaded.gltf", options=AnalysisOptions(density=1.0)).as_dict()
+    assert res["mass"] == pytest.approx(6.0, rel=1e-14)
+
+
+def test_non_manifold_edges_are_named_when_the_winding_cannot_be_made_consistent() -> None:
+    # three tetrahedral cells around one axis, their shared walls kept: no open edge, but edges with three faces
+    a, b, c, d, e = range(5)
+    v = np.array([[0, 0, 0], [0, 0, 1], [1, 0, 0.5], [-0.5, 0.87, 0.5], [-0.5, -0.87, 0.5]], dtype=float)
+    f = np.array([[a, b, c], [a, b, d], [a, b, e], [a, c, d], [b, c, d], [a, d, e], [b, d, e], [a, e, c], [b, e, c]])
+    with pytest.raises(NotWatertightError, match="shared by more than two faces") as err:
+        analyze((v, f))
+    assert err.value.details["nonmanifold_edges"] == 7

@@ -44,7 +44,7 @@ from pathlib import PurePosixPath, PureWindowsPath
 from typing import Any
 from urllib.parse import unquote
 
-from ..errors import ExternalReferenceError, InputTooLargeError, UnreadableFileError
+from ..errors import ExternalReferenceError, InputTooLargeError, UnreadableFileError, UnsupportedFormatError
 
 __all__ = [
     "check_upload",
@@ -436,7 +436,14 @@ _GLB_JSON = 0x4E4F534A
 def _check_glb(data: bytes, ctx: _Context) -> None:
     if len(data) < 12 or data[:4] != b"glTF":
         raise UnreadableFileError("the GLB file does not start with a glTF header", format=ctx.fmt)
-    _, length = struct.unpack_from("<II", data, 4)
+    version, length = struct.unpack_from("<II", data, 4)
+    if version == 1:
+        raise UnsupportedFormatError(
+            "the GLB file is binary glTF 1.0, which this service does not read (glTF 2.0 only); convert it to "
+            "glTF 2.0, e.g. with gltf-pipeline or by importing and exporting it in Blender",
+            format=ctx.fmt,
+            version="1.0",
+        )
     if length != len(data):
         raise UnreadableFileError(
             f"the GLB header declares {length} bytes but the file has {len(data)}; it is truncated or corrupt", format=ctx.fmt

@@ -27,15 +27,25 @@ from .safe import guarded_read
 
 __all__ = ["read_trimesh_parts", "read_surface_parts", "mesh_part"]
 
-# glTF extensions that change nothing in the geometry we read (materials, textures, lights, metadata)
-# extensions that store the geometry itself in another form (glTF extension registry)
+# glTF extensions that store the geometry itself in another form (glTF extension registry)
 _GEOMETRY_EXTENSIONS = {
     "KHR_draco_mesh_compression": "Draco mesh compression",
     "EXT_meshopt_compression": "meshopt compression",
     "KHR_meshopt_compression": "meshopt compression",
     "KHR_mesh_quantization": "quantized geometry",
 }
-_HARMLESS_GLTF_EXTENSIONS = ("KHR_materials_", "KHR_texture_", "KHR_lights_", "KHR_xmp", "KHR_animation_pointer", "EXT_texture_")
+# glTF extensions that change nothing in the geometry we read: materials (KHR_techniques_webgl: shaders, carried
+# over from glTF 1.0), textures, lights, metadata
+_HARMLESS_GLTF_EXTENSIONS = (
+    "KHR_techniques_webgl",
+    "KHR_technique_webgl",
+    "KHR_materials_",
+    "KHR_texture_",
+    "KHR_lights_",
+    "KHR_xmp",
+    "KHR_animation_pointer",
+    "EXT_texture_",
+)
 
 
 def read_surface_parts(
@@ -275,6 +285,15 @@ def _check_gltf_document(data: bytes, fmt: str) -> list[str]:
 
     def refuse(what: str, **details: Any) -> UnsupportedFormatError:
         return UnsupportedFormatError(f"the {fmt.upper()} file {what}", format=fmt, **details)
+
+    asset = doc.get("asset")
+    version = str(asset.get("version", "")) if isinstance(asset, dict) else ""
+    if version.startswith("1") or isinstance(doc.get("meshes"), dict):  # 1.0 keys its meshes by id
+        raise refuse(
+            "is glTF 1.0, which this service does not read (glTF 2.0 only); convert it to glTF 2.0, "
+            "e.g. with gltf-pipeline or by importing and exporting it in Blender",
+            version=version or "1.0",
+        )
 
     required = doc.get("extensionsRequired", [])
     unknown = (

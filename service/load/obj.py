@@ -39,11 +39,33 @@ def _fail(line_no: int, text: str, why: str) -> UnreadableFileError:
     )
 
 
+# byte-order marks of the Unicode encodings an OBJ file is written in besides UTF-8 (Windows editors' "Unicode")
+_WIDE_BOMS = (
+    (b"\xff\xfe\x00\x00", "utf-32-le"),
+    (b"\x00\x00\xfe\xff", "utf-32-be"),
+    (b"\xff\xfe", "utf-16-le"),
+    (b"\xfe\xff", "utf-16-be"),
+)
+
+
 def _lines(data: bytes) -> list[str]:
-    try:
-        text = data.decode("utf-8")
-    except UnicodeDecodeError:
-        text = data.decode("latin-1")  # names only; numbers are ASCII in every encoding OBJ files use
+    text = None
+    for bom, encoding in _WIDE_BOMS:
+        if data.startswith(bom):  # UTF-16 or UTF-32 text: every ASCII character has NUL bytes beside it
+            try:
+                text = data[len(bom) :].decode(encoding)
+            except UnicodeDecodeError as exc:
+                raise UnreadableFileError(
+                    f"the OBJ file starts with a {encoding.upper()} byte-order mark but is not {encoding.upper()} text "
+                    f"({exc.reason})",
+                    format="obj",
+                ) from exc
+            break
+    if text is None:
+        try:
+            text = data.decode("utf-8")
+        except UnicodeDecodeError:
+            text = data.decode("latin-1")  # names only; numbers are ASCII in every encoding OBJ files use
     if "\x00" in text:
         raise UnreadableFileError(
             "the OBJ file holds binary data (NUL bytes), not OBJ text; check the file and its extension", format="obj"
