@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import contextlib
 import io
 import json
 import math
@@ -416,3 +417,19 @@ def test_non_manifold_edges_are_named_when_the_winding_cannot_be_made_consistent
     with pytest.raises(NotWatertightError, match="shared by more than two faces") as err:
         analyze((v, f))
     assert err.value.details["nonmanifold_edges"] == 7
+
+
+@pytest.mark.parametrize("tail", [b"", b"o caf\xe9\n"], ids=["utf-8", "latin-1 name"])
+def test_an_obj_with_a_utf8_byte_order_mark_keeps_its_first_vertex(tail: bytes) -> None:
+    # with the mark left on the first line, "v 0 0 0" was not a vertex and every face pointed one vertex further
+    text = b"v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nv 0 0 3\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n"
+    res = analyze(b"\xef\xbb\xbf" + text + tail, filename="tet.obj", options=AnalysisOptions(density=1.0)).as_dict()
+    assert res["mass"] == pytest.approx(1 / 6, rel=1e-14)
+
+
+@pytest.mark.parametrize("extensions", [5, True, [{}], "KHR_draco_mesh_compression"])
+def test_gltf_primitive_extensions_of_the_wrong_type_are_not_a_crash(extensions: object) -> None:
+    doc = gltf_box_doc()
+    doc["meshes"][0]["primitives"][0]["extensions"] = extensions
+    with contextlib.suppress(ServiceError):  # read or refused with a sentence; never a TypeError
+        analyze(json.dumps(doc).encode(), filename="odd.gltf")

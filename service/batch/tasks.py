@@ -14,6 +14,7 @@ append without further work.
 
 from __future__ import annotations
 
+import os
 from collections.abc import Sequence
 from typing import Any
 
@@ -39,7 +40,7 @@ def analyze_row(source: Source, options: AnalysisOptions, zips: ZipCache | None 
     try:
         if source.member is None and source.name.lower().endswith(".zip"):
             raise UnreadableFileError(f"{source.name!r} is not a readable zip archive", filename=source.name)
-        if source.member is None and "://" not in source.location:
+        if source.member is None and "://" not in source.location and os.path.isfile(source.location):
             # a file on this machine's disk: read by path, with the files it names beside it (a .gltf's .bin),
             # as ``inertia analyze`` reads it
             return analyze(source.location, filename=source.name, options=options).document()

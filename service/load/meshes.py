@@ -288,7 +288,7 @@ def _check_gltf_document(data: bytes, fmt: str) -> list[str]:
 
     asset = doc.get("asset")
     version = str(asset.get("version", "")) if isinstance(asset, dict) else ""
-    if version.startswith("1") or isinstance(doc.get("meshes"), dict):  # 1.0 keys its meshes by id
+    if version.startswith("1") or (not version and isinstance(doc.get("meshes"), dict)):  # 1.0 keys meshes by id
         raise refuse(
             "is glTF 1.0, which this service does not read (glTF 2.0 only); convert it to glTF 2.0, "
             "e.g. with gltf-pipeline or by importing and exporting it in Blender",
@@ -337,7 +337,8 @@ def _check_gltf_document(data: bytes, fmt: str) -> list[str]:
                 )
             attrs: dict[str, Any] = prim["attributes"] if isinstance(prim.get("attributes"), dict) else {}
             position = attrs.get("POSITION")
-            compressed = [e for e in (prim.get("extensions") or {}) if e in _GEOMETRY_EXTENSIONS]
+            extensions = prim.get("extensions")
+            compressed = [e for e in extensions if e in _GEOMETRY_EXTENSIONS] if isinstance(extensions, dict) else []
             if (
                 compressed
                 and isinstance(position, int)

@@ -62,6 +62,8 @@ def _lines(data: bytes) -> list[str]:
                 ) from exc
             break
     if text is None:
+        if data.startswith(b"\xef\xbb\xbf"):  # a UTF-8 byte-order mark (Notepad's "UTF-8 with BOM") is no text:
+            data = data[3:]  # left on the first line, it hid a first "v" line and shifted every face's indices
         try:
             text = data.decode("utf-8")
         except UnicodeDecodeError:

@@ -212,7 +212,7 @@ def read_volume_parts(
     companions : other files of the same upload by name (a TetGen ``.node``
         beside its ``.ele``, an XDMF's HDF5 file), written beside it for the reader.
     """
-    if fmt == "mesh" and data.lstrip()[:4].upper() == b"MFEM":  # the other format named .mesh: not Medit's
+    if fmt == "mesh" and data[:64].lstrip()[:4].upper() == b"MFEM":  # the other format named .mesh: not Medit's
         raise UnsupportedFormatError(
             f"{repr(os.path.basename(filename)) if filename else 'the file'} is an MFEM mesh (its first line says so), "
             "not a Medit one, and this service "

@@ -124,6 +124,7 @@ def test_a_file_that_vanished_becomes_an_unreadable_row(tmp_path: Path) -> None:
         read_source(Source("gone.stl", str(tmp_path / "gone.stl")))
     row = analyze_source(Source("gone.stl", str(tmp_path / "gone.stl")), AnalysisOptions())
     assert row["source"] == {"filename": "gone.stl"} and row["error"]["code"] == "unreadable_file"
+    assert "readable here" in row["error"]["message"]  # where it was looked for: on a Dask worker, its own disk
 
 
 def test_a_broken_zip_in_a_folder_is_one_error_row(tmp_path: Path) -> None:
