@@ -433,3 +433,10 @@ def test_gltf_primitive_extensions_of_the_wrong_type_are_not_a_crash(extensions:
     doc["meshes"][0]["primitives"][0]["extensions"] = extensions
     with contextlib.suppress(ServiceError):  # read or refused with a sentence; never a TypeError
         analyze(json.dumps(doc).encode(), filename="odd.gltf")
+
+
+def test_an_ascii_stl_with_a_utf8_byte_order_mark_is_read() -> None:
+    data = trimesh.creation.box(extents=(1.0, 2.0, 3.0)).export(file_type="stl_ascii")
+    text = data.encode() if isinstance(data, str) else data
+    res = analyze(b"\xef\xbb\xbf" + text, filename="box.stl", options=AnalysisOptions(density=1.0)).as_dict()
+    assert res["mass"] == pytest.approx(6.0, rel=1e-14)

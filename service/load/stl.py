@@ -38,9 +38,9 @@ def read_stl(data: bytes | memoryview) -> tuple[NDArray[np.float64], NDArray[np.
         count = int(np.frombuffer(buf[80:84], dtype="<u4")[0])
         if 84 + 50 * count == len(buf):
             return _binary(buf, count)
-    head = bytes(buf[:512]).lstrip()
+    head = bytes(buf[:512]).removeprefix(b"\xef\xbb\xbf").lstrip()  # an editor's UTF-8 byte-order mark
     if head.startswith(b"solid"):
-        return _ascii(bytes(buf))
+        return _ascii(bytes(buf).removeprefix(b"\xef\xbb\xbf"))
     raise UnreadableFileError(
         "the STL file is neither ASCII (starting with 'solid') nor binary of consistent length; it may be truncated"
     )
