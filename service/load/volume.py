@@ -214,9 +214,9 @@ def read_volume_parts(
     """
     if fmt == "mesh" and data[:64].lstrip()[:4].upper() == b"MFEM":  # the other format named .mesh: not Medit's
         raise UnsupportedFormatError(
-            f"{repr(os.path.basename(filename)) if filename else 'the file'} is an MFEM mesh (its first line says so), "
-            "not a Medit one, and this service "
-            "does not read MFEM's format; convert it to VTK (.vtu) or Gmsh (.msh), e.g. with MFEM's own mesh tools",
+            f"{repr(os.path.basename(filename)) if filename else 'the file'} is an MFEM mesh (its first line says "
+            "so), not a Medit one, and this service does not read MFEM's format; convert it to VTK (.vtu) or Gmsh "
+            "(.msh), e.g. with MFEM's own mesh tools",
             format=fmt,
         )
     if fmt == "inp" and is_avs_ucd(data):  # the other format named .inp: VTK reads it, meshio would take it for Abaqus
@@ -828,6 +828,8 @@ def abaqus_flatten(data: bytes, companions: Mapping[str, bytes], label: str) -> 
     see ``load_body``); the result is bounded by the upload's inflation
     budget, so a file that includes itself or others many times is refused.
     """
+    if not _ABAQUS_INPUT_PARAMETER.search(data):  # most decks read no other file: no pass over their lines
+        return data
     budget = inflate_budget(len(data) + sum(len(v) for v in companions.values()))
     out: list[bytes] = []
     total = 0
