@@ -117,7 +117,8 @@ def _load_beside(path: str, filename: str, format: str | None, units: str | None
     model's folder and the model read again, until nothing is missing.
     """
     folder = os.path.dirname(os.path.abspath(path))
-    companions: dict[str, bytes] = {}
+    companions: dict[str, bytes] = {}  # by the name as written and as URI-decoded
+    read = 0
     while True:
         try:
             if not companions:
@@ -132,9 +133,10 @@ def _load_beside(path: str, filename: str, format: str | None, units: str | None
             if "reference" not in exc.details:  # not a file that could be beside the model (a <!DOCTYPE>, ...)
                 raise
             name = str(exc.details["reference"])
-            found = _companion_beside(folder, name) if name not in companions else None
-            if found is None or len(companions) >= MAX_COMPANIONS_BESIDE:
+            found = _companion_beside(folder, name) if name not in companions and read < MAX_COMPANIONS_BESIDE else None
+            if found is None:
                 raise _missing_beside(exc, name, filename) from None
+            read += 1
             companions[name] = found
             companions.setdefault(unquote(name), found)
 
