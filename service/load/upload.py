@@ -113,6 +113,8 @@ def pick_model_file(files: list[tuple[str, bytes]], format: str | None = None) -
             files=names[:50],
         )
     if len(models) > 1:
+        models = _not_included(models, dict(files))
+    if len(models) > 1:
         raise UnsupportedFormatError(
             f"the upload holds {len(models)} model files ({', '.join(m[:60] for m in models[:8])}); send one model "
             "(with its companion files) per upload, or analyse them one by one with batch",
@@ -126,3 +128,17 @@ def pick_model_file(files: list[tuple[str, bytes]], format: str | None = None) -
         companions[name] = data
         companions.setdefault(posixpath.basename(name), data)
     return main, companions
+
+
+def _not_included(models: list[str], data: dict[str, bytes]) -> list[str]:
+    """The candidates no other candidate reads: an Abaqus deck and the ``.inp`` files it includes are one model.
+
+    Includes name plain files (``guard.plain_name``), offered under their base name.
+    """
+    decks = [n for n in models if _ext(n) == "inp"]
+    if len(decks) < 2:
+        return models
+    from .volume import abaqus_input_names
+
+    read = set().union(*(abaqus_input_names(data[deck]) for deck in decks))
+    return [n for n in models if posixpath.basename(n) not in read] or models

@@ -814,6 +814,20 @@ _ABAQUS_INPUT_PARAMETER = re.compile(rb",[ \t]*input[ \t]*=[ \t]*(?P<name>[^,\r\
 MAX_INCLUDE_DEPTH = 16
 
 
+def abaqus_input_names(data: bytes) -> set[str]:
+    """The file names a deck's keyword lines read (``*INCLUDE, INPUT=name`` and the like)."""
+    names = set()
+    for line in data.splitlines():
+        m = _ABAQUS_INPUT_PARAMETER.search(line) if _abaqus_keyword(line) is not None else None
+        if m is not None:
+            names.add(_input_name(m))
+    return names
+
+
+def _input_name(m: re.Match[bytes]) -> str:
+    return m.group("name").strip().strip(b"'\"").decode("utf-8", "replace")
+
+
 def abaqus_flatten(data: bytes, companions: Mapping[str, bytes], label: str) -> bytes:
     """The deck with each file it reads written in its place, as Abaqus reads it.
 
@@ -844,7 +858,7 @@ def abaqus_flatten(data: bytes, companions: Mapping[str, bytes], label: str) -> 
             keyword = _abaqus_keyword(line)
             m = _ABAQUS_INPUT_PARAMETER.search(line) if keyword is not None else None
             if m is not None:
-                name = m.group("name").strip().strip(b"'\"").decode("utf-8", "replace")
+                name = _input_name(m)
                 refuse_reference("inp", name, "INPUT=", companions)
                 if keyword != b"INCLUDE":  # the keyword stays; its data lines come from the file
                     line = line[: m.start()] + line[m.end() :]

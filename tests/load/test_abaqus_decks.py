@@ -167,6 +167,28 @@ def test_the_caller_reads_nested_includes_beside_the_deck(tmp_path: Path) -> Non
         analyze(tmp_path / "deck.inp", companions_beside=False)
 
 
+def test_an_upload_of_a_deck_with_inp_includes_reads_the_deck_that_includes_them() -> None:
+    # every file ends in .inp: the one no other file includes is the model, wherever it comes in the upload
+    # (a zip's folders included: a companion is offered under its base name)
+    deck = "*HEADING\n*INCLUDE, INPUT=nodes.inp\n*INCLUDE, INPUT=elements.inp\n"
+    files = [
+        ("mesh/nodes.inp", f"*NODE\n{CORNER_TET}{FAR_TET}".encode()),
+        ("elements.inp", b"*ELEMENT, TYPE=C3D4\n1, 1, 2, 3, 4\n2, 5, 6, 7, 8\n"),
+        ("job.inp", deck.encode()),
+    ]
+    doc = analyze_loaded(load_body(files), AnalysisOptions()).as_dict()
+    volume, centre = expected()
+    assert doc["mass"] / doc["density"] == pytest.approx(float(volume), rel=1e-14)
+    assert doc["center_of_mass"] == pytest.approx([float(c) for c in centre], rel=1e-14)
+    assert doc["source"]["filename"] == "job.inp"
+
+
+def test_two_decks_that_include_neither_are_still_two_models() -> None:
+    one = f"*NODE\n{CORNER_TET}*ELEMENT, TYPE=C3D4\n1, 1, 2, 3, 4\n".encode()
+    with pytest.raises(UnsupportedFormatError, match="2 model files"):
+        load_body([("a.inp", one), ("b.inp", one)])
+
+
 def test_the_assemblys_reference_point_is_no_node_of_the_part() -> None:
     # as Abaqus/CAE writes a one-part model: the assembly's reference point is numbered 1 in its own namespace
     deck = (
