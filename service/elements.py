@@ -98,12 +98,26 @@ def atomic_mass(spec: str, isotopes: str = Isotopes.STANDARD) -> float:
 
 def _element(symbol: str, spec: str) -> Any:
     table = _table()
-    # symbols are case-sensitive in chemistry ("Co" vs "CO"); accept "o" or "CL" by normalising
+    # symbols are case-sensitive in chemistry ("Co" vs "CO"); "o" or "cl" are read by normalising, but a label
+    # in capitals whose first letter is an element itself is ambiguous: PDB's "CA" is an alpha carbon, not
+    # calcium, and "NE", "HG", "CD" name nitrogen, hydrogen and carbon atoms of amino acids
     canonical = symbol[0].upper() + symbol[1:].lower()
-    element = getattr(table, canonical, None)
-    if element is None or not hasattr(element, "isotopes") or element.number == 0:
+    element = _lookup(table, canonical)
+    if element is None:
         raise InvalidParameterError(f"element {spec!r} is not an element symbol", parameter="element")
+    if len(symbol) > 1 and symbol.isupper() and _lookup(table, symbol[0]) is not None:
+        raise InvalidParameterError(
+            f"element {spec!r} is ambiguous: element symbols are written with one capital ({canonical!r} is "
+            f"{element.name}), and labels in capitals often name an atom of element {symbol[0]!r} (PDB's 'CA' is an "
+            f"alpha carbon); write {canonical!r} or {symbol[0]!r}",
+            parameter="element",
+        )
     return element
+
+
+def _lookup(table: Any, symbol: str) -> Any:
+    element = getattr(table, symbol, None)
+    return element if element is not None and hasattr(element, "isotopes") and element.number != 0 else None
 
 
 def _abundances(element: Any) -> dict[int, float]:

@@ -222,7 +222,9 @@ def _v11_sections(
 
         out["rotational_constants"] = rotational_constants(frame.moments, cls.rotor == RotorClass.LINEAR)
         if out["rotational_constants"] is None:
-            warnings.append("rotational constants need positive principal moments; a single atom has none")
+            warnings.append(
+                "rotational constants need positive principal moments; a single atom (or atoms all at one place) has none"
+            )
     if options.frame is not None:
         from .frames import named_frame
 

@@ -270,3 +270,78 @@ def test_cli_analyze_water_xyz(tmp_path: Path) -> None:
     )
     _, mhz = _constants(water(), ABUNDANT)
     np.testing.assert_allclose(doc["rotational_constants"]["MHz"], mhz, rtol=REL_MASS)
+
+
+@pytest.mark.parametrize("label", ["CA", "HG", "NE", "CD", "CL"])
+def test_a_capitalised_label_that_may_name_another_element_is_refused(client: Any, label: str) -> None:
+    # MDAnalysis's test.xyz labels alpha carbons 'CA': read as calcium, it weighed 40.078 u instead of 12.011
+    text = f"2\nprotein atoms\n{label} 0 0 0\n{label} 1.5 0 0\n"
+    r = client.post("/v1/analyze/mesh", files={"file": ("test.xyz", text.encode())})
+    assert r.status_code == 422
+    message = r.json()["error"]["message"]
+    assert "ambiguous" in message and f"'{label[0]}'" in message
+
+
+@pytest.mark.parametrize("label, mass", [("ZN", 65.38), ("ca", 40.078), ("o", 15.999)])
+def test_a_label_in_another_case_that_names_one_element_is_read(client: Any, label: str, mass: float) -> None:
+    body = {"points": [{"element": label, "position": [0, 0, 0]}], "mass_unit": "kg"}
+    assert client.post("/v1/analyze/points", json=body).json()["mass"] == pytest.approx(mass * DALTON, rel=1e-12)
+
+
+def _extended(properties: str, rows: list[str]) -> bytes:
+    return (f'{len(rows)}\nLattice="20 0 0 0 20 0 0 0 20" Properties={properties} pbc="T T T"\n' + "\n".join(rows) + "\n").encode()
+
+
+def test_extended_xyz_columns_are_read_where_properties_puts_them(client: Any) -> None:
+    atoms = water()
+    expected = client.post("/v1/analyze/mesh", files={"file": ("w.xyz", _xyz(atoms).encode())}).json()
+    # an id column first and velocities after (as MD writers lay them out), species by atomic number
+    numbers = {"O": 8, "H": 1}
+    rows = [f"{k + 1} {numbers[e]} {p[0]!r} {p[1]!r} {p[2]!r} 0.1 0.2 0.3" for k, (e, p) in enumerate(atoms)]
+    data = _extended("id:I:1:Z:I:1:pos:R:3:velo:R:3", rows)
+    doc = client.post("/v1/analyze/mesh", files={"file": ("w.extxyz", data)}).json()
+    assert doc["mass"] == expected["mass"]
+    assert doc["center_of_mass"] == expected["center_of_mass"]
+    assert doc["inertia_tensor"] == expected["inertia_tensor"]
+
+
+def test_an_extended_xyz_masses_column_is_in_daltons(client: Any) -> None:
+    # ASE writes masses:R:1 for atoms whose masses differ from the table's (here deuterated water)
+    atoms = water()
+    rows = [f"{e} {m!r} {p[0]!r} {p[1]!r} {p[2]!r}" for (e, p), m in zip(atoms, (15.999, DEUTERIUM, DEUTERIUM))]
+    doc = client.post("/v1/analyze/mesh", files={"file": ("d2o.xyz", _extended("species:S:1:masses:R:1:pos:R:3", rows))}).json()
+    assert doc["mass"] == pytest.approx((15.999 + 2 * DEUTERIUM) * DALTON, rel=1e-12)
+    z = atoms[1][1][2] * 1e-10
+    assert doc["center_of_mass"][2] == pytest.approx(2 * DEUTERIUM * z / (15.999 + 2 * DEUTERIUM), rel=1e-12)
+
+
+def test_an_extended_xyz_without_species_or_positions_is_refused(client: Any) -> None:
+    r = client.post("/v1/analyze/mesh", files={"file": ("a.xyz", _extended("id:I:1:pos:R:3", ["1 0 0 0"]))})
+    assert r.status_code == 415
+    assert "species:S:1" in r.json()["error"]["message"]
+
+
+def test_a_form_feed_in_the_comment_line_ends_no_line(client: Any) -> None:
+    # str.splitlines() split the comment at the form feed, and the first atom line became the comment
+    atoms = water()
+    plain = client.post("/v1/analyze/mesh", files={"file": ("w.xyz", _xyz(atoms).encode())}).json()
+    doc = client.post("/v1/analyze/mesh", files={"file": ("w.xyz", _xyz(atoms, "page\x0cbreak\x0bhere").encode())}).json()
+    assert doc["mass"] == plain["mass"] and doc["inertia_tensor"] == plain["inertia_tensor"]
+    assert not doc["warnings"]
+
+
+@pytest.mark.parametrize(
+    "points",
+    [
+        [None, {"mass": 1, "position": [1, 0, 0]}],
+        [1, 2],
+        [[1, 0, 0, 0]],
+        [{"mass": 1, "position": "123"}, {"mass": 1, "position": [1, 0, 0]}],
+        [{"mass": True, "position": [0, 0, 0]}, {"mass": 1, "position": [1, 0, 0]}],
+    ],
+    ids=["null", "numbers", "list", "string-position", "boolean-mass"],
+)
+def test_a_points_file_entry_that_is_no_point_is_refused(client: Any, points: list[Any]) -> None:
+    r = client.post("/v1/analyze/mesh", files={"file": ("p.json", json.dumps(points).encode())})
+    assert r.status_code == 422
+    assert r.json()["error"]["code"] == "invalid_parameter" and "point 0 must be an object" in r.json()["error"]["message"]

@@ -47,7 +47,7 @@ __all__ = [
 ]
 
 # mesh formats, CAD files and XYZ molecules (points files in JSON/CSV are too generic to pick up from a folder)
-KNOWN_EXTENSIONS = frozenset(FORMATS) | {"stla", "stlb", "xyz", "stp", "igs"}  # xyz: molecules, a specific enough name
+KNOWN_EXTENSIONS = frozenset(FORMATS) | {"stla", "stlb", "xyz", "extxyz", "stp", "igs"}  # xyz: molecules, a specific enough name
 ZIP_EXTENSION = "zip"
 
 

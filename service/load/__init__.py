@@ -215,7 +215,7 @@ def _load_bytes(
     companions: Mapping[str, bytes] | None = None,
 ) -> Loaded:
     if not len(data):
-        raise EmptyGeometryError("the file is empty; send a mesh with geometry", filename=filename)
+        raise EmptyGeometryError("the file is empty; send a file with geometry", filename=filename)
     _refuse_lfs_pointer(bytes(data[:64]), filename)
     fmt = sniff_format(filename, format, bytes(data[:512]))
     # includes, external references, inflation bounds: before any reader

@@ -12,14 +12,15 @@ from __future__ import annotations
 import csv
 import io
 import json
+import re
 from collections.abc import Iterable, Mapping
-from dataclasses import replace
+from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
 
 from ..body import PointBody
-from ..errors import EmptyGeometryError, InvalidParameterError, UnreadableFileError
+from ..errors import EmptyGeometryError, InvalidParameterError, UnreadableFileError, UnsupportedFormatError
 from ..vocabulary import Isotopes, MassUnit, values
 
 __all__ = ["MASS_UNITS", "names_elements", "points_from_records", "read_points", "read_points_document", "read_points_file"]
@@ -32,10 +33,24 @@ def names_elements(records: Iterable[Mapping[str, Any]]) -> bool:
     return any(isinstance(rec, Mapping) and rec.get("element") is not None for rec in records)
 
 
+def _number(value: Any) -> float:
+    """A number, or its text (CSV fields are text); not a boolean, which JSON keeps apart from numbers."""
+    if isinstance(value, bool):
+        raise TypeError("a boolean is not a number")
+    return float(value)
+
+
+def _sequence(value: Any) -> Any:
+    """The components of a position: a list, not a string (whose characters would each read as a number)."""
+    if isinstance(value, (str, bytes, Mapping)):
+        raise TypeError("a position is a list of numbers")
+    return value
+
+
 def _mass(rec: Mapping[str, Any], k: int, isotopes: str, dalton: float | None) -> float:
     """The record's mass [kg]: its ``mass`` (times ``dalton`` when in u), else its element's."""
     if rec.get("mass") is not None:
-        return float(rec["mass"]) * (dalton if dalton is not None else 1.0)
+        return _number(rec["mass"]) * (dalton if dalton is not None else 1.0)
     if rec.get("element") is None:
         raise KeyError("mass")
     from ..elements import atomic_mass, dalton_kg
@@ -67,11 +82,13 @@ def points_from_records(
     masses, positions = [], []
     for k, rec in enumerate(records):
         try:
+            if not isinstance(rec, Mapping):
+                raise TypeError
             masses.append(_mass(rec, k, isotopes, dalton))
-            pos = [float(x) for x in rec["position"]]
+            pos = [_number(x) for x in _sequence(rec["position"])]
         except (KeyError, TypeError, ValueError) as exc:
             raise InvalidParameterError(
-                f"point {k} needs a numeric 'mass' (or an 'element') and a 3-component 'position'", index=k
+                f"point {k} must be an object with a numeric 'mass' (or an 'element') and a 'position' of 3 numbers", index=k
             ) from exc
         if len(pos) != 3:
             raise InvalidParameterError(f"point {k} position must have 3 components, got {len(pos)}", index=k)
@@ -114,8 +131,8 @@ _BODY_KEYS = ("points", "units", "mass_unit")
 
 
 def _file_records(text: str, fmt: str) -> tuple[list[Any], list[str], str | None, str]:
-    if fmt == "xyz":
-        return (*_xyz_records(text), None, MassUnit.KG)
+    if fmt == "xyz":  # an extended XYZ file's masses column is in u (element masses are always right)
+        return (*_xyz_records(text), None, MassUnit.U)
     if fmt == "json":
         try:
             doc = json.loads(text)
@@ -164,16 +181,24 @@ def _document_keys(doc: Mapping[str, Any]) -> tuple[list[str], str | None, str]:
 
 
 def _xyz_records(text: str) -> tuple[list[Any], list[str]]:
-    """Atoms of the first frame of an XYZ file: count line, comment line, ``El x y z`` lines."""
+    """Atoms of the first frame of an XYZ file: count line, comment line, ``El x y z`` lines.
+
+    An extended XYZ file (ASE, QUIP, OVITO) says in its comment line which columns hold what
+    (``Properties=species:S:1:pos:R:3:...``); its species (or atomic numbers, ``Z``), positions and
+    masses, if given, are read from those columns, and a layout without species or positions is refused.
+    """
     from ..elements import element_symbol
 
-    lines = text.splitlines()
+    # lines end at \n, \r\n or \r only: str.splitlines also splits at form feeds and other
+    # separators, which a comment line may hold
+    lines = text.replace("\r\n", "\n").replace("\r", "\n").split("\n")
     try:
         count = int(lines[0].split()[0])
     except (IndexError, ValueError):
         raise UnreadableFileError("an XYZ file starts with the number of atoms on its first line") from None
     if count < 1:
-        raise EmptyGeometryError("the XYZ file holds no atoms; send at least one")
+        raise EmptyGeometryError(f"the XYZ file's first line gives {count} atoms; send at least one")
+    layout = _xyz_layout(lines[1] if len(lines) > 1 else "")
     atoms = lines[2 : 2 + count]
     if len(atoms) < count:
         raise UnreadableFileError(f"the XYZ file announces {count} atoms but holds {len(atoms)} atom lines")
@@ -181,15 +206,70 @@ def _xyz_records(text: str) -> tuple[list[Any], list[str]]:
     for k, line in enumerate(atoms):
         fields = line.split()
         try:
-            if len(fields) < 4:
+            if len(fields) < layout.width:
                 raise ValueError
-            position = [float(x) for x in fields[1:4]]
+            record: dict[str, Any] = {
+                "element": element_symbol(fields[layout.species]),
+                "position": [float(x) for x in fields[layout.pos : layout.pos + 3]],
+            }
+            if layout.mass is not None:
+                record["mass"] = float(fields[layout.mass])
         except ValueError:
-            raise UnreadableFileError(f"XYZ line {k + 3} must read 'element x y z', got {line.strip()!r}", line=k + 3) from None
-        records.append({"element": element_symbol(fields[0]), "position": position})
+            raise UnreadableFileError(
+                f"XYZ line {k + 3} must read {layout.reads}, got {line.strip()[:120]!r}", line=k + 3
+            ) from None
+        records.append(record)
     warnings = []
     if any(line.strip() for line in lines[2 + count :]):
         warnings.append(
             f"the XYZ file goes on after its first frame of {count} atoms (a trajectory?); only the first frame was analysed"
         )
     return records, warnings
+
+
+@dataclass(frozen=True, slots=True)
+class _XyzLayout:
+    """Where an XYZ atom line holds the element, the position and (extended XYZ) the mass [u]."""
+
+    species: int = 0
+    pos: int = 1  # the first of three columns
+    mass: int | None = None
+    width: int = 4
+    reads: str = "'element x y z'"
+
+
+_PROPERTIES = re.compile(r"(?:^|\s)properties\s*=\s*(\"?)(?P<spec>[^\s\"]*)\1", re.IGNORECASE)
+
+
+def _xyz_layout(comment: str) -> _XyzLayout:
+    """The columns of an extended XYZ file's ``Properties=`` (name:type:count triples); plain XYZ without one."""
+    found = _PROPERTIES.search(comment)
+    if found is None:
+        return _XyzLayout()
+    fields = found.group("spec").split(":")
+    if len(fields) % 3 or not fields[0]:
+        raise UnreadableFileError(f"the extended XYZ Properties= {found.group('spec')[:120]!r} is not name:type:count triples")
+    columns: dict[str, tuple[str, int, int]] = {}
+    width = 0
+    for name, kind, number in zip(fields[0::3], fields[1::3], fields[2::3]):
+        if not number.isdigit() or kind.upper() not in ("S", "R", "I", "L"):
+            raise UnreadableFileError(f"the extended XYZ Properties= {found.group('spec')[:120]!r} has a bad column {name!r}")
+        columns[name] = (kind.upper(), width, int(number))
+        width += int(number)
+    species = columns.get("species") or columns.get("Z")
+    pos = columns.get("pos")
+    mass = columns.get("masses") or columns.get("mass")
+    if species is None or species[2] != 1 or pos is None or pos[:3:2] != ("R", 3) or (mass is not None and mass[:3:2] != ("R", 1)):
+        raise UnsupportedFormatError(
+            f"the extended XYZ file's columns ({found.group('spec')[:120]}) name no element column ('species:S:1' or "
+            "'Z:I:1') and position column ('pos:R:3'); write the file with both",
+            format="xyz",
+        )
+    names = {species[1]: "element", pos[1]: "x y z", **({} if mass is None else {mass[1]: "mass"})}
+    return _XyzLayout(
+        species[1],
+        pos[1],
+        None if mass is None else mass[1],
+        width,
+        f"{width} columns as its Properties= says ({', '.join(f'{names[c]} in column {c + 1}' for c in sorted(names))})",
+    )

@@ -29,7 +29,7 @@ POINT_FORMATS = ("json", "csv", "xyz")  # xyz: atoms by element, in angstrom
 CAD_FORMATS = ("step", "iges")
 FORMATS = SURFACE_FORMATS + tuple(VOLUME_FORMATS) + CAD_FORMATS
 
-_ALIASES = {"gmsh": "msh", "stla": "stl", "stlb": "stl", "ascii_stl": "stl", "stp": "step", "igs": "iges"}
+_ALIASES = {"extxyz": "xyz", "gmsh": "msh", "stla": "stl", "stlb": "stl", "ascii_stl": "stl", "stp": "step", "igs": "iges"}
 
 
 def sniff_format(filename: str | None, declared: str | None, head: bytes = b"") -> str:
@@ -38,7 +38,7 @@ def sniff_format(filename: str | None, declared: str | None, head: bytes = b"") 
         fmt = _ALIASES.get(declared.lower().lstrip("."), declared.lower().lstrip("."))
         if fmt not in FORMATS and fmt not in POINT_FORMATS:
             raise UnsupportedFormatError(
-                f"format {declared!r} is not supported; readable formats are {', '.join(FORMATS)}",
+                f"format {declared!r} is not supported; readable formats are {', '.join(FORMATS + POINT_FORMATS)}",
                 format=declared,
             )
         return fmt
@@ -48,7 +48,7 @@ def sniff_format(filename: str | None, declared: str | None, head: bytes = b"") 
         if ext in FORMATS or ext in POINT_FORMATS:
             return ext
         raise UnsupportedFormatError(
-            f"cannot read files ending in .{ext}; readable formats are {', '.join(FORMATS)} "
+            f"cannot read files ending in .{ext}; readable formats are {', '.join(FORMATS + POINT_FORMATS)} "
             "(or pass format=... if the name is misleading)",
             format=ext,
         )
