@@ -415,6 +415,7 @@ def _combined(loaded: Loaded, parts: Sequence[PartResult], options: AnalysisOpti
     warnings = [f"{p.name}: {w}" for p in parts for w in p.props.warnings]
     return replace(
         whole,
+        mass=math.fsum(p.props.mass for p in parts),  # the parts' masses add up to the whole's, to the last digit
         volume=float(sum(v for v in volumes if v is not None)) if None not in volumes else None,
         density=densities.pop() if len(densities) == 1 and None not in densities else None,
         warnings=tuple(warnings),

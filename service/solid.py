@@ -44,6 +44,8 @@ from .topology import SurfaceTopology, _components, face_components, orient_cons
 
 __all__ = ["closed_surface"]
 
+INVERTED = "inverted winding corrected"  # API.md's words for a body whose faces all pointed inward
+
 
 def closed_surface(body: MeshBody) -> tuple[NDArray[np.float64], NDArray[np.int64], tuple[str, ...]]:
     """Weld, check closedness, repair winding; the geometry to integrate."""
@@ -135,7 +137,7 @@ def _orient_outward(
     flat = np.abs(vol) <= 64 * EPS * noise  # a shell of zero volume: no orientation makes it a body
     if count == 1:
         if total < 0:
-            return faces[:, [0, 2, 1]], ["inverted winding corrected (all faces pointed inward)"]
+            return faces[:, [0, 2, 1]], [INVERTED]
         return faces, []
     if bool(np.all((vol > 0) | flat)):
         # every shell encloses positive volume as the file winds it: the file says each is a solid (one inside
@@ -145,7 +147,7 @@ def _orient_outward(
     depth = _nesting_depth(vertices - local_origin(vertices), faces, label, count)  # formed again: not held above
     if isinstance(depth, str):  # nesting undecidable: keep the file's orientation
         if total < 0 and np.all(vol <= 0):
-            return faces[:, [0, 2, 1]], ["inverted winding corrected (all faces pointed inward)"]
+            return faces[:, [0, 2, 1]], [INVERTED]
         return faces, [
             f"the {count} shells are kept as the file winds them ({depth}, so nesting was not tested); "
             f"{int(np.count_nonzero(vol < 0))} of them enclose negative volume (cavities)"
@@ -158,7 +160,7 @@ def _orient_outward(
     sel = flip_shell[label]
     out[sel] = out[sel][:, [0, 2, 1]]
     if np.all(flip_shell | flat):
-        return out, ["inverted winding corrected (all faces pointed inward)"]
+        return out, [INVERTED]
     return out, [
         f"winding corrected on {int(flip_shell.sum())} of {count} shells by their nesting "
         "(a shell inside an odd number of others is a cavity)"

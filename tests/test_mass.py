@@ -2,11 +2,14 @@
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 from typing import Any, cast
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from numpy.typing import ArrayLike
 from scipy.spatial.transform import Rotation
 
@@ -315,3 +318,31 @@ def test_single_point_mass_has_zero_inertia() -> None:
 def test_overflowing_coordinates_are_invalid_not_infinite() -> None:
     with pytest.raises(InvalidParameterError):
         mass_properties(PointBody(np.array([1.0, 1.0]), np.array([[1e254, 0, 0], [0, 1e254, 0]])))
+
+
+@given(mass=st.floats(min_value=1e-9, max_value=1e9, allow_nan=False, allow_infinity=False))
+@settings(max_examples=60, deadline=None)
+def test_a_requested_mass_comes_back_as_sent(mass: float) -> None:
+    # density = mass / volume, then density x volume, rounded the requested mass by an ulp (24 -> 23.999999999999996)
+    bodies = [
+        MeshBody(*l_bracket(1000.0), length_scale=1e-3),
+        MeshBody(*prism(6, 1.0, 3.0)),
+        PointBody(np.array([1.0, 2.0, 3.0]), np.eye(3)),
+    ]
+    for body in bodies:
+        assert mass_properties(body, mass=mass).mass == mass
+
+
+def test_the_parts_masses_add_up_to_the_whole() -> None:
+    # the whole was integrated as one body and rounded on its own: two boxes of 1000 and 2000 kg made 2999.9999999999995
+    from inertia.pipeline import analyze
+
+    quads = [(1, 3, 4, 2), (5, 6, 8, 7), (1, 2, 6, 5), (3, 7, 8, 4), (1, 5, 7, 3), (2, 4, 8, 6)]
+    lines = []
+    for k, (a, b, c) in enumerate([(0.1, 0.7, 1.3), (0.3, 1.1, 0.9), (2.0, 0.2, 0.7)]):
+        lines.append(f"o part{k}")
+        lines += [f"v {x * a + 3 * k!r} {y * b!r} {z * c!r}" for x in (0, 1) for y in (0, 1) for z in (0, 1)]
+        lines += ["f " + " ".join(str(8 * k + i) for i in quad) for quad in quads]
+    doc = analyze("\n".join(lines).encode(), filename="three.obj").as_dict()
+    assert len(doc["parts"]) == 3
+    assert doc["mass"] == math.fsum(p["mass"] for p in doc["parts"])

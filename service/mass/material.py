@@ -129,7 +129,8 @@ def _properties(
     d = DIMENSION[whole.kind]
     to_mass = material.per_measure * L**d
     inertia_scale = material.per_measure * L ** (d + 2)
-    total_mass = s.m0 * to_mass
+    # a requested mass is the body's mass by definition (density x volume would round it by an ulp)
+    total_mass = float(mass) if mass is not None and single else s.m0 * to_mass
     _check_finite_results(total_mass, com * L, tensor * inertia_scale)
     return MassProperties(
         mass=float(total_mass),
