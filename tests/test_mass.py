@@ -324,7 +324,7 @@ def test_overflowing_coordinates_are_invalid_not_infinite() -> None:
 @settings(max_examples=60, deadline=None)
 def test_a_requested_mass_comes_back_as_sent(mass: float) -> None:
     # density = mass / volume, then density x volume, rounded the requested mass by an ulp (24 -> 23.999999999999996)
-    bodies = [
+    bodies: list[MeshBody | PointBody] = [
         MeshBody(*l_bracket(1000.0), length_scale=1e-3),
         MeshBody(*prism(6, 1.0, 3.0)),
         PointBody(np.array([1.0, 2.0, 3.0]), np.eye(3)),
