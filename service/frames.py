@@ -21,11 +21,26 @@ from .arrays import freeze_fields
 from .conventions import matrix_from_quaternion
 from .errors import InvalidParameterError
 
-__all__ = ["NamedFrame", "named_frame", "frame_rotation", "UNIT_QUATERNION_TOLERANCE"]
+__all__ = ["NamedFrame", "named_frame", "frame_rotation", "frame_norm_warning", "UNIT_QUATERNION_TOLERANCE", "TYPED_ROUNDING"]
 
-# a quaternion typed with 7-8 significant digits per component has a norm within ~1e-7 of one;
-# beyond 1e-6 it is more likely a mistake (Euler angles, a vector) than rounding, so it is refused
-UNIT_QUATERNION_TOLERANCE = 1e-6
+# a quaternion typed with 7-8 significant digits per component has a norm within ~1e-7 of one, and one
+# typed with four (0.7071) within ~1e-4: such a quaternion is normalised, named in a warning past
+# TYPED_ROUNDING; beyond UNIT_QUATERNION_TOLERANCE it is more likely a mistake (Euler angles, a vector)
+# than rounding, so it is refused
+UNIT_QUATERNION_TOLERANCE = 1e-3
+TYPED_ROUNDING = 1e-6
+
+
+def _norm(q: Sequence[float]) -> float:
+    return math.sqrt(math.fsum(float(v) * float(v) for v in q))
+
+
+def frame_norm_warning(quaternion: Sequence[float]) -> str | None:
+    """A warning naming the normalisation of a frame quaternion typed with few digits; None if at rounding."""
+    norm = _norm(quaternion)
+    if abs(norm - 1.0) <= TYPED_ROUNDING:
+        return None
+    return f"the frame quaternion's norm is {norm:.9g}, not 1; it was normalised (divided by its norm)"
 
 
 @dataclass(frozen=True, slots=True)
@@ -57,7 +72,7 @@ def frame_rotation(quaternion: Sequence[float]) -> tuple[NDArray[np.float64], ND
         raise InvalidParameterError("frame must be four numbers w,x,y,z", parameter="frame") from exc
     if q.shape != (4,) or not np.all(np.isfinite(q)):
         raise InvalidParameterError("frame must be four finite numbers w,x,y,z (a unit quaternion)", parameter="frame")
-    norm = math.sqrt(math.fsum(float(v) * float(v) for v in q))
+    norm = _norm(q)
     if abs(norm - 1.0) > UNIT_QUATERNION_TOLERANCE:
         raise InvalidParameterError(
             f"frame must be a unit quaternion w,x,y,z (its norm is {norm:.9g}); scalar first, e.g. 1,0,0,0", parameter="frame"

@@ -107,8 +107,8 @@ def _check_v11(options: AnalysisOptions) -> None:
     if options.frame is not None:
         from .frames import frame_rotation
 
-        q, _ = frame_rotation(options.frame)
-        object.__setattr__(options, "frame", tuple(float(v) for v in q))
+        frame_rotation(options.frame)  # refused here if it is no unit quaternion; normalised in the section
+        object.__setattr__(options, "frame", tuple(float(v) for v in options.frame))
     if options.isotopes not in values(Isotopes):
         raise InvalidParameterError(f"isotopes must be 'standard' or 'abundant', got {options.isotopes!r}", parameter="isotopes")
     if options.mass_unit not in values(MassUnit):

@@ -226,7 +226,11 @@ def _v11_sections(
                 "rotational constants need positive principal moments; a single atom (or atoms all at one place) has none"
             )
     if options.frame is not None:
-        from .frames import named_frame
+        from .frames import frame_norm_warning, named_frame
+
+        typed = frame_norm_warning(options.frame)
+        if typed is not None:
+            warnings.append(typed)
 
         out["named_frame"] = named_frame(
             options.frame,

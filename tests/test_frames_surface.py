@@ -108,6 +108,17 @@ def test_a_frame_that_is_not_a_unit_quaternion_is_refused(client: Any, frame: st
     assert r.json()["error"]["details"].get("parameter") == "frame"
 
 
+def test_a_quaternion_typed_with_four_digits_is_normalised_with_a_warning(client: Any) -> None:
+    # 0.7071,0,0,0.7071 (90 degrees about z as people type it) has norm 0.99999041
+    box = {"file": ("box.obj", _box_obj(ROTATION.as_matrix(), OFFSET).encode())}
+    typed = client.post("/v1/analyze/mesh", params={"frame": "0.7071,0,0,0.7071"}, files=box).json()
+    exact = client.post("/v1/analyze/mesh", params={"frame": f"{math.sqrt(0.5)!r},0,0,{math.sqrt(0.5)!r}"}, files=box).json()
+    assert typed["frame"]["quaternion"] == pytest.approx([math.sqrt(0.5), 0, 0, math.sqrt(0.5)], abs=1e-16)
+    np.testing.assert_allclose(typed["frame"]["inertia_tensor"], exact["frame"]["inertia_tensor"], rtol=0, atol=1e-15)
+    assert any("frame quaternion's norm is 0.99999" in w for w in typed["warnings"])
+    assert not any("frame quaternion" in w for w in exact["warnings"])
+
+
 def test_surface_area_and_radii_of_gyration_of_a_box(client: Any) -> None:
     a, b, c = EDGES
     doc = _post(client, _box_obj(ROTATION.as_matrix(), OFFSET))
