@@ -31,7 +31,7 @@ UNIT_QUATERNION_TOLERANCE = 1e-3
 TYPED_ROUNDING = 1e-6
 
 
-def _norm(q: Sequence[float]) -> float:
+def _norm(q: Sequence[float] | NDArray[np.float64]) -> float:
     return math.sqrt(math.fsum(float(v) * float(v) for v in q))
 
 
