@@ -76,7 +76,9 @@ Modelling decisions (stated once, here):
 - ``stable`` follows the contract: an asymmetric top is unstable when Omega
   starts nearest its intermediate axis; permanent rotation about the
   intermediate axis is unstable; every other regime is stable (a symmetric
-  top spun about a perpendicular axis is neutrally stable: no growth).
+  top spun about a perpendicular axis is neutrally stable: no growth).  A
+  body the classification calls symmetric is one: its middle axis, one of
+  the pair equal within ``tolerance``, is stable whatever rounding ordered.
 
 References: Landau & Lifshitz, Mechanics §§33-37; Celledoni, Fasso, Safstrom
 & Zanna, SIAM J. Sci. Comput. 30 (2008) 2084; Carlson, Numer. Algorithms 10

@@ -80,6 +80,11 @@ def _labelled(setup: Setup, classification: Classification) -> Setup:
     elif rotor.is_symmetric and regime is Regime.ASYMMETRIC:
         unique = 0 if rotor is RotorClass.SYMMETRIC_PROLATE else 2
         label = Regime.REGULAR_PRECESSION if setup.problem.omega_body[unique] != 0.0 else Regime.PERMANENT_ROTATION
+    elif rotor.is_symmetric and regime is Regime.PERMANENT_ROTATION and setup.stable is False:
+        # about the intermediate axis of moments the class calls equal (always one of the equal pair): the
+        # symmetric top's permanent rotation across its axis, which is stable (API.md: only an asymmetric
+        # top's intermediate axis is unstable); the trajectory is still the motion of the moments as they are
+        label, unique = Regime.PERMANENT_ROTATION, None
     else:
         return setup
     moments = np.asarray(setup.problem.moments, dtype=np.float64)
