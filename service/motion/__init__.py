@@ -49,9 +49,11 @@ Modelling decisions (stated once, here):
   symmetric top is not replaced by an ideal one whose motion departs from
   the true one over time.
 - Linear rotator: the component of Omega along its axis carries neither
-  angular momentum nor energy and moves no mass, so it is physically
-  meaningless; it is dropped (with a warning when it is not negligible) and
-  the rotator turns uniformly about M, perpendicular to its axis.
+  angular momentum nor energy and moves no mass, but it turns the body's
+  frame; it is kept, so the trajectory starts at the Omega given: the axis
+  turns uniformly about M, perpendicular to it, while the body spins about
+  the axis (the limit of a needle's regular precession as I1 -> 0).  Spun
+  only about its axis, a rotator is a permanent rotation, not at rest.
 - Omega is along a principal axis (permanent rotation) when its other
   principal components are within the rounding of ``axes @ Omega``
   (``Tolerances.permanent_rotation_rel``); a larger tilt, even 1e-9, is

@@ -24,7 +24,7 @@ from ..tolerances import Tolerances
 from .jacobi import AsymmetricTop
 from .regime import Setup
 from .result import MotionMethod, Regime
-from .symmetric import SymmetricTop, uniform_rotation
+from .symmetric import SymmetricTop, rotator_motion, uniform_rotation
 
 __all__ = ["PropagationMethod", "Exact", "Dop853", "Rk45", "Splitting", "METHODS", "CAPABILITIES", "EXACT_REST", "method_for"]
 
@@ -71,6 +71,8 @@ class Exact(PropagationMethod):
             # separatrix (no period), but the hyperbolic limit would part from the true motion by O(1)
             # after ~ln(1/gap)/rate (the first approach to the intermediate axis)
             return AsymmetricTop.from_initial(problem.moments, problem.omega_body, 0.0).propagate(t)
+        if setup.regime is Regime.ROTATOR:
+            return rotator_motion(problem.omega_body, t)
         return uniform_rotation(problem.omega_body, t)
 
 

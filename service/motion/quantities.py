@@ -47,10 +47,16 @@ def precession_quantities(setup: Setup, method: MotionMethod, tol: Tolerances) -
             period=2.0 * np.pi / abs(top.body_precession_rate),
         )
     if setup.regime is Regime.ROTATOR:
+        # M is perpendicular to the axis; a spin a about the axis adds the needle's limit rates (I1 -> 0):
+        # Omega turns about the axis in the body at -a, the body spins about it at a (``rotator_motion``)
+        spin = float(problem.omega_body[0])
         return replace(
             base,
-            space_precession_rate=float(np.linalg.norm(problem.omega_body)),
+            space_precession_rate=float(np.hypot(problem.omega_body[1], problem.omega_body[2])),
             nutation_angle=0.5 * np.pi,
+            body_precession_rate=-spin if spin != 0.0 else None,
+            spin_rate=spin if spin != 0.0 else None,
+            period=2.0 * np.pi / abs(spin) if spin != 0.0 else None,
         )
     if setup.regime is Regime.ASYMMETRIC:
         return _asymmetric_quantities(base, AsymmetricTop.from_initial(problem.moments, problem.omega_body, tol.separatrix_rel))

@@ -9,7 +9,6 @@ are stated in the package's docstring.
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -125,16 +124,6 @@ def _decide(
     rotor = motion_rotor(frame, classification, exact_moments)
     moments = ideal_moments(np.asarray(frame.moments, dtype=np.float64), rotor)
     warnings: list[str] = []
-    if rotor is RotorClass.LINEAR and omega_body[0] != 0.0:
-        along = abs(float(omega_body[0]))
-        if along > tol.permanent_rotation_rel * float(np.linalg.norm(omega_body)):
-            in_rad_s = math.ldexp(along, omega_exponent)
-            warnings.append(
-                f"the component of omega along the rotator axis ({in_rad_s:.3g} rad/s) has no physical effect "
-                "on a linear rotator and was dropped"
-            )
-        omega_body = omega_body.copy()
-        omega_body[0] = 0.0
     given = np.asarray(frame.moments, dtype=np.float64)
     if rotor is RotorClass.LINEAR and given[2] - given[1] > MOTION_ROUNDING * given[2]:
         warnings.append(
@@ -147,12 +136,16 @@ def _decide(
         return Setup(problem, Regime.REST, None, tuple(warnings))
     if rotor is RotorClass.SPHERICAL:
         return Setup(problem, Regime.SPHERICAL, True, tuple(warnings))
-    if rotor is RotorClass.LINEAR:
-        return Setup(problem, Regime.ROTATOR, True, tuple(warnings))
     # Omega_body = axes @ Omega carries rounding (and the axes their own error) unless the axes are an
     # exact signed permutation (principal moments given, a diagonal tensor): then a tilt is real, even
     # 1e-17, and moves as it does (about the intermediate axis it grows to a flip after ~40 / rate)
     noise = 0.0 if exact_axes(axes) else tol.permanent_rotation_rel
+    if rotor is RotorClass.LINEAR:
+        # the spin about the rotator's own axis carries no M or E and moves no mass, but it turns the body's
+        # frame: it is kept, so that Omega(t) starts as given (the limit of a needle as I1 -> 0)
+        if float(np.hypot(omega_body[1], omega_body[2])) <= noise * rate:
+            return Setup(_snap(problem, 0, None), Regime.PERMANENT_ROTATION, True, tuple(warnings))
+        return Setup(problem, Regime.ROTATOR, True, tuple(warnings))
     along_axis = _principal_axis_of(omega_body, noise)
     if rotor.is_symmetric:
         unique = 0 if rotor is RotorClass.SYMMETRIC_PROLATE else 2

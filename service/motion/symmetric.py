@@ -29,7 +29,7 @@ def uniform_rotation(omega_body: Array, t: Array) -> tuple[Array, Array]:
     """Omega constant in body and space: a rotation by |Omega| t about Omega.
 
     Exact for rest, permanent rotation about a principal axis, every motion of
-    a spherical top, and a linear rotator (Omega perpendicular to its axis).
+    a spherical top, and a linear rotator spun across its axis (``rotator_motion``).
     """
     rate = float(np.linalg.norm(omega_body))
     omega = np.broadcast_to(omega_body, (t.size, 3)).copy()
@@ -38,6 +38,29 @@ def uniform_rotation(omega_body: Array, t: Array) -> tuple[Array, Array]:
         attitude[:, 0] = 1.0
         return omega, attitude
     return omega, quat.from_axis_angle(omega_body / rate, rate * t)
+
+
+def rotator_motion(omega_body: Array, t: Array) -> tuple[Array, Array]:
+    """A linear rotator (axis x1, I1 = 0) with Omega_body = (a, w2, w3): M = I_perp (0, w2, w3) is fixed in
+    space, the axis turns about it at |w|, and the body spins about its axis at a.
+
+    The attitude is A(t) B(t): A a rotation by |w| t about w (a fixed direction in space, since the axis stays
+    perpendicular to it), B one by a t about x1; then Omega = w + a x1(t) in space, and in the body
+    Omega_body(t) = (a, w turned by -a t about x1).  This is the needle's regular precession as I1 -> 0
+    (L&L §33: body precession rate -a, spin a); with a = 0 it is the uniform rotation about w.
+    """
+    a = float(omega_body[0])
+    across = np.array([0.0, omega_body[1], omega_body[2]])
+    if a == 0.0:
+        return uniform_rotation(across, t)
+    c, s = np.cos(a * t), np.sin(a * t)
+    omega = np.empty((t.size, 3))
+    omega[:, 0] = a
+    omega[:, 1] = c * across[1] + s * across[2]
+    omega[:, 2] = c * across[2] - s * across[1]
+    _, turn = uniform_rotation(across, t)
+    spin = quat.from_axis_angle(np.array([1.0, 0.0, 0.0]), a * t)
+    return omega, quat.multiply(turn, spin)
 
 
 _CYCLIC = {0: (1, 2), 2: (0, 1)}  # unique index s -> (p, q) with (p, q, s) right-handed

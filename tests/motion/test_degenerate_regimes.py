@@ -143,13 +143,42 @@ def test_a_zero_smallest_moment_is_a_linear_rotator_whatever_rounding_left(i2: f
     """I1 = 0 puts all mass on a line, so I2 = I3 (L&L §32); the triangle inequality admits a gap of
     rounding (or of the tolerance).  Such moments divided by I1 = 0 (ZeroDivisionError, a 422 that
     said the numbers were too large or too small) before; the rotator turns uniformly about M."""
-    omega = (0.3, 0.5, 0.2)
+    omega = (0.0, 0.5, 0.2)
     res = precession(omega, principal_moments=(0.0, i2, 1.0), duration=5.0, samples=3)
     assert res.motion.regime.value == "rotator"
     assert res.motion.trajectory is not None
     assert np.array_equal(res.motion.trajectory.omega_body, np.tile([0.0, 0.5, 0.2], (3, 1)))
-    assert any("has no physical effect" in w for w in res.warnings)
     assert any("their mean was used" in w for w in res.warnings) is (1.0 - i2 > 1e-12)
+
+
+@pytest.mark.parametrize("spin", [0.3, -1.7])
+def test_a_rotator_spun_about_its_axis_too_is_the_needles_limit(spin: float) -> None:
+    """A spin about a linear rotator's own axis carries no M or E; it was dropped, so the trajectory's
+    Omega(0) was not the one given.  Kept, the motion is a needle's regular precession as I1 -> 0: the
+    same trajectory as the symmetric top (L&L §33, its own closed form) of I1 = 1e-12, to ~1e-12."""
+    omega = (spin, 0.5, 0.2)
+    rotator = precession(omega, principal_moments=(0.0, 1.0, 1.0), duration=7.0, samples=15).motion
+    needle = precession(omega, principal_moments=(1e-12, 1.0, 1.0), tolerance=1e-15, duration=7.0, samples=15).motion
+    assert rotator.regime.value == "rotator" and needle.regime.value == "regular_precession"
+    assert rotator.trajectory is not None and needle.trajectory is not None
+    assert np.array_equal(rotator.trajectory.omega_body[0], omega)
+    np.testing.assert_allclose(rotator.trajectory.omega_body, needle.trajectory.omega_body, rtol=0, atol=1e-10)
+    np.testing.assert_allclose(rotator.trajectory.quaternion, needle.trajectory.quaternion, rtol=0, atol=1e-10)
+    np.testing.assert_allclose(rotator.trajectory.omega, needle.trajectory.omega, rtol=0, atol=1e-10)
+    assert rotator.body_precession_rate == pytest.approx(needle.body_precession_rate, rel=1e-11)
+    assert rotator.spin_rate == pytest.approx(needle.spin_rate, rel=1e-11)
+    assert rotator.space_precession_rate == pytest.approx(needle.space_precession_rate, rel=1e-11)
+    drifts = (rotator.diagnostics.energy_drift, rotator.diagnostics.momentum_drift)
+    assert all(d is not None and d <= 1e-15 for d in drifts)
+
+
+def test_a_rotator_spun_only_about_its_axis_is_a_permanent_rotation_not_rest() -> None:
+    res = precession((2.0, 0.0, 0.0), principal_moments=(0.0, 1.0, 1.0), duration=1.0, samples=3).motion
+    assert res.regime.value == "permanent_rotation" and res.stable is True
+    assert res.trajectory is not None
+    assert np.array_equal(res.trajectory.omega, np.tile([2.0, 0.0, 0.0], (3, 1)))
+    half = np.array([np.cos(0.5), np.sin(0.5), 0.0, 0.0])  # turned by 1 rad about x after 0.5 s
+    np.testing.assert_allclose(res.trajectory.quaternion[1], half, rtol=0, atol=1e-15)
 
 
 def test_rounding_level_permanent_rotation_about_the_intermediate_axis_says_when_it_stops_holding() -> None:
