@@ -48,6 +48,7 @@ from ..errors import ExternalReferenceError, InputTooLargeError, UnreadableFileE
 
 __all__ = [
     "check_upload",
+    "own_name",
     "plain_name",
     "refuse_reference",
     "inflate_budget",
@@ -92,7 +93,7 @@ class _Context:
 
     def reference(self, target: str, what: str) -> None:
         """Accept a referenced file only if it is a plain name that came in the same upload."""
-        name = target.strip().strip("'\"")
+        name = own_name(target.strip().strip("'\""))
         if plain_name(name) and name in self.companions:
             return
         raise ExternalReferenceError(
@@ -114,6 +115,13 @@ def _relative_within(name: str) -> bool:
     if not name or ":" in name or name.startswith(("/", "\\")):
         return False
     return ".." not in PurePosixPath(name.replace("\\", "/")).parts
+
+
+def own_name(name: str) -> str:
+    """The name without leading ``./`` (the folder itself): ``./mesh.bin`` is ``mesh.bin``."""
+    while name.startswith(("./", ".\\")):
+        name = name[2:]
+    return name
 
 
 def plain_name(name: str) -> bool:

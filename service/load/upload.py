@@ -131,12 +131,13 @@ def pick_model_file(files: list[tuple[str, bytes]], format: str | None = None) -
 
 
 def _not_included(models: list[str], data: dict[str, bytes]) -> list[str]:
-    """The candidates no other candidate reads: an Abaqus deck and the ``.inp`` files it includes are one model.
+    """The candidates no Abaqus deck among them reads: a deck and the files it includes (``.inp``, or a
+    CalculiX ``all.msh``) are one model.
 
     Includes name plain files (``guard.plain_name``), offered under their base name.
     """
     decks = [n for n in models if _ext(n) == "inp"]
-    if len(decks) < 2:
+    if not decks:
         return models
     from .volume import abaqus_input_names
 

@@ -74,7 +74,7 @@ from numpy.typing import NDArray
 from ..body import CellBlock, MeshBody, Part, VolumeBody, stored_eps
 from ..cells import CELL_NODES, VOXEL_TO_HEXAHEDRON
 from ..errors import EmptyGeometryError, InputTooLargeError, UnreadableFileError, UnsupportedFormatError
-from .guard import INFLATE_RATIO, inflate_budget, refuse_reference
+from .guard import INFLATE_RATIO, inflate_budget, own_name, refuse_reference
 from .polygons import fan_split_note, fan_triangles
 from .sniff import VOLUME_FORMATS
 
@@ -433,9 +433,37 @@ def _mesh_from_grid(grid: Any, to_numpy: Any, label: str) -> _Mesh:
         if name == "voxel":
             nodes, name = nodes[:, VOXEL_TO_HEXAHEDRON], "hexahedron"
         mesh.blocks.append(_Block(name, nodes, ids, f"{VTK_CELL_TYPES[vtk_type]}_{len(mesh.blocks)}"))
+    ghosts = grid.GetCellData().GetArray("vtkGhostType")
+    if ghosts is not None:
+        _drop_ghost_cells(mesh, np.asarray(to_numpy(ghosts), dtype=np.int64).reshape(-1), label)
     if not mesh.blocks:
         mesh.surface = _vtk_surface(types, conn, offsets, label, mesh.warnings)
     return mesh
+
+
+# vtkDataSetAttributes::DUPLICATECELL | HIDDENCELL: the cells VTK's own integration (vtkIntegrateAttributes)
+# leaves out, a neighbouring piece's copy or a blanked cell
+_VTK_GHOST_SKIPPED = 1 | 32
+
+
+def _drop_ghost_cells(mesh: _Mesh, ghosts: NDArray[np.int64], label: str) -> None:
+    """Leave out the cells a ``vtkGhostType`` array marks as another piece's copy or as hidden, as VTK does."""
+    if len(ghosts) == 0 or not np.any(ghosts & _VTK_GHOST_SKIPPED):
+        return
+    skipped = (ghosts & _VTK_GHOST_SKIPPED) != 0
+    dropped = 0
+    for b in mesh.blocks:
+        keep = ~skipped[b.cell_ids] if len(ghosts) > int(b.cell_ids.max(initial=-1)) else np.ones(len(b.cell_ids), bool)
+        if not keep.all():
+            dropped += len(np.unique(b.cell_ids[~keep]))
+            b.nodes, b.cell_ids = b.nodes[keep], b.cell_ids[keep]
+            b.file_cells = None if b.file_cells is None else len(np.unique(b.cell_ids))
+    mesh.blocks = [b for b in mesh.blocks if len(b.nodes)]
+    if dropped:
+        mesh.warnings.append(
+            f"{label} marks {_count(dropped, 'cell')} as ghost cells (vtkGhostType: a neighbouring piece's copy "
+            "or hidden); they were left out, as VTK's own integration leaves them out"
+        )
 
 
 # linear 2-D VTK cells of a fixed size: corners in order around the face (a pixel's go row by row: 0 1 3 2)
@@ -703,7 +731,14 @@ def _read_meshio(data: bytes, fmt: str, label: str, filename: str | None, compan
             if isinstance(exc, ImportError) and (exc.name or "").partition(".")[0] == "h5py":
                 raise _hdf5_missing(label, fmt, exc) from exc
             raise UnreadableFileError(_meshio_failure(exc, printed.getvalue(), path, fmt, label, companions), format=fmt) from exc
+    if fmt == "msh":
+        _gmsh_node_order(mesh)
     out = _mesh_from_meshio(mesh, label)
+    if fmt == "msh":
+        _drop_repeated_cells(out, label)
+    ghosts = mesh.cell_data.get("vtkGhostType")
+    if ghosts is not None:
+        _drop_ghost_cells(out, np.concatenate([np.asarray(g, dtype=np.int64).reshape(-1) for g in ghosts]), label)
     if fmt == "inp":  # Abaqus's 2-D elements are shells and membranes: their mass is their sections', not a solid's
         out.surface = None
     if fmt == "inp" and out.blocks and out.other:  # Abaqus shells, beams, trusses have mass through their sections
@@ -713,6 +748,60 @@ def _read_meshio(data: bytes, fmt: str, label: str, filename: str | None, compan
             "section properties; they were not weighed: the result is the solid elements alone"
         )
     return out
+
+
+# Gmsh numbers an 18-node prism's nodes its own way (edges 0-1, 0-2, 0-3, 1-2, 1-4, 2-5, 3-4, 3-5, 4-5, then the
+# quadrilateral faces 0-1-4-3, 0-2-5-3, 1-2-5-4; gmsh.info, "Node ordering"), VTK another (edges 0-1, 1-2, 2-0,
+# 3-4, 4-5, 5-3, 0-3, 1-4, 2-5, faces 0-1-4-3, 1-2-5-4, 2-0-3-5; vtkBiQuadraticQuadraticWedge).  meshio 5.3.5
+# reorders the 15-node prism but passes the 18-node one on as it is: every such cell came back folded.
+_GMSH_TO_VTK = {"wedge18": [0, 1, 2, 3, 4, 5, 6, 9, 7, 12, 14, 13, 8, 10, 11, 15, 17, 16]}
+
+
+def _gmsh_node_order(mesh: Any) -> None:
+    """Put the Gmsh cells meshio leaves in Gmsh's node order into VTK's (``_GMSH_TO_VTK``), in place."""
+    try:
+        from meshio.gmsh.common import _gmsh_to_meshio_order as meshio_order
+    except ImportError:  # pragma: no cover - a meshio without it reorders nothing we know of
+        meshio_order = None
+    for block in mesh.cells:
+        order = _GMSH_TO_VTK.get(block.type)
+        if order is None:
+            continue
+        probe = np.arange(len(order))[None, :]
+        if meshio_order is not None and not np.array_equal(meshio_order(block.type, probe), probe):
+            continue  # a meshio that reorders it itself
+        block.data = np.asarray(block.data)[:, order]
+
+
+def _drop_repeated_cells(mesh: _Mesh, label: str) -> None:
+    """Weigh once a 3-D cell that a Gmsh file lists more than once.
+
+    MSH 2.2 writes an element once for each physical group it belongs to (MSH 4 once, with its entity's
+    groups): a volume in two groups came back twice as heavy.  A repeat (the same type on the same nodes)
+    is left out of the later block, and a warning says how many there were.
+    """
+    repeated = 0
+    for ctype in dict.fromkeys(b.type for b in mesh.blocks):
+        blocks = [b for b in mesh.blocks if b.type == ctype]
+        rows = np.concatenate([np.sort(b.nodes, axis=1) for b in blocks])
+        _, first = np.unique(rows, axis=0, return_index=True)
+        if len(first) == len(rows):
+            continue
+        keep = np.zeros(len(rows), dtype=bool)
+        keep[first] = True  # the first listing of each cell, in file order
+        repeated += len(rows) - len(first)
+        start = 0
+        for b in blocks:
+            mine = keep[start : start + len(b.nodes)]
+            start += len(b.nodes)
+            if not mine.all():
+                b.nodes, b.cell_ids, b.file_cells = b.nodes[mine], b.cell_ids[mine], None
+    if repeated:
+        mesh.blocks = [b for b in mesh.blocks if len(b.nodes)]
+        mesh.warnings.append(
+            f"{label} lists {_count(repeated, '3-D cell')} more than once (MSH 2.2 writes an element once for each "
+            "physical group it is in); each was weighed once, in the first group that lists it"
+        )
 
 
 def _hdf5_missing(label: str, fmt: str, exc: ImportError) -> UnsupportedFormatError:
@@ -825,7 +914,7 @@ def abaqus_input_names(data: bytes) -> set[str]:
 
 
 def _input_name(m: re.Match[bytes]) -> str:
-    return m.group("name").strip().strip(b"'\"").decode("utf-8", "replace")
+    return own_name(m.group("name").strip().strip(b"'\"").decode("utf-8", "replace"))
 
 
 def abaqus_flatten(data: bytes, companions: Mapping[str, bytes], label: str) -> bytes:

@@ -183,6 +183,18 @@ def test_an_upload_of_a_deck_with_inp_includes_reads_the_deck_that_includes_them
     assert doc["source"]["filename"] == "job.inp"
 
 
+def test_an_include_named_from_the_folder_itself_is_the_file_beside(tmp_path: Path) -> None:
+    # CalculiX decks include their generated mesh as INPUT=./all.msh: refused as a path, and all.msh (a readable
+    # format's name) counted as a second model of the upload
+    deck, mesh = b"*HEADING\n*INCLUDE, INPUT=./all.msh\n", f"*NODE\n{CORNER_TET}*ELEMENT, TYPE=C3D4\n1, 1, 2, 3, 4\n".encode()
+    doc = analyze_loaded(load_body([("beam.inp", deck), ("all.msh", mesh)]), AnalysisOptions()).as_dict()
+    assert doc["mass"] / doc["density"] == pytest.approx(1 / 6, rel=1e-14)
+    (tmp_path / "beam.inp").write_bytes(deck)
+    (tmp_path / "all.msh").write_bytes(mesh)
+    doc = analyze(tmp_path / "beam.inp").as_dict()
+    assert doc["mass"] / doc["density"] == pytest.approx(1 / 6, rel=1e-14)
+
+
 def test_two_decks_that_include_neither_are_still_two_models() -> None:
     one = f"*NODE\n{CORNER_TET}*ELEMENT, TYPE=C3D4\n1, 1, 2, 3, 4\n".encode()
     with pytest.raises(UnsupportedFormatError, match="2 model files"):

@@ -49,6 +49,17 @@ def test_analyze_reads_the_buffers_beside_a_gltf(tmp_path: Path) -> None:
     assert doc["center_of_mass"] == pytest.approx([0.0, 0.0, 0.0], abs=1e-15)
 
 
+def test_a_uri_written_from_the_folder_itself_names_the_file_beside(tmp_path: Path) -> None:
+    # "./gltf_buffer_0.bin" is a relative reference (RFC 3986) to the file beside the model; it was refused as a
+    # path, on disk and in an upload alike
+    path = write_gltf(tmp_path, rename={"gltf_buffer_0.bin": "./gltf_buffer_0.bin"})
+    assert "./gltf_buffer_0.bin" in path.read_text(encoding="utf-8")
+    doc = analyze(path).as_dict()
+    assert doc["mass"] == pytest.approx(doc["density"] * VOLUME, rel=1e-14)
+    buffers = [(p.name, p.read_bytes()) for p in sorted(tmp_path.glob("*.bin"))]
+    assert load_body([(path.name, path.read_bytes()), *buffers]).parts
+
+
 def test_the_command_line_reads_them_too(tmp_path: Path) -> None:
     out = subprocess.run(
         [sys.executable, "-m", "inertia", "analyze", str(write_gltf(tmp_path)), "--json"],

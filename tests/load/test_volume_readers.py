@@ -447,3 +447,25 @@ def test_an_mfem_mesh_is_named_as_such_not_misread_as_medit() -> None:
     data = b"MFEM mesh v1.0\n\ndimension\n3\n\nelements\n1\n1 4 0 1 2 3\n"
     with pytest.raises(UnsupportedFormatError, match="is an MFEM mesh"):
         analyze(data, filename="beam-tet.mesh")
+
+
+@pytest.mark.parametrize("ext", ["vtu", "vtk"])
+@pytest.mark.parametrize("ghost", [0, 1, 2, 32, 33])
+def test_ghost_cells_are_left_out_as_vtks_integration_leaves_them(tmp_path: Path, ext: str, ghost: int) -> None:
+    # a piece of a parallel data set carries its neighbour's cells marked vtkGhostType: they were weighed
+    points = np.array([(0, 0, 0), (1, 0, 0), (0, 1, 0), (0, 0, 1), (3, 0, 0), (5, 0, 0), (3, 2, 0), (3, 0, 2)], float)
+    ug = grid([(vtk.VTK_TETRA, [0, 1, 2, 3]), (vtk.VTK_TETRA, [4, 5, 6, 7])], points)
+    marks = vtk.vtkUnsignedCharArray()
+    marks.SetName("vtkGhostType")
+    marks.InsertNextValue(0)
+    marks.InsertNextValue(ghost)
+    ug.GetCellData().AddArray(marks)
+    integrate = vtk.vtkIntegrateAttributes()
+    integrate.SetInputData(ug)
+    integrate.Update()
+    expected = integrate.GetOutput().GetCellData().GetArray("Volume").GetValue(0)  # VTK's own figure
+    path = tmp_path / f"piece.{ext}"
+    data = write_vtu(ug, path) if ext == "vtu" else write_legacy(ug, path)
+    doc = analyze(data, filename=path.name).as_dict()
+    assert doc["mass"] / doc["density"] == pytest.approx(expected, rel=1e-14)
+    assert any("ghost" in w for w in doc["warnings"]) is bool(ghost & 33)
