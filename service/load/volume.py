@@ -297,6 +297,12 @@ def _safe_name(name: str) -> str:
 def _reason(exc: BaseException, printed: str, tmp_paths: tuple[str, ...]) -> str:
     """One line saying what the library objected to, without our temporary paths."""
     text = str(exc).strip() if not isinstance(exc, SystemExit) else ""
+    if isinstance(exc, KeyError) and exc.args:  # str() of a KeyError is the bare key: np.int32(7)
+        key = exc.args[0]
+        key = key.item() if hasattr(key, "item") else key
+        text = f"it refers to {key!r} (a node, element, tag or entity number) without defining it"
+    elif isinstance(exc, IndexError):
+        text = f"it refers to an entry it does not hold, or announces more than it holds ({text or 'index out of range'})"
     if not text:
         text = next((ln.strip() for ln in printed.splitlines() if ln.strip()), "") or type(exc).__name__
     text = text.splitlines()[0]
@@ -433,12 +439,36 @@ def _mesh_from_grid(grid: Any, to_numpy: Any, label: str) -> _Mesh:
         if name == "voxel":
             nodes, name = nodes[:, VOXEL_TO_HEXAHEDRON], "hexahedron"
         mesh.blocks.append(_Block(name, nodes, ids, f"{VTK_CELL_TYPES[vtk_type]}_{len(mesh.blocks)}"))
+    if mesh.blocks:
+        lower = np.flatnonzero(~np.isin(types, list(VTK_CELL_TYPES) + list(_VTK_POLYHEDRA)))
+        if len(lower):
+            starts, ends = offsets[lower], offsets[lower + 1]
+            used = np.concatenate([conn[a:b] for a, b in zip(starts.tolist(), ends.tolist())])
+            _surface_apart_warning(mesh, used, label)
     ghosts = grid.GetCellData().GetArray("vtkGhostType")
     if ghosts is not None:
         _drop_ghost_cells(mesh, np.asarray(to_numpy(ghosts), dtype=np.int64).reshape(-1), label)
     if not mesh.blocks:
         mesh.surface = _vtk_surface(types, conn, offsets, label, mesh.warnings)
     return mesh
+
+
+def _surface_apart_warning(mesh: _Mesh, lower_nodes: NDArray[np.int64], label: str) -> None:
+    """Say so where the file's 2-D (or 1-D, 0-D) cells reach points no 3-D cell uses: a body of its own
+    (a closed skin beside the volume), which the volume's weight leaves out; boundary faces of the
+    volume itself, as Gmsh writes its physical surfaces, use only the volume's points."""
+    if len(lower_nodes) == 0:
+        return
+    used = np.zeros(len(mesh.points), dtype=bool)
+    for b in mesh.blocks:
+        used[b.nodes.ravel()] = True
+    inside = (lower_nodes >= 0) & (lower_nodes < len(used))
+    apart = np.unique(lower_nodes[inside][~used[lower_nodes[inside]]])
+    if len(apart):
+        mesh.warnings.append(
+            f"{label} also holds surface, line or point cells on {_count(len(apart), 'point')} that no 3-D cell "
+            "uses (a body apart from the volume); only the 3-D cells were weighed"
+        )
 
 
 # vtkDataSetAttributes::DUPLICATECELL | HIDDENCELL: the cells VTK's own integration (vtkIntegrateAttributes)
@@ -1121,6 +1151,9 @@ def _mesh_from_meshio(mesh: Any, label: str) -> _Mesh:
             out.blocks.append(_Block(ctype, nodes, ids, names[i]))
     if unsupported:
         raise UnsupportedFormatError(_unsupported_cells(label, unsupported), cell_types=sorted(unsupported))
+    if out.blocks:
+        flat = [np.asarray(b.data, dtype=np.int64).ravel() for b in mesh.cells if _ALIASES.get(b.type, b.type) not in _NODES]
+        _surface_apart_warning(out, np.concatenate(flat) if flat else np.empty(0, np.int64), label)
     if not out.blocks:
         faces = [np.asarray(b.data, dtype=np.int64) for b in mesh.cells if b.type in _MESHIO_POLYGONS]
         faces = [f for f in faces if f.ndim == 2 and f.shape[1] >= 3 and len(f)]

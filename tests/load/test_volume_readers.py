@@ -469,3 +469,16 @@ def test_ghost_cells_are_left_out_as_vtks_integration_leaves_them(tmp_path: Path
     doc = analyze(data, filename=path.name).as_dict()
     assert doc["mass"] / doc["density"] == pytest.approx(expected, rel=1e-14)
     assert any("ghost" in w for w in doc["warnings"]) is bool(ghost & 33)
+
+
+def test_a_surface_cell_apart_from_the_volume_is_named(tmp_path: Path) -> None:
+    points = np.array([(0, 0, 0), (1, 0, 0), (0, 1, 0), (0, 0, 1), (5, 0, 0), (6, 0, 0), (5, 1, 0)], float)
+    apart = grid([(vtk.VTK_TETRA, [0, 1, 2, 3]), (vtk.VTK_TRIANGLE, [4, 5, 6])], points)
+    face = grid([(vtk.VTK_TETRA, [0, 1, 2, 3]), (vtk.VTK_TRIANGLE, [0, 1, 2])], points)
+    docs = [
+        analyze(write_vtu(ug, tmp_path / f"{name}.vtu"), filename=f"{name}.vtu").as_dict()
+        for name, ug in (("a", apart), ("f", face))
+    ]
+    assert docs[0]["mass"] == docs[1]["mass"] == pytest.approx(1000 / 6, rel=1e-14)
+    assert any("3 points that no 3-D cell uses" in w for w in docs[0]["warnings"])
+    assert not any("no 3-D cell uses" in w for w in docs[1]["warnings"])
