@@ -440,3 +440,34 @@ def test_an_ascii_stl_with_a_utf8_byte_order_mark_is_read() -> None:
     text = data.encode() if isinstance(data, str) else data
     res = analyze(b"\xef\xbb\xbf" + text, filename="box.stl", options=AnalysisOptions(density=1.0)).as_dict()
     assert res["mass"] == pytest.approx(6.0, rel=1e-14)
+
+
+# a 1 x 2 x 3 box, vertex x + 2y + 4z at (x, 2y, 3z), each face a quad wound outward
+_BOX_CORNERS = [(x * 1.0, y * 2.0, z * 3.0) for z in (0, 1) for y in (0, 1) for x in (0, 1)]
+_BOX_QUADS = [(0, 2, 3, 1), (4, 5, 7, 6), (0, 1, 5, 4), (2, 6, 7, 3), (0, 4, 6, 2), (1, 3, 7, 5)]
+
+
+@pytest.mark.parametrize("encoding", ["ascii", "binary_little_endian"])
+def test_ply_triangle_strips_are_read(encoding: str) -> None:
+    # Stanford's igea.ply keeps its 268,686 triangles as one tristrips element, which trimesh does not read: it
+    # was refused as "only points or lines". Quad a b c d is the strip a b d c: (a, b, d), then (d, b, c) turned;
+    # -1 starts the next strip; the second element joins two faces by a repeated vertex (a zero-area triangle)
+    strips = [[v for q in _BOX_QUADS[:4] for v in (q[0], q[1], q[3], q[2], -1)]]
+    q4, q5 = _BOX_QUADS[4], _BOX_QUADS[5]
+    strips.append([q4[0], q4[1], q4[3], q4[2], q4[2], q5[0], q5[0], q5[1], q5[3], q5[2]])
+    if encoding != "ascii":  # one element, as igea.ply has (trimesh reads binary lists of one length per element)
+        strips = [strips[0] + strips[1]]
+    head = ["ply", f"format {encoding} 1.0", "element vertex 8", "property double x", "property double y"]
+    head += ["property double z", f"element tristrips {len(strips)}", "property list int int vertex_indices", "end_header"]
+    text = ("\n".join(head) + "\n").encode()
+    if encoding == "ascii":
+        text += "".join(f"{x!r} {y!r} {z!r}\n" for x, y, z in _BOX_CORNERS).encode()
+        text += "".join(" ".join(str(v) for v in [len(s), *s]) + "\n" for s in strips).encode()
+    else:
+        text += np.asarray(_BOX_CORNERS, dtype="<f8").tobytes()
+        text += b"".join(np.asarray([len(s), *s], dtype="<i4").tobytes() for s in strips)
+    doc = analyze(text, filename="strips.ply").as_dict()
+    assert doc["mass"] / doc["density"] == pytest.approx(6.0, rel=1e-15)
+    assert doc["center_of_mass"] == pytest.approx([0.5, 1.0, 1.5], rel=1e-15)
+    assert doc["principal"]["moments"] == pytest.approx(sorted(6000 * (p + q) / 12 for p, q in ((4, 9), (1, 9), (1, 4))), rel=1e-14)
+    assert not doc["warnings"]

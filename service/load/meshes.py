@@ -125,6 +125,8 @@ def read_trimesh_parts(
         ),
         fmt,
     )
+    if fmt == "ply":
+        _with_triangle_strips(scene)
     parts: list[Part] = []
     skipped = 0
     nodes = guarded_read(lambda: sorted(scene.graph.nodes_geometry, key=str), fmt)  # node order is not stable
@@ -221,10 +223,44 @@ def _off_face_lists(data: bytes) -> list[list[int]] | None:
         return None
 
 
-def _ply_face_lists(raw: Any) -> list[Any] | None:
+def _with_triangle_strips(scene: Any) -> None:
+    """Add the triangles of a PLY file's ``tristrips`` element (trimesh reads no strips) to its mesh, in place.
+
+    Each strip lists vertices; -1 starts a new strip.  Triangle i of a strip is (v_i, v_i+1, v_i+2), every
+    other one turned (v_i+1, v_i, v_i+2) so that all wind alike; triangles that repeat a vertex (the joins
+    of stitched strips) are left out.  Stanford's and VCG's tools write meshes this way (igea.ply).
+    """
+    import trimesh
+
+    for name, geom in list(scene.geometry.items()):
+        strips = _ply_face_lists((getattr(geom, "metadata", None) or {}).get("_ply_raw"), "tristrips")
+        if not strips:
+            continue
+        lists = [np.asarray(strip, dtype=np.int64).reshape(-1) for strip in strips]
+        runs = [run for strip in lists for run in np.split(strip, np.flatnonzero(strip < 0))]
+        triangles = [_strip_triangles(run[run >= 0]) for run in runs]
+        added = np.concatenate(triangles) if triangles else np.empty((0, 3), np.int64)
+        faces = np.asarray(getattr(geom, "faces", np.empty((0, 3))), dtype=np.int64).reshape(-1, 3)
+        mesh = trimesh.Trimesh(np.asarray(geom.vertices), np.concatenate([faces, added]), process=False)
+        mesh.metadata.update(geom.metadata)
+        scene.geometry[name] = mesh
+
+
+def _strip_triangles(run: NDArray[np.int64]) -> NDArray[np.int64]:
+    """The triangles of one triangle strip, all wound as its first (``_with_triangle_strips``)."""
+    if len(run) < 3:
+        return np.empty((0, 3), np.int64)
+    a, b, c = run[:-2], run[1:-1], run[2:]
+    odd = np.arange(len(a)) % 2 == 1
+    triangles = np.stack([np.where(odd, b, a), np.where(odd, a, b), c], axis=1)
+    kept: NDArray[np.int64] = triangles[(a != b) & (b != c) & (a != c)]
+    return kept
+
+
+def _ply_face_lists(raw: Any, element: str = "face") -> list[Any] | None:
     """Each face's vertex list from trimesh's raw PLY elements (a dict of arrays or a structured array), or None."""
     try:
-        data = raw["face"]["data"]
+        data = raw[element]["data"]
         for key in ("vertex_indices", "vertex_index"):
             named = isinstance(data, np.ndarray) and bool(data.dtype.names) and key in (data.dtype.names or ())
             if not ((isinstance(data, dict) and key in data) or named):
