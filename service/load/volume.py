@@ -764,7 +764,7 @@ def _read_meshio(data: bytes, fmt: str, label: str, filename: str | None, compan
     if fmt == "msh":
         _gmsh_node_order(mesh)
     out = _mesh_from_meshio(mesh, label)
-    if fmt == "msh":
+    if fmt == "msh" and re.match(rb"\s*\$MeshFormat\s+[12]\.", data[:64]):  # MSH 4 lists an element once
         _drop_repeated_cells(out, label)
     ghosts = mesh.cell_data.get("vtkGhostType")
     if ghosts is not None:
@@ -814,12 +814,15 @@ def _drop_repeated_cells(mesh: _Mesh, label: str) -> None:
     for ctype in dict.fromkeys(b.type for b in mesh.blocks):
         blocks = [b for b in mesh.blocks if b.type == ctype]
         rows = np.concatenate([np.sort(b.nodes, axis=1) for b in blocks])
-        _, first = np.unique(rows, axis=0, return_index=True)
-        if len(first) == len(rows):
+        order = np.lexsort(rows.T[::-1])  # stable: equal rows stay in file order
+        ranked = rows[order]
+        again = np.zeros(len(rows), dtype=bool)
+        again[1:] = np.all(ranked[1:] == ranked[:-1], axis=1)
+        if not again.any():
             continue
-        keep = np.zeros(len(rows), dtype=bool)
-        keep[first] = True  # the first listing of each cell, in file order
-        repeated += len(rows) - len(first)
+        keep = np.ones(len(rows), dtype=bool)
+        keep[order[again]] = False  # every listing after the first, in file order
+        repeated += int(again.sum())
         start = 0
         for b in blocks:
             mine = keep[start : start + len(b.nodes)]
