@@ -147,7 +147,8 @@ def read_trimesh_parts(
         name = str(node) if node != geom_name or len(nodes) > 1 else str(geom_name)
         parts.append(mesh_part(name, vertices, faces, length_scale, fmt))
     if not parts:
-        what = " (only points or lines)" if skipped else ""
+        # what the reader found: an OFF face split over several lines, say, is read as none
+        what = " its reader could take (it found only points or lines)" if skipped else ""
         raise EmptyGeometryError(f"the {fmt.upper()} file holds no triangles{what}; a solid needs a triangle mesh", format=fmt)
     if fmt == "ply":
         notes += _ply_split_notes(scene)
