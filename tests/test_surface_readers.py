@@ -155,6 +155,27 @@ def test_3mf_support_objects_are_listed_not_weighed() -> None:
     assert any("'prop'" in w and "not weighed" in w for w in doc["warnings"])
 
 
+@pytest.mark.parametrize("closed", [True, False])
+def test_3mf_a_support_that_is_a_component_of_the_part_is_not_weighed(closed: bool) -> None:
+    # ch. 4.1 recommends attaching supports to a part as components (lib3mf's 3mfbase13_holed_cube_support.3mf):
+    # a closed support was weighed silently, an open one refused the file as not watertight
+    v, f = cube(5.0, (20.0, 0.0, 0.0))
+    support = mesh_xml(v, f if closed else f[:-2])
+    data = package(
+        model(
+            f'<object id="1" type="model" name="block">{mesh_xml(*cube(10.0))}</object>'
+            f'<object id="2" type="support" name="prop">{support}</object>'
+            '<object id="3" type="model" name="part"><components><component objectid="1"/><component objectid="2"/>'
+            "</components></object>",
+            '<item objectid="3"/>',
+        )
+    )
+    doc = analyze(data, filename="p.3mf", options=AnalysisOptions(density=1.0)).as_dict()
+    assert doc["mass"] == pytest.approx(1000 * 1e-9, rel=1e-14)
+    assert doc["center_of_mass"] == pytest.approx([0.005, 0.005, 0.005], rel=1e-14)
+    assert any("prop (support)" in w and "not weighed" in w for w in doc["warnings"])
+
+
 def test_3mf_production_objects_in_another_model_part_are_read() -> None:
     other = (
         f'<?xml version="1.0" encoding="UTF-8"?><model unit="millimeter" xmlns="{CORE}"><resources>'

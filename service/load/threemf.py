@@ -230,9 +230,15 @@ class _Reader:
                 )
                 continue
             placed: list[tuple[float, float]] = []  # rotations written to few digits, taken as rotations
-            pieces = list(self.meshes(path, obj, transform, 0, placed))
+            left_out: list[str] = []  # components that are supports or other objects, not the part's material
+            pieces = list(self.meshes(path, obj, transform, 0, placed, left_out))
             if placed:
                 notes.append(_rotation_note(name, placed))
+            if left_out:
+                notes.append(
+                    f"3MF object {name!r} has components that are not of type 'model' ({', '.join(left_out[:8])}): "
+                    "listed but not weighed (a support or other object is no part of the solid)"
+                )
             if not pieces:
                 raise EmptyGeometryError(f"the 3MF object {name!r} holds no triangles", format="3mf")
             verts = [v for v, _ in pieces]
@@ -249,10 +255,18 @@ class _Reader:
         return ThreeMF(parts, root.unit, notes)
 
     def meshes(
-        self, path: str, obj: _Object, transform: NDArray[np.float64], depth: int, placed: list[tuple[float, float]]
+        self,
+        path: str,
+        obj: _Object,
+        transform: NDArray[np.float64],
+        depth: int,
+        placed: list[tuple[float, float]],
+        left_out: list[str],
     ) -> Iterator[tuple[NDArray[np.float64], NDArray[np.int64]]]:
         """Each mesh under ``obj`` in build coordinates; ``placed`` collects (departure, determinant) of
-        each placement taken as the rotation its digits round."""
+        each placement taken as the rotation its digits round, ``left_out`` the components that are not
+        of type ``model`` (ch. 4.1: a device does not fill a support; the spec suggests attaching supports
+        to a part as its components)."""
         if depth > _MAX_DEPTH:
             raise _invalid("components nest more than 32 deep (a cycle?)", "chapter 4.2")
         if obj.vertices is not None and obj.triangles is not None:
@@ -264,7 +278,10 @@ class _Reader:
             yield v, f
         for sub_path, sub_id, sub_transform in obj.components:
             sub = self.object(sub_path or path, sub_id, f"a component of object {obj.id}")
-            yield from self.meshes(sub_path or path, sub, transform @ sub_transform, depth + 1, placed)
+            if sub.type != "model":
+                left_out.append(f"{sub.name or f'object {sub_id}'} ({sub.type})")
+                continue
+            yield from self.meshes(sub_path or path, sub, transform @ sub_transform, depth + 1, placed, left_out)
 
 
 _ROTATION_DIGITS = 1e-5
