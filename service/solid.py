@@ -117,14 +117,36 @@ def _signed_volumes(x: NDArray[np.float64], faces: NDArray[np.int64]) -> NDArray
     return det
 
 
+def _volume_magnitudes(x: NDArray[np.float64], faces: NDArray[np.int64]) -> NDArray[np.float64]:
+    """The sum of the magnitudes of the six products in each face's a . (b x c): the scale of its rounding.
+
+    |a . (b x c)| itself is no such scale: for a face far from the local origin and nearly in line with it the
+    products cancel, and the determinant's rounding (~eps x these products) can exceed it many times.
+    """
+    records = point_records(x)
+    out = np.empty(len(faces))
+
+    def block(start: int) -> None:
+        a, b, c = (np.abs(v) for v in gather_corners(records, faces[start : start + CHUNK]))
+        out[start : start + CHUNK] = (
+            a[0] * (b[1] * c[2] + b[2] * c[1]) + a[1] * (b[2] * c[0] + b[0] * c[2]) + a[2] * (b[0] * c[1] + b[1] * c[0])
+        )
+
+    for_each_block(block, range(0, len(faces), CHUNK))
+    return out
+
+
 def _orient_outward(
     vertices: NDArray[np.float64], faces: NDArray[np.int64], topo: SurfaceTopology
 ) -> tuple[NDArray[np.int64], list[str]]:
     """Keep shells that all wind outward; otherwise orient every shell by its nesting depth: material outward,
     cavities inward."""
-    det = _signed_volumes(vertices - local_origin(vertices), faces)
+    x = vertices - local_origin(vertices)
+    det = _signed_volumes(x, faces)
     if np.all(det >= 0):  # every face sees the local origin from outside: outward already
         return faces, []
+    scale = _volume_magnitudes(x, faces)  # each face's rounding scale, for the shells' noise
+    del x
     total = float(det.sum())
     count, label = face_components(faces, topo)
     vol = np.bincount(label, weights=det, minlength=count)
@@ -133,7 +155,7 @@ def _orient_outward(
         # re-winding one of them would make volume; the shells are the components joined across every edge
         count, label = _edge_connected(faces)
         vol = np.bincount(label, weights=det, minlength=count)
-    noise = np.bincount(label, weights=np.abs(det), minlength=count)
+    noise = np.bincount(label, weights=scale, minlength=count)
     flat = np.abs(vol) <= 64 * EPS * noise  # a shell of zero volume: no orientation makes it a body
     if count == 1:
         if total < 0:

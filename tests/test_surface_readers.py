@@ -492,3 +492,20 @@ def test_ply_triangle_strips_are_read(encoding: str) -> None:
     assert doc["center_of_mass"] == pytest.approx([0.5, 1.0, 1.5], rel=1e-15)
     assert doc["principal"]["moments"] == pytest.approx(sorted(6000 * (p + q) / 12 for p, q in ((4, 9), (1, 9), (1, 4))), rel=1e-14)
     assert not doc["warnings"]
+
+
+def test_a_flat_pillow_shell_far_from_the_origin_does_not_turn_a_body_into_a_cavity() -> None:
+    # PrusaSlicer's extruder_idler_quads.obj: 92 pairs of back-to-back triangles (zero volume) whose determinants'
+    # rounding, far from the local origin, exceeded eps x |det|; such a pair counted as a shell wound inward and
+    # sent the file into nesting mode, where two small bodies inside the main one were subtracted as cavities
+    outer, inner = cube(30.0, (50.0, 20.0, 15.0)), cube(5.0, (60.0, 30.0, 20.0))
+    p = np.array([[72.92038, 25.986547, 27.487391], [72.940994, 25.984016, 27.524689], [72.865799, 25.99324, 27.388683]])
+    pillow = (p, np.array([[0, 1, 2], [2, 1, 0]]))
+    lines, n = [], 0
+    for v, f in (outer, inner, pillow):
+        lines += [f"v {x!r} {y!r} {z!r}" for x, y, z in np.asarray(v).tolist()]
+        lines += [f"f {a + 1 + n} {b + 1 + n} {c + 1 + n}" for a, b, c in np.asarray(f).tolist()]
+        n += len(v)
+    doc = analyze("\n".join(lines).encode(), filename="nested.obj", options=AnalysisOptions(units="mm")).as_dict()
+    assert doc["volume"] * 1e9 == pytest.approx(30.0**3 + 5.0**3, rel=1e-12)  # two bodies, both wound outward
+    assert not any("winding corrected" in w for w in doc["warnings"])
