@@ -509,3 +509,70 @@ def test_a_flat_pillow_shell_far_from_the_origin_does_not_turn_a_body_into_a_cav
     doc = analyze("\n".join(lines).encode(), filename="nested.obj", options=AnalysisOptions(units="mm")).as_dict()
     assert doc["volume"] * 1e9 == pytest.approx(30.0**3 + 5.0**3, rel=1e-12)  # two bodies, both wound outward
     assert not any("winding corrected" in w for w in doc["warnings"])
+
+
+def _prusa_config(kind: str) -> str:
+    return (
+        '<?xml version="1.0" encoding="UTF-8"?><config><object id="1" instances_count="1">'
+        '<volume firstid="0" lastid="11"><metadata type="volume" key="volume_type" value="ModelPart"/></volume>'
+        f'<volume firstid="12" lastid="23"><metadata type="volume" key="name" value="inner"/>{kind}</volume>'
+        "</object></config>"
+    )
+
+
+@pytest.mark.parametrize(
+    "kind",
+    [
+        '<metadata type="volume" key="volume_type" value="ParameterModifier"/>',
+        '<metadata type="volume" key="volume_type" value="SupportBlocker"/>',
+        '<metadata type="volume" key="modifier" value="1"/>',  # PrusaSlicer before volume_type
+    ],
+    ids=["modifier", "blocker", "old-modifier"],
+)
+def test_a_prusaslicer_modifier_volume_is_not_weighed(kind: str) -> None:
+    # a 4 mm modifier cube inside a 10 mm part, in one mesh: PrusaSlicer prints 1000 mm^3; it weighed 1064
+    v1, f1 = cube(10.0)
+    v2, f2 = cube(4.0, (3.0, 3.0, 3.0))
+    mesh = mesh_xml(np.concatenate([v1, v2]), np.concatenate([f1, f2 + len(v1)]))
+    data = package(
+        model(f'<object id="1" type="model" name="cube">{mesh}</object>', '<item objectid="1"/>'),
+        parts={"Metadata/Slic3r_PE_model.config": _prusa_config(kind)},
+    )
+    doc = analyze(data, filename="p.3mf", options=AnalysisOptions(density=1.0)).as_dict()
+    assert doc["mass"] == pytest.approx(1000 * 1e-9, rel=1e-14)
+    assert any("inner (" in w and "not weighed" in w for w in doc["warnings"])
+
+
+def test_a_prusaslicer_negative_volume_is_refused_not_weighed_as_material() -> None:
+    v1, f1 = cube(10.0)
+    v2, f2 = cube(4.0, (3.0, 3.0, 3.0))
+    mesh = mesh_xml(np.concatenate([v1, v2]), np.concatenate([f1, f2 + len(v1)]))
+    negative = '<metadata type="volume" key="volume_type" value="NegativeVolume"/>'
+    data = package(
+        model(f'<object id="1" type="model" name="cube">{mesh}</object>', '<item objectid="1"/>'),
+        parts={"Metadata/Slic3r_PE_model.config": _prusa_config(negative)},
+    )
+    with pytest.raises(UnsupportedFormatError, match="negative volume"):
+        analyze(data, filename="p.3mf")
+
+
+def test_a_bambu_modifier_part_is_not_weighed() -> None:
+    # Bambu Studio and OrcaSlicer make each volume a component and name its subtype in model_settings.config
+    settings = (
+        '<?xml version="1.0" encoding="UTF-8"?><config><object id="3"><metadata key="name" value="cube"/>'
+        '<part id="1" subtype="normal_part"/><part id="2" subtype="modifier_part"><metadata key="name" value="inner"/>'
+        "</part></object></config>"
+    )
+    data = package(
+        model(
+            f'<object id="1" type="model">{mesh_xml(*cube(10.0))}</object>'
+            f'<object id="2" type="model">{mesh_xml(*cube(4.0, (3.0, 3.0, 3.0)))}</object>'
+            '<object id="3" type="model" name="cube"><components><component objectid="1"/><component objectid="2"/>'
+            "</components></object>",
+            '<item objectid="3"/>',
+        ),
+        parts={"Metadata/model_settings.config": settings},
+    )
+    doc = analyze(data, filename="b.3mf", options=AnalysisOptions(density=1.0)).as_dict()
+    assert doc["mass"] == pytest.approx(1000 * 1e-9, rel=1e-14)
+    assert any("inner (modifier)" in w for w in doc["warnings"])

@@ -189,7 +189,61 @@ class _Reader:
                 if len(tickets) > 1:
                     raise _invalid(f"{name} names {len(tickets)} print tickets; at most one is allowed", "chapter 2.1.4")
         root = self.part(root_path, is_root=True)
-        return self.flatten(root)
+        notes = self.slicer_volumes(root)
+        found = self.flatten(root)
+        return ThreeMF(found.parts, found.unit, [*notes, *found.notes]) if notes else found
+
+    # --- slicer projects --------------------------------------------------------------------------
+    def slicer_volumes(self, root: _Part) -> list[str]:
+        """Leave out the volumes a slicer project marks as no material, and refuse the ones it subtracts.
+
+        PrusaSlicer (``Metadata/Slic3r_PE_model.config``) keeps an object's volumes in one mesh, each a range
+        of its triangles with a ``volume_type``; Bambu Studio and OrcaSlicer (``Metadata/model_settings.config``)
+        make each volume a component with a ``subtype``.  Modifiers, support blockers and enforcers only
+        change print settings in their region, so they are left out, with a note; a negative volume is cut
+        out of the part by the slicer, which this reader does not do, so the file is refused.
+        """
+        notes: list[str] = []
+        for config_path, volume_tag in (("Metadata/Slic3r_PE_model.config", "volume"), ("Metadata/model_settings.config", "part")):
+            raw = self.member(config_path)
+            if raw is None:
+                continue
+            config = _parse(raw, config_path)
+            for entry in config.iter("object"):
+                obj = root.objects.get(_slicer_int(entry.get("id"), config_path))
+                if obj is None:
+                    continue
+                left: list[str] = []
+                drop = np.zeros(0 if obj.triangles is None else len(obj.triangles), dtype=bool)
+                for volume in entry.iter(volume_tag):
+                    meta = {m.get("key"): m.get("value") for m in volume.iter("metadata")}
+                    kind = _slicer_kind(volume, meta)
+                    if kind == "part":
+                        continue
+                    label = f"{meta.get('name') or kind} ({kind})"
+                    if kind == "negative volume":
+                        raise UnsupportedFormatError(
+                            f"3MF object {obj.name or obj.id!r} has a negative volume {label!r} that the slicer cuts out "
+                            "of the part, which this reader does not do; apply it in the slicer (or remove it) and "
+                            "export the part again",
+                            format="3mf",
+                        )
+                    if volume_tag == "volume" and len(drop):
+                        first = _slicer_int(volume.get("firstid"), config_path)
+                        last = _slicer_int(volume.get("lastid"), config_path)
+                        drop[max(first, 0) : last + 1] = True
+                    elif volume_tag == "part":
+                        part_id = _slicer_int(volume.get("id"), config_path)
+                        obj.components = [c for c in obj.components if c[1] != part_id]
+                    left.append(label)
+                if drop.any() and obj.triangles is not None:
+                    obj.triangles = obj.triangles[~drop]
+                if left:
+                    notes.append(
+                        f"3MF object {obj.name or obj.id!r}: the slicer project marks {', '.join(left[:8])} as no "
+                        "material (they change print settings where they are); they were not weighed"
+                    )
+        return notes
 
     # --- model parts ------------------------------------------------------------------------------
     def part(self, path: str, is_root: bool = False) -> _Part:
@@ -321,6 +375,44 @@ def _absolute(target: str, base: str) -> str:
         return target
     folder = base.rsplit("/", 1)[0]
     return f"{folder}/{target}"
+
+
+# what a slicer project calls each volume: PrusaSlicer's volume_type (an older file says modifier="1"),
+# Bambu Studio's and OrcaSlicer's part subtype
+_SLICER_KINDS = {
+    "ModelPart": "part",
+    "normal_part": "part",
+    "ParameterModifier": "modifier",
+    "modifier_part": "modifier",
+    "SupportBlocker": "support blocker",
+    "support_blocker": "support blocker",
+    "SupportEnforcer": "support enforcer",
+    "support_enforcer": "support enforcer",
+    "NegativeVolume": "negative volume",
+    "negative_part": "negative volume",
+}
+
+
+def _slicer_kind(volume: Any, meta: dict[str, str | None]) -> str:
+    written = volume.get("subtype") or meta.get("volume_type") or ("ParameterModifier" if meta.get("modifier") == "1" else None)
+    if written is None:
+        return "part"
+    kind = _SLICER_KINDS.get(written)
+    if kind is None:
+        raise UnsupportedFormatError(
+            f"the 3MF file's slicer project names a volume of kind {written[:40]!r}, which this reader does not know; "
+            "export the parts without the project settings",
+            format="3mf",
+        )
+    return kind
+
+
+def _slicer_int(text: str | None, path: str) -> int:
+    try:
+        return int(text or "")
+    except ValueError:
+        written = (text or "")[:20]
+        raise UnreadableFileError(f"the 3MF file's {path} has a number that is not one ({written!r})", format="3mf") from None
 
 
 def _parse(raw: bytes, path: str) -> Any:
