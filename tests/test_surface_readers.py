@@ -576,3 +576,30 @@ def test_a_bambu_modifier_part_is_not_weighed() -> None:
     doc = analyze(data, filename="b.3mf", options=AnalysisOptions(density=1.0)).as_dict()
     assert doc["mass"] == pytest.approx(1000 * 1e-9, rel=1e-14)
     assert any("inner (modifier)" in w for w in doc["warnings"])
+
+
+@pytest.mark.parametrize(
+    "offset, overlaps",
+    [
+        ((5.0, 0.0, 0.0), True),
+        ((10.0, 0.0, 0.0), False),
+        ((0.0, 0.0, 0.0), True),
+        ((4.0, 3.0, 2.0), True),
+        ((0.0, 10.0, 10.0), False),
+    ],
+    ids=["half", "touching", "same-place", "corner", "edge"],
+)
+def test_3mf_overlapping_components_are_named(offset: tuple[float, float, float], overlaps: bool) -> None:
+    # the specification unites overlapping components (ch. 4.2); they are weighed each in full, so the overlap
+    # (500 mm^3 of two 10 mm cubes half over each other) counted twice without a word
+    data = package(
+        model(
+            f'<object id="1" type="model">{mesh_xml(*cube(10.0))}</object>'
+            f'<object id="2" type="model">{mesh_xml(*cube(10.0, offset))}</object>'
+            '<object id="3" type="model" name="pair"><components><component objectid="1"/><component objectid="2"/>'
+            "</components></object>",
+            '<item objectid="3"/>',
+        )
+    )
+    doc = analyze(data, filename="o.3mf").as_dict()
+    assert any("overlap" in w for w in doc["warnings"]) is overlaps
