@@ -440,11 +440,9 @@ def _mesh_from_grid(grid: Any, to_numpy: Any, label: str) -> _Mesh:
             nodes, name = nodes[:, VOXEL_TO_HEXAHEDRON], "hexahedron"
         mesh.blocks.append(_Block(name, nodes, ids, f"{VTK_CELL_TYPES[vtk_type]}_{len(mesh.blocks)}"))
     if mesh.blocks:
-        lower = np.flatnonzero(~np.isin(types, list(VTK_CELL_TYPES) + list(_VTK_POLYHEDRA)))
-        if len(lower):
-            starts, ends = offsets[lower], offsets[lower + 1]
-            used = np.concatenate([conn[a:b] for a, b in zip(starts.tolist(), ends.tolist())])
-            _surface_apart_warning(mesh, used, label)
+        lower = ~np.isin(types, list(VTK_CELL_TYPES) + list(_VTK_POLYHEDRA))
+        if lower.any():  # the corners of every cell that is not 3-D, by each connectivity entry's cell
+            _surface_apart_warning(mesh, conn[np.repeat(lower, np.diff(offsets))], label)
     ghosts = grid.GetCellData().GetArray("vtkGhostType")
     if ghosts is not None:
         _drop_ghost_cells(mesh, np.asarray(to_numpy(ghosts), dtype=np.int64).reshape(-1), label)
