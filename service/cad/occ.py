@@ -298,7 +298,9 @@ def _label_name(label: Any) -> str | None:
     from OCP.TDataStd import TDataStd_Name
 
     attr = TDataStd_Name()
-    if label.IsNull() or not label.FindAttribute(TDataStd_Name.GetID_s(), attr):
+    # FindAttribute on a label without a name crashes the process in OCP 8.0.1 (a segfault on the face-colour
+    # labels of SolidWorks exports); IsAttribute asks the same safely
+    if label.IsNull() or not label.IsAttribute(TDataStd_Name.GetID_s()) or not label.FindAttribute(TDataStd_Name.GetID_s(), attr):
         return None
     text = str(attr.Get().ToExtString()).strip()
     # OpenCASCADE's writers fill unnamed products with such placeholders

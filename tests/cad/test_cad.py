@@ -291,3 +291,20 @@ def test_cli_reads_step_and_deflection_implies_mesh(tmp_path: Path, step_assembl
     assert doc["source"]["kind"] == "cad" and doc["source"]["geometry"] == "mesh"
     assert [p["name"] for p in doc["parts"]] == ["plate", "rod"]
     assert doc["diagnostics"]["tessellation_error"] > 0
+
+
+def test_a_label_without_a_name_has_none_and_does_not_crash() -> None:
+    # OCP 8.0.1's FindAttribute segfaulted on an unnamed label (the face-colour labels of SolidWorks exports in
+    # the KiCad 3D library killed the process); run apart, so a crash fails the test instead of the suite
+    code = textwrap.dedent(
+        """
+        from OCP.TCollection import TCollection_ExtendedString
+        from OCP.TDocStd import TDocStd_Document
+        from inertia.cad.occ import _label_name
+        doc = TDocStd_Document(TCollection_ExtendedString("MDTV-XCAF"))
+        print(_label_name(doc.Main().FindChild(6, True)))
+        """
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
+    assert out.returncode == 0, out.stderr[-500:]
+    assert out.stdout.strip() == "None"
