@@ -143,7 +143,9 @@ def read_solids(data: bytes, fmt: str) -> tuple[list[Solid], str | None]:
 
 # A STEP assembly may name its parts' files (DOCUMENT_FILE / EXTERNAL_SOURCE entities), which
 # OpenCASCADE's XDE reader then opens from disk: the server never opens a file an upload names.
-_STEP_EXTERNAL = re.compile(rb"EXTERNAL_SOURCE\s*\(|DOCUMENT_FILE\s*\(\s*'[^']*\.(?:stp|step|p21)'", re.IGNORECASE)
+# a part kept in another file: a DOCUMENT_FILE or an EXTERNAL_SOURCE naming a STEP file (an EXTERNAL_SOURCE
+# also names the program a text font comes from, IDENTIFIER('UG NX'), which is no file)
+_STEP_EXTERNAL = re.compile(rb"(?:EXTERNAL_SOURCE|DOCUMENT_FILE)\s*\([^;]*?'[^']*\.(?:stp|step|p21|stpz)'", re.IGNORECASE)
 
 
 def _refuse_external(data: bytes, fmt: str) -> None:

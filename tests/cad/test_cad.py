@@ -229,6 +229,16 @@ def test_step_naming_another_file_is_refused(step_assembly: bytes) -> None:
     text = step_assembly.replace(b"DATA;", b"DATA;\n#999999=DOCUMENT_FILE('/etc/part.stp','',$,#1,'',$);", 1)
     with pytest.raises(ExternalReferenceError):
         analyze(text, filename="bracket.step")
+    text = step_assembly.replace(b"DATA;", b"DATA;\n#999999=EXTERNAL_SOURCE(IDENTIFIER('parts/plate.STEP'));", 1)
+    with pytest.raises(ExternalReferenceError):
+        analyze(text, filename="bracket.step")
+
+
+def test_a_font_from_an_external_source_is_no_file(step_assembly: bytes) -> None:
+    # NX writes EXTERNAL_SOURCE(IDENTIFIER('UG NX')) for the font of its text (CAx-IF io1-tu-203.stp): refused
+    font = b"DATA;\n#999998=EXTERNAL_SOURCE(IDENTIFIER('UG NX'));\n#999999=EXTERNALLY_DEFINED_TEXT_FONT(#999998,'1');"
+    doc = analyze(step_assembly.replace(b"DATA;", font, 1), filename="bracket.step").as_dict()
+    assert doc["mass"] == analyze(step_assembly, filename="bracket.step").as_dict()["mass"]
 
 
 def test_step_is_recognised_by_content() -> None:
