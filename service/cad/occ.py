@@ -291,9 +291,13 @@ def _walk(label: Any, location: Any, out: list[Solid], depth: int) -> None:
         found.append(explorer.Current())
         explorer.Next()
     for k, solid in enumerate(found):
-        name = _sub_shape_name(label, solid) or (own if own and len(found) == 1 else None)
+        # a product of one solid is named by its product; the solids of one product by their own names
+        name = own if own and len(found) == 1 else _sub_shape_name(label, solid)
         name = name or (f"{own} {k + 1}" if own else f"solid {len(out) + 1}")
         out.append(Solid(name, solid.Moved(location)))
+
+
+_PLACEHOLDER_NAMES = frozenset({"NONE", "SOLID", "COMPOUND", "COMPSOLID", "SHELL", "FACE", "SHAPE"})
 
 
 def _label_name(label: Any) -> str | None:
@@ -305,8 +309,9 @@ def _label_name(label: Any) -> str | None:
     if label.IsNull() or not label.IsAttribute(TDataStd_Name.GetID_s()) or not label.FindAttribute(TDataStd_Name.GetID_s(), attr):
         return None
     text = str(attr.Get().ToExtString()).strip()
-    # OpenCASCADE's writers fill unnamed products with such placeholders
-    if not text or text.lower().startswith("open cascade") or text.upper() == "NONE":
+    # OpenCASCADE's writers fill unnamed products with such placeholders, and its readers name unnamed
+    # shapes by their type
+    if not text or text.lower().startswith("open cascade") or text.upper() in _PLACEHOLDER_NAMES:
         return None
     return text
 
