@@ -163,7 +163,7 @@ def predict_motion(
     frame = units.frame(frame)
     times = None if given_times is None else units.times(given_times)
     chosen.check(motion_rotor(frame, classification, exact_moments))
-    setup = decide_regime(frame, classification, units.angular_velocity(omega), tolerances, units.omega, exact_moments)
+    setup = decide_regime(frame, classification, units.angular_velocity(omega), tolerances, exact_moments)
     motion = precession_quantities(setup, chosen.name, tolerances)
     if times is None:
         motion = units.restore(motion, None)

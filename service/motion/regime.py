@@ -53,15 +53,14 @@ def decide_regime(
     classification: Classification,
     omega: Array,
     tol: Tolerances,
-    omega_exponent: int = 0,
     exact_moments: bool = False,
 ) -> Setup:
     """The regime, and the ideal problem that is solved; the state as given is kept beside it.
 
-    ``omega`` is in units of 2^omega_exponent rad/s (``scaling.Units``); warnings quote rad/s.
+    ``omega`` is in the computation's units (``scaling.Units``); the regime does not depend on them.
     ``exact_moments``: the moments are numbers given, not computed (see ``motion_rotor``).
     """
-    decided = _decide(frame, classification, omega, tol, omega_exponent, exact_moments)
+    decided = _decide(frame, classification, omega, tol, exact_moments)
     axes = np.asarray(frame.axes, dtype=np.float64)
     given = RigidProblem(np.asarray(frame.moments, dtype=np.float64), axes @ omega, axes, frame.quaternion)
     return _labelled(replace(decided, initial=given), classification)
@@ -116,9 +115,7 @@ def _pair_gap(moments: Array, rotor: RotorClass) -> float:
     return float(moments[2] - moments[1]) if rotor is RotorClass.SYMMETRIC_PROLATE else float(moments[1] - moments[0])
 
 
-def _decide(
-    frame: PrincipalFrame, classification: Classification, omega: Array, tol: Tolerances, omega_exponent: int, exact_moments: bool
-) -> Setup:
+def _decide(frame: PrincipalFrame, classification: Classification, omega: Array, tol: Tolerances, exact_moments: bool) -> Setup:
     axes = np.asarray(frame.axes, dtype=np.float64)
     omega_body = axes @ omega
     rotor = motion_rotor(frame, classification, exact_moments)
