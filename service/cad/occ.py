@@ -54,6 +54,7 @@ MODEL_UNIT = 1e-3  # metres per model unit: OpenCASCADE works in millimetres
 
 COARSE_EPS = 1e-12  # below ~1e-12 the moments, not only the volume, settle (API.md, accuracy of brep)
 FINE_EPS = 1e-14  # a hundredfold tighter: its difference to COARSE_EPS is the error estimate
+FREE_FORM_TOLERANCE = 1e-13  # green.py, per interval: relative to the box's volume times its diagonal's powers
 ROUNDING_FLOOR = 64 * 2.220446049250313e-16  # Gauss sums of a few hundred terms per face, far from cancellation
 
 # OpenCASCADE's own names of length units, as STEPControl_Reader.FileUnits and the IGES global section spell them
@@ -375,24 +376,189 @@ def _properties(shape: Any, reference: Any, eps: float) -> tuple[float, NDArray[
 def _integrate(solid: Solid) -> BrepIntegral:
     from OCP.gp import gp_Pnt
 
+    from . import green
+
     _check_closed(solid)
     lo, hi = bounding_box(solid.shape)
+    box_volume = float(np.prod(np.maximum(hi - lo, 0.0)))
+    faces = list(green.closed_shell_faces(solid.shape))
+    free = [f for f in faces if not green.is_analytic(f)]
+    if free:
+        return _integrate_free_form(solid, faces, free, lo, hi)
     centre = gp_Pnt(*((lo + hi) / 2).tolist())
     v1, c1, t1 = _properties(solid.shape, centre, COARSE_EPS)
     v2, c2, t2 = _properties(solid.shape, centre, FINE_EPS)
-    if not all(math.isfinite(x) for x in (v1, v2)) or abs(v2) <= VOLUME_REL * float(np.prod(np.maximum(hi - lo, 0.0))):
+    if not all(math.isfinite(x) for x in (v1, v2)) or abs(v2) <= VOLUME_REL * box_volume:
         raise ZeroVolumeError(f"the solid {solid.name!r} encloses no volume; export it again as a closed solid")
     if v2 < 0:  # an inside-out solid: every integral changes sign
         v1, t1, v2, t2 = -v1, -t1, -v2, -t2
+    estimate = max(_difference(v1, c1, t1, v2, c2, t2), ROUNDING_FLOOR)
+    return BrepIntegral(v2, c2, 0.5 * (t2 + t2.T), estimate, _count_faces(solid.shape))
+
+
+def _difference(
+    v1: float, c1: NDArray[np.float64], t1: NDArray[np.float64], v2: float, c2: NDArray[np.float64], t2: NDArray[np.float64]
+) -> float:
+    """Relative difference of two results: volume, centre (in radii of gyration), each principal moment."""
     m1, m2 = np.linalg.eigvalsh(t1), np.linalg.eigvalsh(t2)
     gyration = math.sqrt(max(float(m2.max()), 0.0) / v2)
-    estimate = max(
+    return max(
         abs(v1 - v2) / v2,
         float(np.max(np.abs(c1 - c2))) / gyration if gyration > 0 else 0.0,
         float(np.max(np.abs(m1 - m2) / np.maximum(np.abs(m2), 1e-300))),
+    )
+
+
+def _integrate_free_form(
+    solid: Solid, faces: list[Any], free: list[Any], lo: NDArray[np.float64], hi: NDArray[np.float64]
+) -> BrepIntegral:
+    """Analytic faces by OpenCASCADE's adaptive rule (twice, as above), the others by ``green``.
+
+    All sums are taken about the box's centre and added before the centre of mass is formed.  The
+    estimate is the larger of the two-accuracy difference and the free-form faces' own error bound,
+    carried to volume, centre and principal moments component by component (first order).
+    """
+    from . import green
+
+    origin = _rough_centre(solid.shape, lo, hi)
+    size = float(np.linalg.norm(hi - lo))
+    box_volume = float(np.prod(np.maximum(hi - lo, 0.0)))
+    scale = np.array([box_volume] + [box_volume * size] * 3 + [box_volume * size * size] * 6 + [size * size] * 3)
+    free_ids = {id(f) for f in free}
+    pending = list(free)
+    runs = [np.zeros(green.SUMS), np.zeros(green.SUMS)]
+    for face in (f for f in faces if id(f) not in free_ids):
+        coarse, fine = (_face_sums(face, origin, eps, size) for eps in (COARSE_EPS, FINE_EPS))
+        if coarse is None or fine is None:
+            pending.append(face)
+            continue
+        runs[0] += coarse
+        runs[1] += fine
+    own, own_error = np.zeros(green.SUMS), np.zeros(green.SUMS)
+    for face in pending:
+        s, e = green.face_sums(face, origin, FREE_FORM_TOLERANCE * scale)
+        own += s
+        own_error += e
+    runs = [run + own for run in runs]
+    if not all(math.isfinite(float(x)) for run in runs for x in run) or abs(runs[1][0]) <= VOLUME_REL * box_volume:
+        raise ZeroVolumeError(f"the solid {solid.name!r} encloses no volume; export it again as a closed solid")
+    sign = 1.0 if runs[1][0] > 0 else -1.0  # an inside-out solid: every integral changes sign
+    v1, c1, t1 = _from_sums(sign * runs[0], origin)
+    v2, c2, t2 = _from_sums(sign * runs[1], origin)
+    estimate = max(
+        _difference(v1, c1, t1, v2, c2, t2),
+        _propagated(sign * runs[1], own_error, origin),
+        _unclosed(runs[1], v2, t2, float(np.linalg.norm(np.maximum(np.abs(lo - origin), np.abs(hi - origin))))),
         ROUNDING_FLOOR,
     )
-    return BrepIntegral(v2, c2, 0.5 * (t2 + t2.T), estimate, _count_faces(solid.shape))
+    return BrepIntegral(v2, c2, t2, estimate, _count_faces(solid.shape))
+
+
+def _unclosed(sums: NDArray[np.float64], volume: float, tensor: NDArray[np.float64], reach: float) -> float:
+    """What the faces' failure to close costs.  Over a closed surface the vector area ∮n dA is zero
+    and the cone integrals do not depend on their apex.  Where the faces leave a vector area
+    ``delta`` (gaps and overlaps within the file's tolerance), an apex elsewhere in the box (at most
+    ``reach`` from ours) would move the volume by up to |delta| reach / 3, the centre by that volume
+    times ``reach`` over the whole volume, and each moment by that volume times ``reach`` squared."""
+    moved = float(np.linalg.norm(sums[10:13])) * reach / 3
+    m = np.linalg.eigvalsh(tensor)
+    gyration = math.sqrt(max(float(m.max()), 0.0) / volume)
+    return max(
+        moved / volume,
+        moved * reach / (volume * gyration) if gyration > 0 else 0.0,
+        moved * reach**2 / max(float(m.min()), 1e-300),
+    )
+
+
+def _rough_centre(shape: Any, lo: NDArray[np.float64], hi: NDArray[np.float64]) -> NDArray[np.float64]:
+    """The mean of the shape's vertices, as each visit of the explorer finds them: the apex that
+    ``BRepGProp.VolumeProperties_s`` takes for its cones, so that a file whose faces do not quite
+    close gets the same volume by both routes.  The box's centre where there are no vertices."""
+    from OCP.BRep import BRep_Tool
+    from OCP.TopAbs import TopAbs_VERTEX
+    from OCP.TopExp import TopExp_Explorer
+    from OCP.TopoDS import TopoDS
+
+    total, count = np.zeros(3), 0
+    explorer = TopExp_Explorer(shape, TopAbs_VERTEX)
+    while explorer.More():
+        p = BRep_Tool.Pnt_s(TopoDS.Vertex(explorer.Current()))
+        total += (p.X(), p.Y(), p.Z())
+        count += 1
+        explorer.Next()
+    return total / count if count else (lo + hi) / 2
+
+
+def _face_sums(face: Any, origin: NDArray[np.float64], eps: float, size: float) -> NDArray[np.float64] | None:
+    """``green.SUMS`` of one face by OpenCASCADE's adaptive rule, the cone from ``origin`` over the face
+    (``BRepGProp_Vinert`` with ``origin`` as its apex and location).  None where the cone's volume is
+    too small to carry the face's first moment back (OpenCASCADE keeps the centre, not the moment)."""
+    from OCP.BRepGProp import BRepGProp_Domain, BRepGProp_Face, BRepGProp_Vinert
+    from OCP.gp import gp_Pnt
+
+    apex = gp_Pnt(*origin.tolist())
+    props = BRepGProp_Vinert(BRepGProp_Face(face, False), BRepGProp_Domain(face), apex, apex, eps)
+    volume = float(props.Mass())
+    area = np.empty(3)  # the vector area: the cone's volume moves by -a·area/3 with its apex
+    for k in range(3):
+        moved = origin.copy()
+        moved[k] += size
+        point = gp_Pnt(*moved.tolist())  # the rule's apex is its location
+        cone = BRepGProp_Vinert(BRepGProp_Face(face, False), BRepGProp_Domain(face), point, point, eps)
+        area[k] = 3 * (volume - float(cone.Mass())) / size
+    c = props.CentreOfMass()
+    d = np.array([c.X(), c.Y(), c.Z()], dtype=np.float64) - origin
+    if volume == 0.0 or float(np.max(np.abs(d))) > 1e3 * size:
+        return None
+    m = props.MatrixOfInertia()  # about the centre of mass; back to the origin (L&L eq. 32.12)
+    tensor = np.array([[m.Value(i, j) for j in (1, 2, 3)] for i in (1, 2, 3)], dtype=np.float64)
+    tensor += volume * (float(d @ d) * np.eye(3) - np.outer(d, d))
+    half_trace = 0.5 * float(np.trace(tensor))  # x^2 + y^2 + z^2 integrated
+    return np.array(
+        [
+            volume,
+            *(volume * d),
+            half_trace - tensor[0, 0],
+            half_trace - tensor[1, 1],
+            half_trace - tensor[2, 2],
+            -tensor[0, 1],
+            -tensor[0, 2],
+            -tensor[1, 2],
+            *area,
+        ],
+        dtype=np.float64,
+    )
+
+
+def _from_sums(sums: NDArray[np.float64], origin: NDArray[np.float64]) -> tuple[float, NDArray[np.float64], NDArray[np.float64]]:
+    """Volume, centre of mass and the tensor about it (L&L sign convention) from ``green.SUMS`` about ``origin``."""
+    volume = float(sums[0])
+    d = sums[1:4] / volume
+    xx, yy, zz, xy, xz, yz = sums[4:10]
+    tensor = np.array([[yy + zz, -xy, -xz], [-xy, xx + zz, -yz], [-xz, -yz, xx + yy]], dtype=np.float64)
+    tensor -= volume * (float(d @ d) * np.eye(3) - np.outer(d, d))
+    return volume, origin + d, 0.5 * (tensor + tensor.T)
+
+
+def _propagated(sums: NDArray[np.float64], error: NDArray[np.float64], origin: NDArray[np.float64]) -> float:
+    """The sums' error bound carried to the relative errors of volume, centre and principal moments:
+    each sum moved by its bound in turn, the changes added (first order)."""
+    v, c, t = _from_sums(sums, origin)
+    m = np.linalg.eigvalsh(t)
+    gyration = math.sqrt(max(float(m.max()), 0.0) / v)
+    dv, dc, dm = 0.0, np.zeros(3), np.zeros(3)
+    for i in np.flatnonzero(error[:10]):
+        moved = sums.copy()
+        moved[i] += error[i]
+        v_i, c_i, t_i = _from_sums(moved, origin)
+        dv += abs(v_i - v)
+        dc += np.abs(c_i - c)
+        dm += np.abs(np.linalg.eigvalsh(t_i) - m)
+    return max(
+        dv / v,
+        float(np.max(dc)) / gyration if gyration > 0 else 0.0,
+        float(np.max(dm / np.maximum(np.abs(m), 1e-300))),
+    )
 
 
 def surface_area(solid: Solid) -> float:
