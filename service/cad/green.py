@@ -40,7 +40,6 @@ returned, is the error estimate, with each inner error weighted as it enters the
 
 from __future__ import annotations
 
-import itertools
 from collections.abc import Callable, Iterator
 from typing import Any
 
@@ -152,21 +151,27 @@ def closed_shell_faces(shape: Any) -> Iterator[Any]:
 def _adaptive(
     values: Callable[[NDArray[np.float64]], NDArray[np.float64]], breaks: list[float], tolerance: NDArray[np.float64]
 ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """Integral over [breaks[0], breaks[-1]] of a vector integrand (``values(x)``: (len(x), SUMS)), and its error."""
+    """Integral over [breaks[0], breaks[-1]] of a vector integrand (``values(x)``: (len(x), SUMS)), and its error.
+
+    The intervals still open are evaluated together, one call of ``values`` per round of bisection."""
     total = np.zeros(SUMS)
     error = np.zeros(SUMS)
-    stack = [(a, b, 0) for a, b in itertools.pairwise(breaks) if b > a]
-    while stack:
-        a, b, depth = stack.pop()
-        middle, half = 0.5 * (a + b), 0.5 * (b - a)
-        f = values(middle + half * NODES)
-        kronrod = half * (KRONROD @ f)
-        difference = np.abs(kronrod - half * (GAUSS @ f))
-        if depth >= MAX_DEPTH or bool(np.all(difference <= tolerance)):
-            total += kronrod
-            error += difference
-        else:
-            stack += [(a, middle, depth + 1), (middle, b, depth + 1)]
+    lo = np.array(breaks[:-1], dtype=np.float64)
+    hi = np.array(breaks[1:], dtype=np.float64)
+    keep = hi > lo
+    lo, hi = lo[keep], hi[keep]
+    for depth in range(MAX_DEPTH + 1):
+        if lo.size == 0:
+            break
+        middle, half = 0.5 * (lo + hi), 0.5 * (hi - lo)
+        f = values((middle[:, None] + half[:, None] * NODES).ravel()).reshape(lo.size, NODES.size, SUMS)
+        kronrod = half[:, None] * np.einsum("k,ikj->ij", KRONROD, f)
+        difference = np.abs(kronrod - half[:, None] * np.einsum("k,ikj->ij", GAUSS, f))
+        done = np.all(difference <= tolerance, axis=1) | (depth == MAX_DEPTH)
+        total += kronrod[done].sum(axis=0)
+        error += difference[done].sum(axis=0)
+        lo, middle, hi = lo[~done], middle[~done], hi[~done]
+        lo, hi = np.concatenate([lo, middle]), np.concatenate([middle, hi])
     return total, error
 
 
@@ -201,44 +206,57 @@ class _Face:
         self.tolerance = tolerance
         self._point, self._normal, self._point2d, self._tangent2d = gp_Pnt(), gp_Vec(), gp_Pnt2d(), gp_Vec2d()
 
-    def integrand(self, us: NDArray[np.float64], v: float) -> NDArray[np.float64]:
-        """The integrands (``SUMS``) times |S_u × S_v| at (u, v) for each u (OpenCASCADE's oriented normal)."""
+    def integrand(self, us: NDArray[np.float64], vs: NDArray[np.float64]) -> NDArray[np.float64]:
+        """The integrands (``SUMS``) times |S_u × S_v| at each (u, v) (OpenCASCADE's oriented normal)."""
         point, normal, surface = self._point, self._normal, self.surface
         rows = []
-        for u in us.tolist():
+        for u, v in zip(us.tolist(), vs.tolist()):
             surface.Normal(u, v, point, normal)
             rows.append((point.X(), point.Y(), point.Z(), normal.X(), normal.Y(), normal.Z()))
         q = np.array(rows)
         r = q[:, :3] - self.origin
         dv = np.einsum("ij,ij->i", r, q[:, 3:])
-        x, y, z = r.T
-        nx, ny, nz = q[:, 3:].T
-        return np.stack(
-            [
-                dv / 3,
-                x * dv / 4,
-                y * dv / 4,
-                z * dv / 4,
-                x * x * dv / 5,
-                y * y * dv / 5,
-                z * z * dv / 5,
-                x * y * dv / 5,
-                x * z * dv / 5,
-                y * z * dv / 5,
-                nx,
-                ny,
-                nz,
-            ],
-            axis=1,
-        )
+        out = np.empty((len(rows), SUMS))
+        out[:, 0] = dv / 3
+        out[:, 1:4] = r * (dv / 4)[:, None]
+        fifth = r * (dv / 5)[:, None]
+        out[:, 4:7] = r * fifth
+        out[:, 7] = r[:, 0] * fifth[:, 1]
+        out[:, 8] = r[:, 0] * fifth[:, 2]
+        out[:, 9] = r[:, 1] * fifth[:, 2]
+        out[:, 10:13] = q[:, 3:]
+        return out
 
-    def along_u(self, v: float, u: float) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-        """F(u, v): the integrand integrated along u from the face's lower bound, and its error."""
-        if u == self.u_lo:
-            return np.zeros(SUMS), np.zeros(SUMS)
-        lo, hi, sign = (self.u_lo, u, 1.0) if u > self.u_lo else (u, self.u_lo, -1.0)
-        total, error = _adaptive(lambda us: self.integrand(us, v), _breaks(lo, hi, self.u_knots), self.tolerance)
-        return sign * total, error
+    def along_u(self, vs: NDArray[np.float64], us: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """F(u, v) at each (u, v): the integrand integrated along u from the face's lower bound, with its
+        error; all of them adaptively at once (the intervals still open are evaluated together)."""
+        starts, ends, owners = [], [], []
+        for i, u in enumerate(us.tolist()):
+            lo, hi = min(u, self.u_lo), max(u, self.u_lo)
+            cuts = _breaks(lo, hi, self.u_knots)
+            starts += cuts[:-1]
+            ends += cuts[1:]
+            owners += [i] * (len(cuts) - 1)
+        lo_, hi_, owner = np.array(starts), np.array(ends), np.array(owners, dtype=np.intp)
+        keep = hi_ > lo_
+        lo_, hi_, owner = lo_[keep], hi_[keep], owner[keep]
+        total, error = np.zeros((len(us), SUMS)), np.zeros((len(us), SUMS))
+        for depth in range(MAX_DEPTH + 1):
+            if lo_.size == 0:
+                break
+            middle, half = 0.5 * (lo_ + hi_), 0.5 * (hi_ - lo_)
+            nodes = (middle[:, None] + half[:, None] * NODES).ravel()
+            f = self.integrand(nodes, np.repeat(vs[owner], NODES.size)).reshape(lo_.size, NODES.size, SUMS)
+            kronrod = half[:, None] * np.einsum("k,ikj->ij", KRONROD, f)
+            difference = np.abs(kronrod - half[:, None] * np.einsum("k,ikj->ij", GAUSS, f))
+            done = np.all(difference <= self.tolerance, axis=1) | (depth == MAX_DEPTH)
+            np.add.at(total, owner[done], kronrod[done])
+            np.add.at(error, owner[done], difference[done])
+            open_ = ~done
+            lo_, middle, hi_, owner = lo_[open_], middle[open_], hi_[open_], owner[open_]
+            lo_, hi_, owner = np.concatenate([lo_, middle]), np.concatenate([middle, hi_]), np.concatenate([owner, owner])
+        sign = np.where(us >= self.u_lo, 1.0, -1.0)
+        return total * sign[:, None], error
 
     def sums(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """The face's integrals (``SUMS``) and their error."""
@@ -262,10 +280,8 @@ class _Face:
         inner: list[NDArray[np.float64]] = []
 
         def values(vs: NDArray[np.float64]) -> NDArray[np.float64]:
-            out = np.empty((len(vs), SUMS))
-            for i, v in enumerate(vs.tolist()):
-                out[i], e = self.along_u(v, self.u_hi)
-                inner.append(e)
+            out, e = self.along_u(vs, np.full(len(vs), self.u_hi))
+            inner.append(e.max(axis=0))
             return out
 
         total, error = _adaptive(values, _breaks(self.v_lo, self.v_hi, self.v_knots), self.tolerance)
@@ -298,17 +314,19 @@ class _Face:
         inner: list[NDArray[np.float64]] = []
 
         def values(ls: NDArray[np.float64]) -> NDArray[np.float64]:
-            out = np.zeros((len(ls), SUMS))
+            uvd = np.empty((len(ls), 3))
             for i, parameter in enumerate(ls.tolist()):
                 surface.D12d(parameter, p, t)
-                dv = t.Y()
-                if dv == 0.0:
-                    continue
-                v = min(max(p.Y(), self.v_lo), self.v_hi)
-                u = min(max(p.X(), self.u_lo), self.u_hi)
+                uvd[i] = (p.X(), p.Y(), t.Y())
+            out = np.zeros((len(ls), SUMS))
+            moving = uvd[:, 2] != 0.0  # along u, dv = 0: nothing to add
+            if moving.any():
+                u = np.clip(uvd[moving, 0], self.u_lo, self.u_hi)
+                v = np.clip(uvd[moving, 1], self.v_lo, self.v_hi)
+                dv = uvd[moving, 2]
                 s, e = self.along_u(v, u)
-                out[i] = s * dv
-                inner.append(e * abs(dv))
+                out[moving] = s * dv[:, None]
+                inner.append((e * np.abs(dv)[:, None]).max(axis=0))
             return out
 
         total, error = _adaptive(values, breaks, self.tolerance)
