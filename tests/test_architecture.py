@@ -41,7 +41,7 @@ LAYERS: list[tuple[str, list[str]]] = [
     ),
     ("body", ["body"]),
     ("geometry", ["topology", "seams", "solid", "surface"]),
-    ("load", ["load", "cad.read", "cad.occ"]),
+    ("load", ["load", "cad.read", "cad.occ", "cad.green"]),  # green: the adapter's own face integrals
     ("mass geometry", ["mass.properties", "mass.points", "mass.geometry"]),
     ("refinement", ["mass.refine"]),
     ("mass", ["mass", "mass.material", "cad"]),

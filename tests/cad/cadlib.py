@@ -11,9 +11,6 @@ __all__ = [
     "box",
     "cylinder",
     "nurbs",
-    "spline_profile",
-    "spline_prism",
-    "spline_revolution",
     "write_step",
     "write_iges",
     "open_shell",
@@ -51,50 +48,6 @@ def nurbs(shape: Any) -> Any:
     from OCP.BRepBuilderAPI import BRepBuilderAPI_NurbsConvert
 
     return BRepBuilderAPI_NurbsConvert(shape, True).Shape()
-
-
-def spline_profile(poles: Sequence[tuple[float, float, float]], degree: int = 3) -> Any:
-    """A clamped, uniform, non-rational B-spline through ``poles`` (the last pole repeats the first, so the
-    curve closes), as a ``Geom_BSplineCurve``; knots 0, 1, ..., n - degree with end multiplicity degree + 1."""
-    from OCP.collections import Array1_double, Array1_gp_Pnt, Array1_int
-    from OCP.Geom import Geom_BSplineCurve
-    from OCP.gp import gp_Pnt
-
-    spans = len(poles) - degree
-    points, knots, mults = Array1_gp_Pnt(1, len(poles)), Array1_double(1, spans + 1), Array1_int(1, spans + 1)
-    for i, p in enumerate(poles):
-        points.SetValue(i + 1, gp_Pnt(*p))
-    for i in range(spans + 1):
-        knots.SetValue(i + 1, float(i))
-        mults.SetValue(i + 1, degree + 1 if i in (0, spans) else 1)
-    return Geom_BSplineCurve(points, knots, mults, degree)
-
-
-def _face(curve: Any) -> Any:
-    from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeEdge, BRepBuilderAPI_MakeFace, BRepBuilderAPI_MakeWire
-
-    wire = BRepBuilderAPI_MakeWire(BRepBuilderAPI_MakeEdge(curve).Edge()).Wire()
-    return BRepBuilderAPI_MakeFace(wire, True).Face()
-
-
-def spline_prism(curve: Any, height: float) -> Any:
-    """The planar region inside ``curve`` (in z = 0) extruded by ``height`` along z: its side is a
-    ``SurfaceOfExtrusion`` over the B-spline, its ends planes bounded by it."""
-    from OCP.BRepPrimAPI import BRepPrimAPI_MakePrism
-    from OCP.gp import gp_Vec
-
-    return BRepPrimAPI_MakePrism(_face(curve), gp_Vec(0.0, 0.0, height)).Shape()
-
-
-def spline_revolution(curve: Any) -> Any:
-    """The region inside ``curve`` (in the plane y = 0, at x > 0) turned once about the z axis: one
-    ``SurfaceOfRevolution`` face."""
-    import math
-
-    from OCP.BRepPrimAPI import BRepPrimAPI_MakeRevol
-    from OCP.gp import gp_Ax1, gp_Dir, gp_Pnt
-
-    return BRepPrimAPI_MakeRevol(_face(curve), gp_Ax1(gp_Pnt(0.0, 0.0, 0.0), gp_Dir(0.0, 0.0, 1.0)), 2 * math.pi).Shape()
 
 
 def open_shell() -> Any:
