@@ -48,10 +48,10 @@ from numpy.typing import NDArray
 
 __all__ = ["SUMS", "is_analytic", "closed_shell_faces", "face_sums"]
 
-SUMS = 13
-"""Integrals per face, about L: V, ∫x, ∫y, ∫z, ∫x², ∫y², ∫z², ∫xy, ∫xz, ∫yz (dV), then the face's
-vector area ∫n dA, whose sum over a closed surface is zero: what is left measures how far the
-faces of a file fail to close (their gaps and overlaps), on which the volume integrals depend."""
+SUMS = 14
+"""Integrals per face, about L: V, ∫x, ∫y, ∫z, ∫x², ∫y², ∫z², ∫xy, ∫xz, ∫yz (dV); the face's
+vector area ∫n dA, whose sum over a closed surface is zero (what is left measures how far the
+faces of a file fail to close, on which the volume integrals depend); and its area ∫dA."""
 
 # QUADPACK qk15: Kronrod nodes on [0, 1] (the odd ones, 1, 3, 5, 7, are the 7-point Gauss nodes) and weights
 _XK = np.array(
@@ -225,6 +225,7 @@ class _Face:
         out[:, 8] = r[:, 0] * fifth[:, 2]
         out[:, 9] = r[:, 1] * fifth[:, 2]
         out[:, 10:13] = q[:, 3:]
+        out[:, 13] = np.sqrt(np.einsum("ij,ij->i", q[:, 3:], q[:, 3:]))
         return out
 
     def along_u(self, vs: NDArray[np.float64], us: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
