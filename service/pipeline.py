@@ -152,7 +152,7 @@ def analyze_loaded(loaded: Loaded, options: AnalysisOptions, start: float | None
         frame = principal_frame(props, options.tolerance)
         cls = classify(frame)
         parts = part_results
-    warnings = list(loaded.warnings) + list(props.warnings)
+    warnings = list(loaded.warnings) + list(props.warnings) + _uncertain_class(cls, props.relative_error_estimate)
     if loaded.units_from == "file":
         warnings.append(f"length unit {loaded.units!r} taken from the file")
     warnings.extend(_unit_warning(loaded))
@@ -299,6 +299,25 @@ def _extent(body: Any) -> NDArray[np.float64] | None:
     columns = range(coords.shape[1])
     extent: NDArray[np.float64] = np.array([coords[:, k].max() - coords[:, k].min() for k in columns]) * body.length_scale
     return extent
+
+
+def _uncertain_class(cls: Classification, estimate: float) -> list[str]:
+    """A warning where a margin that decided the class is nearer its tolerance than the moments' error
+    allows (each gap is off by at most twice the relative error estimate): the class may differ."""
+    margins = cls.margins
+    named = (
+        ("(I2 - I1) / I3", margins.gap12),
+        ("(I3 - I2) / I3", margins.gap23),
+        ("I1 / I3", margins.smallest),
+        ("|I1 + I2 - I3| / I3", margins.planarity),
+    )
+    close = [f"{name} = {value:.2g}" for name, value in named if abs(value - cls.tolerance) <= 2 * estimate]
+    if not close:
+        return []
+    return [
+        f"classification uncertain: {', '.join(close)} against the tolerance {cls.tolerance:g} is within twice the "
+        f"relative error estimate {estimate:.2g}, so the class may differ within that error"
+    ]
 
 
 def _unit_warning(loaded: Loaded) -> list[str]:
