@@ -1,4 +1,5 @@
-"""The OpenCASCADE adapter (``OCP``, the ``cadquery-ocp-novtk`` wheel): the only module that imports it.
+"""The OpenCASCADE adapter (``OCP``, the ``cadquery-ocp-novtk`` wheel): with ``green`` (its face
+integrals), the only module that imports it.
 
 Everything the binding can throw is caught here and translated into a
 ``ServiceError``; nothing above this module sees an OCP object's exception.
@@ -17,11 +18,15 @@ Integration.  ``BRepGProp.VolumeProperties_s(shape, props, eps)`` runs
 OpenCASCADE's adaptive Gauss integration over the exact faces; its returned
 error is the last relative change of each face's *volume* and says nothing
 about the moments (measured: it reports 1e-16 where the moments of a NURBS
-torus are still 8e-7 off).  So each solid is integrated twice, at
-``COARSE_EPS`` and ``FINE_EPS``; the fine result is returned and the
-difference between the two, which bounds the fine result's error whenever
-the integration converges (it shrank about tenfold per hundredfold in eps on
-every part measured, see docs/cad.md), is the error estimate.
+torus are still 8e-7 off).  On analytic faces (planes, cylinders, cones,
+spheres, tori bounded by lines and circles) it integrates every moment to
+rounding, so a solid of such faces only is integrated twice, at
+``COARSE_EPS`` and ``FINE_EPS``, and the difference is the estimate.  On any
+other face it can stop far off while both runs agree (9 % on a prism over a
+B-spline profile, docs/cad.md): those faces are integrated by ``green``
+(Green's theorem in the face's parameter plane, adaptive Gauss-Kronrod with its
+own error bound), the analytic ones of the same solid face by face with
+``BRepGProp_Vinert``, all as cones from one apex, and the sums added.
 """
 
 from __future__ import annotations
