@@ -242,8 +242,11 @@ and Bezier surfaces, extrusions and revolutions of curves, offsets, and analytic
 surfaces with a free-form boundary) is integrated by `inertia.cad.green`: Green's
 theorem in the face's parameter plane, adaptive 15-point Gauss-Kronrod in both
 directions with the intervals starting at the knots, and the Kronrod-Gauss differences
-as its error bound. The faces' leftover vector area (zero for a closed surface) bounds
-what the gaps of a file's tolerance cost, and enters the estimate.
+as its error bound. All faces are summed as cones from one apex, the one
+`BRepGProp.VolumeProperties_s` takes (the mean of the vertices). Where a file's faces
+do not quite close (gaps within its tolerance), the volume depends on that apex: the
+faces' leftover vector area (zero for a closed surface) bounds by how much, that bound
+enters the estimate, and past 1e-6 a warning names the solid.
 
 ## Free-form faces: OpenCASCADE's own rules against ours
 
@@ -270,8 +273,11 @@ gmsh's `getMass` calls) is off by about 1 % on the NURBS cylinder.
 On a real part, pythonocc-demos' `Ventilator.stp` (305 faces, 290 of them free-form,
 from CATIA V5), the adaptive rule's volume is 6e-6 from the Gauss-Kronrod rule's and
 ours 3.5e-8 from it; ours takes 18 s against the adaptive rule's 12 s and Gauss-Kronrod's
-59 s. That file's faces leave a vector area of 0.66 mm^2 unclosed, so its estimate
-(3.5e-3, from the moments) says how little the file itself decides beyond that.""")
+59 s. That file's faces leave 0.66 mm^2 of vector area open, which leaves its volume
+open by up to 4e-4 (its estimate, with a warning). On 192 solids of public STEP and IGES
+files (CadQuery, build123d, pythonocc, OCCT's and CAx-IF's samples via occt-import-js,
+KiCad models, gmsh's tutorials) ours was within its estimate of the Gauss-Kronrod rule on
+every one.""")
     return report
 
 

@@ -74,7 +74,7 @@ def brep_mass_properties(
         relative_error_estimate=float(integral.estimate),
         volume=float(volume),
         density=float(rho),
-        warnings=body.warnings,
+        warnings=body.warnings + integral.warnings,
     )
 
 
