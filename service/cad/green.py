@@ -212,7 +212,7 @@ class _Face:
         rows = []
         for u, v in zip(us.tolist(), vs.tolist()):
             surface.Normal(u, v, point, normal)
-            rows.append((point.X(), point.Y(), point.Z(), normal.X(), normal.Y(), normal.Z()))
+            rows.append(point.Coord() + normal.Coord())
         q = np.array(rows)
         r = q[:, :3] - self.origin
         dv = np.einsum("ij,ij->i", r, q[:, 3:])
@@ -318,7 +318,8 @@ class _Face:
             uvd = np.empty((len(ls), 3))
             for i, parameter in enumerate(ls.tolist()):
                 surface.D12d(parameter, p, t)
-                uvd[i] = (p.X(), p.Y(), t.Y())
+                uvd[i, :2] = p.Coord()
+                uvd[i, 2] = t.Y()
             out = np.zeros((len(ls), SUMS))
             moving = uvd[:, 2] != 0.0  # along u, dv = 0: nothing to add
             if moving.any():
