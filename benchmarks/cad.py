@@ -279,7 +279,9 @@ files (CadQuery, build123d, pythonocc, OCCT's and CAx-IF's samples via occt-impo
 KiCad models, gmsh's tutorials), ours and the Gauss-Kronrod rule agreed within our
 estimate on 184 and within 3e-12 on the other 5 (small parts far from the file's origin,
 where the reference, taken about that origin, rounds at that level); 9 of them carry the
-warning about faces that do not close.""")
+warning about faces that do not close. On gmsh's `wing_fuselage.step` (B-spline,
+extrusion and revolution faces) the adaptive rule alone was 2.7e-4 off while its two
+runs agreed to 1e-14; ours is 1.2e-7 from the Gauss-Kronrod rule, within its estimate.""")
     return report
 
 
