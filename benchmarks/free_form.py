@@ -35,6 +35,7 @@ __all__ = [
     "prism_reference",
     "revolution_reference",
     "comparison_rows",
+    "relative_error",
 ]
 
 DEGREE = 3
@@ -181,10 +182,15 @@ def _occ(shape: Any, gauss_kronrod: bool, eps: float) -> tuple[float, np.ndarray
     return float(props.Mass()), np.array([c.X(), c.Y(), c.Z()]), np.linalg.eigvalsh(tensor), seconds
 
 
-def _error(result: tuple[float, np.ndarray, np.ndarray], reference: tuple[float, np.ndarray, np.ndarray]) -> float:
+def relative_error(result: tuple[float, Any, Any], reference: tuple[float, np.ndarray, np.ndarray]) -> float:
+    """Largest relative error of volume, centre (in radii of gyration) and principal moments (any order)."""
     (v, c, m), (v0, c0, m0) = result, reference
     gyration = math.sqrt(float(m0.max()) / v0)
-    return max(abs(v - v0) / v0, float(np.max(np.abs(c - c0))) / gyration, float(np.max(np.abs(np.sort(m) - m0) / m0)))
+    return max(
+        abs(v - v0) / v0,
+        float(np.max(np.abs(np.asarray(c) - c0))) / gyration,
+        float(np.max(np.abs(np.sort(m) - m0) / m0)),
+    )
 
 
 def cases() -> list[tuple[str, Any, tuple[float, np.ndarray, np.ndarray]]]:
@@ -214,13 +220,14 @@ def comparison_rows(gauss_kronrod_eps: float = 1e-9) -> list[str]:
         start = time.perf_counter()
         ours = occ.integrate(occ.Solid(name, shape))
         t_ours = time.perf_counter() - start
-        ours_error = _error((ours.volume, ours.center, np.linalg.eigvalsh(ours.tensor)), reference)
+        ours_error = relative_error((ours.volume, ours.center, np.linalg.eigvalsh(ours.tensor)), reference)
         coarse, fine = _occ(shape, False, 1e-12), _occ(shape, False, 1e-14)
-        adaptive_estimate = _error(coarse[:3], fine[:3])
+        adaptive_estimate = relative_error(coarse[:3], fine[:3])
         gk = _occ(shape, True, gauss_kronrod_eps)
+        adaptive_ms, gk_ms, ours_ms = (coarse[3] + fine[3]) * 1e3, gk[3] * 1e3, t_ours * 1e3
         rows.append(
-            f"| {name} | {_error(fine[:3], reference):.1e} | {adaptive_estimate:.1e} | {(coarse[3] + fine[3]) * 1e3:.0f} "
-            f"| {_error(gk[:3], reference):.1e} | {gk[3] * 1e3:.0f} | {ours_error:.1e} | {ours.estimate:.1e} | {t_ours * 1e3:.0f} |"
+            f"| {name} | {relative_error(fine[:3], reference):.1e} | {adaptive_estimate:.1e} | {adaptive_ms:.0f} "
+            f"| {relative_error(gk[:3], reference):.1e} | {gk_ms:.0f} | {ours_error:.1e} | {ours.estimate:.1e} | {ours_ms:.0f} |"
         )
         print(rows[-1], flush=True)
     return rows

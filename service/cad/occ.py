@@ -470,9 +470,8 @@ def _integrate_free_form(solid: Solid, free_form: _FreeForm) -> BrepIntegral:
 
     All sums are taken about the same origin and added before the centre of mass is formed.  The
     estimate is the largest of the two-accuracy difference, the free-form faces' own error bound
-    carried to volume, centre and principal moments component by component (first order), and what
-    the faces' failure to close, which is no error of the integration (OpenCASCADE's own tools take
-    the same apex), is reported in a warning where it matters (``_unclosed``).
+    carried to volume, centre and principal moments component by component (first order), and the
+    volume the faces' gaps leave open (``_unclosed``, with a warning where that matters).
     """
     from . import green
 
@@ -483,7 +482,8 @@ def _integrate_free_form(solid: Solid, free_form: _FreeForm) -> BrepIntegral:
     for i, face in enumerate(free_form.faces):
         if i in free:
             continue
-        coarse, fine = (_face_sums(face, origin, eps, free_form.size) for eps in (COARSE_EPS, FINE_EPS))
+        coarse = _face_sums(face, origin, COARSE_EPS, free_form.size, vector_area=False)
+        fine = _face_sums(face, origin, FINE_EPS, free_form.size, vector_area=True)
         if coarse is None or fine is None:  # its first moment is lost: integrated here as well
             s, e = green.face_sums(face, origin, FREE_FORM_TOLERANCE * free_form.scale)
             own += s
@@ -551,27 +551,28 @@ def _rough_centre(shape: Any, lo: NDArray[np.float64], hi: NDArray[np.float64]) 
     return total / count if count else (lo + hi) / 2
 
 
-def _face_sums(face: Any, origin: NDArray[np.float64], eps: float, size: float) -> NDArray[np.float64] | None:
+def _face_sums(face: Any, origin: NDArray[np.float64], eps: float, size: float, vector_area: bool) -> NDArray[np.float64] | None:
     """``green.SUMS`` of one face by OpenCASCADE's adaptive rule, the cone from ``origin`` over the face
-    (``BRepGProp_Vinert`` with ``origin`` as its apex and location).  None where the cone's volume is
-    too small to carry the face's first moment back (OpenCASCADE keeps the centre, not the moment)."""
+    (``BRepGProp_Vinert`` with ``origin`` as its apex and location); its vector area only if asked
+    (zeros otherwise).  None where the cone's volume is too small to carry the face's first moment
+    back (OpenCASCADE keeps the centre, not the moment)."""
     from OCP.BRepGProp import BRepGProp_Domain, BRepGProp_Face, BRepGProp_Vinert
     from OCP.gp import gp_Pnt
 
     apex = gp_Pnt(*origin.tolist())
     props = BRepGProp_Vinert(BRepGProp_Face(face, False), BRepGProp_Domain(face), apex, apex, eps)
     volume = float(props.Mass())
-    area = np.empty(3)  # the vector area: the cone's volume moves by -a·area/3 with its apex
-    for k in range(3):
+    c = props.CentreOfMass()
+    d = np.array([c.X(), c.Y(), c.Z()], dtype=np.float64) - origin
+    if volume == 0.0 or float(np.max(np.abs(d))) > 1e3 * size:
+        return None
+    area = np.zeros(3)  # the vector area: the cone's volume moves by -a·area/3 with its apex
+    for k in range(3 if vector_area else 0):
         moved = origin.copy()
         moved[k] += size
         point = gp_Pnt(*moved.tolist())  # the rule's apex is its location
         cone = BRepGProp_Vinert(BRepGProp_Face(face, False), BRepGProp_Domain(face), point, point, eps)
         area[k] = 3 * (volume - float(cone.Mass())) / size
-    c = props.CentreOfMass()
-    d = np.array([c.X(), c.Y(), c.Z()], dtype=np.float64) - origin
-    if volume == 0.0 or float(np.max(np.abs(d))) > 1e3 * size:
-        return None
     m = props.MatrixOfInertia()  # about the centre of mass; back to the origin (L&L eq. 32.12)
     tensor = np.array([[m.Value(i, j) for j in (1, 2, 3)] for i in (1, 2, 3)], dtype=np.float64)
     tensor += volume * (float(d @ d) * np.eye(3) - np.outer(d, d))

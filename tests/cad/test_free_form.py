@@ -6,7 +6,6 @@ the prism and 4e-4 off in the moments of the revolution, while reporting converg
 
 from __future__ import annotations
 
-import math
 from typing import Any
 
 import numpy as np
@@ -19,6 +18,7 @@ from benchmarks.free_form import (
     PRISM_HEIGHT,
     prism_poles,
     prism_reference,
+    relative_error,
     revolution_poles,
     revolution_reference,
     spline_prism,
@@ -33,30 +33,19 @@ RHO = 1000.0  # kg/m^3, the default density
 MM = 1e-3
 
 
-def _error(volume: float, centre: Any, moments: Any, reference: tuple[float, np.ndarray, np.ndarray]) -> float:
-    """Largest relative error of volume, centre (in radii of gyration) and principal moments."""
-    v, c, m = reference
-    gyration = math.sqrt(float(m.max()) / v)
-    return max(
-        abs(volume - v) / v,
-        float(np.max(np.abs(np.asarray(centre) - c))) / gyration,
-        float(np.max(np.abs(np.sort(moments) - m) / m)),
-    )
-
-
 def _check(shape: Any, name: str, reference: tuple[float, np.ndarray, np.ndarray]) -> None:
     """The integral of the solid as built is within its own estimate of the reference, and the
     analysis of the same solid written to STEP (poles printed to 15 digits) is within 1e-12."""
     from inertia.cad import occ
 
     integral = occ.integrate(occ.Solid(name, shape))
-    error = _error(integral.volume, integral.center, np.linalg.eigvalsh(integral.tensor), reference)
+    error = relative_error((integral.volume, integral.center, np.linalg.eigvalsh(integral.tensor)), reference)
     assert error <= 1e-12, f"off by {error:.2g}"
     assert error <= integral.estimate <= 1e-6, f"estimate {integral.estimate:.2g} against an error of {error:.2g}"
 
     doc = analyze(write_step([(name, shape)]), filename=f"{name}.step").as_dict()
     si = (reference[0] * RHO * MM**3, reference[1] * MM, reference[2] * RHO * MM**5)
-    error = _error(doc["mass"], doc["center_of_mass"], doc["principal"]["moments"], si)
+    error = relative_error((doc["mass"], doc["center_of_mass"], doc["principal"]["moments"]), si)
     assert error <= 1e-12, f"off by {error:.2g} after the STEP round trip"
     assert doc["diagnostics"]["relative_error_estimate"] <= 1e-6
 
