@@ -272,11 +272,11 @@ gmsh's `getMass` calls) is off by about 1 % on the NURBS cylinder.
 
 On a real part, pythonocc-demos' `Ventilator.stp` (305 faces, 290 of them free-form,
 from CATIA V5), the adaptive rule's volume is 6e-6 from the Gauss-Kronrod rule's and
-ours 3.5e-8 from it; ours takes 18 s against the adaptive rule's 12 s and Gauss-Kronrod's
-59 s. That file's faces leave 0.66 mm^2 of vector area open, which leaves its volume
-open by up to 4e-4 (its estimate, with a warning). On 189 solids of public STEP and IGES
-files (CadQuery, build123d, pythonocc, OCCT's and CAx-IF's samples via occt-import-js,
-KiCad models, gmsh's tutorials), ours and the Gauss-Kronrod rule agreed within our
+ours 3.5e-8 from it; ours takes 13 s against the adaptive rule's 11 s (its two
+runs, on a quiet machine) and Gauss-Kronrod's 59 s. That file's faces leave 0.66 mm^2
+of vector area open, which leaves its volume open by up to 4e-4 (its estimate, with a
+warning). On 189 solids of public STEP and IGES files (CadQuery, build123d, pythonocc,
+OCCT's and CAx-IF's samples via occt-import-js, KiCad models, gmsh's tutorials), ours and the Gauss-Kronrod rule agreed within our
 estimate on 184 and within 3e-12 on the other 5 (small parts far from the file's origin,
 where the reference, taken about that origin, rounds at that level); 9 of them carry the
 warning about faces that do not close. On gmsh's `wing_fuselage.step` (B-spline,

@@ -149,30 +149,43 @@ def closed_shell_faces(shape: Any) -> Iterator[Any]:
 
 
 def _adaptive(
-    values: Callable[[NDArray[np.float64]], NDArray[np.float64]], breaks: list[float], tolerance: NDArray[np.float64]
+    values: Callable[[NDArray[np.float64], NDArray[np.intp]], NDArray[np.float64]],
+    lo: NDArray[np.float64],
+    hi: NDArray[np.float64],
+    owner: NDArray[np.intp],
+    count: int,
+    tolerance: NDArray[np.float64],
 ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """Integral over [breaks[0], breaks[-1]] of a vector integrand (``values(x)``: (len(x), SUMS)), and its error.
-
-    The intervals still open are evaluated together, one call of ``values`` per round of bisection."""
-    total = np.zeros(SUMS)
-    error = np.zeros(SUMS)
-    lo = np.array(breaks[:-1], dtype=np.float64)
-    hi = np.array(breaks[1:], dtype=np.float64)
+    """``count`` integrals of a vector integrand, each over the intervals [lo, hi] that ``owner`` gives
+    it, and their errors: (count, SUMS) each.  ``values(x, owner)`` is the integrand at the nodes x of
+    intervals of those owners, (len(x), SUMS).  The intervals still open are evaluated together, one
+    call of ``values`` per round of bisection."""
+    total, error = np.zeros((count, SUMS)), np.zeros((count, SUMS))
     keep = hi > lo
-    lo, hi = lo[keep], hi[keep]
+    lo, hi, owner = lo[keep], hi[keep], owner[keep]
     for depth in range(MAX_DEPTH + 1):
         if lo.size == 0:
             break
         middle, half = 0.5 * (lo + hi), 0.5 * (hi - lo)
-        f = values((middle[:, None] + half[:, None] * NODES).ravel()).reshape(lo.size, NODES.size, SUMS)
+        nodes = (middle[:, None] + half[:, None] * NODES).ravel()
+        f = values(nodes, np.repeat(owner, NODES.size)).reshape(lo.size, NODES.size, SUMS)
         kronrod = half[:, None] * np.einsum("k,ikj->ij", KRONROD, f)
         difference = np.abs(kronrod - half[:, None] * np.einsum("k,ikj->ij", GAUSS, f))
         done = np.all(difference <= tolerance, axis=1) | (depth == MAX_DEPTH)
-        total += kronrod[done].sum(axis=0)
-        error += difference[done].sum(axis=0)
-        lo, middle, hi = lo[~done], middle[~done], hi[~done]
-        lo, hi = np.concatenate([lo, middle]), np.concatenate([middle, hi])
+        np.add.at(total, owner[done], kronrod[done])
+        np.add.at(error, owner[done], difference[done])
+        lo, middle, hi, owner = lo[~done], middle[~done], hi[~done], owner[~done]
+        lo, hi, owner = np.concatenate([lo, middle]), np.concatenate([middle, hi]), np.concatenate([owner, owner])
     return total, error
+
+
+def _adaptive_one(
+    values: Callable[[NDArray[np.float64]], NDArray[np.float64]], breaks: list[float], tolerance: NDArray[np.float64]
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """One integral over [breaks[0], breaks[-1]], its intervals starting at ``breaks``."""
+    cuts = np.array(breaks, dtype=np.float64)
+    total, error = _adaptive(lambda x, _: values(x), cuts[:-1], cuts[1:], np.zeros(len(breaks) - 1, dtype=np.intp), 1, tolerance)
+    return total[0], error[0]
 
 
 def _breaks(lo: float, hi: float, knots: list[float]) -> list[float]:
@@ -233,29 +246,18 @@ class _Face:
         error; all of them adaptively at once (the intervals still open are evaluated together)."""
         starts, ends, owners = [], [], []
         for i, u in enumerate(us.tolist()):
-            lo, hi = min(u, self.u_lo), max(u, self.u_lo)
-            cuts = _breaks(lo, hi, self.u_knots)
+            cuts = _breaks(min(u, self.u_lo), max(u, self.u_lo), self.u_knots)
             starts += cuts[:-1]
             ends += cuts[1:]
             owners += [i] * (len(cuts) - 1)
-        lo_, hi_, owner = np.array(starts), np.array(ends), np.array(owners, dtype=np.intp)
-        keep = hi_ > lo_
-        lo_, hi_, owner = lo_[keep], hi_[keep], owner[keep]
-        total, error = np.zeros((len(us), SUMS)), np.zeros((len(us), SUMS))
-        for depth in range(MAX_DEPTH + 1):
-            if lo_.size == 0:
-                break
-            middle, half = 0.5 * (lo_ + hi_), 0.5 * (hi_ - lo_)
-            nodes = (middle[:, None] + half[:, None] * NODES).ravel()
-            f = self.integrand(nodes, np.repeat(vs[owner], NODES.size)).reshape(lo_.size, NODES.size, SUMS)
-            kronrod = half[:, None] * np.einsum("k,ikj->ij", KRONROD, f)
-            difference = np.abs(kronrod - half[:, None] * np.einsum("k,ikj->ij", GAUSS, f))
-            done = np.all(difference <= self.tolerance, axis=1) | (depth == MAX_DEPTH)
-            np.add.at(total, owner[done], kronrod[done])
-            np.add.at(error, owner[done], difference[done])
-            open_ = ~done
-            lo_, middle, hi_, owner = lo_[open_], middle[open_], hi_[open_], owner[open_]
-            lo_, hi_, owner = np.concatenate([lo_, middle]), np.concatenate([middle, hi_]), np.concatenate([owner, owner])
+        total, error = _adaptive(
+            lambda x, owner: self.integrand(x, vs[owner]),
+            np.array(starts, dtype=np.float64),
+            np.array(ends, dtype=np.float64),
+            np.array(owners, dtype=np.intp),
+            len(us),
+            self.tolerance,
+        )
         sign = np.where(us >= self.u_lo, 1.0, -1.0)
         return total * sign[:, None], error
 
@@ -285,7 +287,7 @@ class _Face:
             inner.append(e.max(axis=0))
             return out
 
-        total, error = _adaptive(values, _breaks(self.v_lo, self.v_hi, self.v_knots), self.tolerance)
+        total, error = _adaptive_one(values, _breaks(self.v_lo, self.v_hi, self.v_knots), self.tolerance)
         return total, error + _weighted(inner, self.v_hi - self.v_lo)
 
     def _edge(self, edge: Any) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
@@ -331,7 +333,7 @@ class _Face:
                 inner.append((e * np.abs(dv)[:, None]).max(axis=0))
             return out
 
-        total, error = _adaptive(values, breaks, self.tolerance)
+        total, error = _adaptive_one(values, breaks, self.tolerance)
         return total, error + _weighted(inner, hi - lo)
 
 
