@@ -1,0 +1,121 @@
+"""The short way for small point requests (``api.lane``) answers exactly as FastAPI's route would.
+
+Each request goes to two apps built alike, one without the lane in its middleware: status, content
+type and document (elapsed times aside) must agree, for answers the lane gives itself and for every
+case it leaves to FastAPI (invalid JSON, validation errors, another content type, a pooled job, an
+error of the input). The lane in front of an app that answers only 404 shows which requests it answered.
+"""
+
+from __future__ import annotations
+
+import gc
+import json
+from collections.abc import Iterator
+from typing import Any
+
+import pytest
+from fastapi import FastAPI
+from fastapi.testclient import TestClient
+from starlette.responses import Response
+
+from inertia.api import Settings, create_app
+from inertia.api.lane import POINTS_PATH, SmallPointsLane
+
+from .test_points_inline import BODIES, TRIANGLE, _untimed
+
+
+def _without_lane(app: FastAPI) -> FastAPI:
+    app.user_middleware = [m for m in app.user_middleware if m.cls is not SmallPointsLane]  # type: ignore[comparison-overlap]
+    return app
+
+
+@pytest.fixture(scope="module")
+def clients() -> Iterator[tuple[TestClient, TestClient, TestClient]]:
+    settings = Settings(compute_processes=1, max_upload_bytes=4096)
+    alone = TestClient(SmallPointsLane(Response(status_code=404)))  # the lane in front of nothing
+    with TestClient(create_app(settings)) as lane, TestClient(_without_lane(create_app(settings))) as route:
+        yield lane, route, alone
+
+
+# (body, content type) of requests the lane answers itself
+ANSWERED: list[tuple[bytes, str]] = [
+    *[(json.dumps(b).encode(), "application/json") for b in BODIES],
+    (json.dumps({"points": TRIANGLE}).encode(), "application/json; charset=utf-8"),
+    # an error of the input itself: the error handler's envelope
+    (json.dumps({"points": [{"element": "Xx", "position": [0, 0, 0]}]}).encode(), "application/json"),
+    (json.dumps({"points": [{"mass": 1e-320, "position": [0, 0, 0]}]}).encode(), "application/json"),
+]
+
+# requests the lane leaves to FastAPI
+PASSED_ON: list[tuple[bytes, str]] = [
+    (b'{"points": [', "application/json"),  # not JSON
+    (b"[" * 5000 + b"]" * 5000, "application/json"),  # too deep for json.loads
+    (json.dumps({"points": []}).encode(), "application/json"),  # fails validation
+    (json.dumps({"points": TRIANGLE, "tolerance": 2}).encode(), "application/json"),
+    (json.dumps({"points": TRIANGLE, "surprise": 1}).encode(), "application/json"),
+    (json.dumps({"points": TRIANGLE}).encode(), "text/plain"),  # not a JSON body to FastAPI either
+    (json.dumps({"points": TRIANGLE}).encode(), "application/vnd.api+json"),
+    (json.dumps({"points": TRIANGLE, "omega": [0, 0, 1], "duration": 1, "samples": 8}).encode(), "application/json"),  # pooled
+    (json.dumps({"points": TRIANGLE, "omega": [0, 0, 1], "samples": 8}).encode(), "application/json"),  # refused by the options
+]
+
+
+def _post(client: TestClient, body: bytes, content_type: str) -> tuple[int, dict[str, str], Any]:
+    """Status, headers (but the length, which the elapsed time's digits move) and the untimed document."""
+    response = client.post(POINTS_PATH, content=body, headers={"content-type": content_type})
+    headers = {k: v for k, v in response.headers.items() if k != "content-length"}
+    return response.status_code, headers, _untimed(response.json()) if response.content else None
+
+
+@pytest.mark.parametrize(("body", "content_type"), ANSWERED + PASSED_ON)
+def test_the_lane_answers_as_the_route(clients: tuple[TestClient, TestClient, TestClient], body: bytes, content_type: str) -> None:
+    lane, route, _ = clients
+    assert _post(lane, body, content_type) == _post(route, body, content_type)
+
+
+@pytest.mark.parametrize(("body", "content_type"), ANSWERED)
+def test_small_valid_requests_never_reach_the_router(
+    clients: tuple[TestClient, TestClient, TestClient], body: bytes, content_type: str
+) -> None:
+    _, route, alone = clients
+    assert _post(alone, body, content_type) == _post(route, body, content_type)
+
+
+@pytest.mark.parametrize(("body", "content_type"), PASSED_ON)
+def test_everything_else_is_left_to_fastapi(
+    clients: tuple[TestClient, TestClient, TestClient], body: bytes, content_type: str
+) -> None:
+    _, _, alone = clients
+    assert alone.post(POINTS_PATH, content=body, headers={"content-type": content_type}).status_code == 404
+
+
+def test_the_guard_still_stands_in_front(clients: tuple[TestClient, TestClient, TestClient]) -> None:
+    lane, _, _ = clients
+    big = json.dumps({"points": TRIANGLE * 200}).encode()  # over this app's 4096-byte limit
+    response = lane.post(POINTS_PATH, content=big, headers={"content-type": "application/json"})
+    assert response.status_code == 413
+    assert response.json()["error"]["code"] == "payload_too_large"
+
+
+def test_the_api_key_is_checked_before_the_lane() -> None:
+    with TestClient(create_app(Settings(compute_processes=1, api_key="k"))) as client:
+        body = {"points": TRIANGLE}
+        assert client.post(POINTS_PATH, json=body).status_code == 401
+        assert client.post(POINTS_PATH, json=body, headers={"X-API-Key": "k"}).status_code == 200
+
+
+def test_another_method_or_a_mounted_app_goes_the_usual_way(clients: tuple[TestClient, TestClient, TestClient]) -> None:
+    lane, route, _ = clients
+    assert lane.get(POINTS_PATH).status_code == route.get(POINTS_PATH).status_code == 405
+    with TestClient(create_app(Settings(compute_processes=1)), root_path="/mounted") as mounted:
+        response = mounted.post(POINTS_PATH, json={"points": TRIANGLE})
+        assert response.status_code == 200
+        assert response.json()["mass"] == 4.0
+
+
+def test_what_start_up_built_is_out_of_the_collectors_sight_while_serving() -> None:
+    # a full collection would otherwise walk every module, schema and route object every few hundred small requests
+    gc.unfreeze()
+    with TestClient(create_app(Settings(compute_processes=1))):
+        assert gc.get_freeze_count() > 10_000
+    assert gc.get_freeze_count() == 0
