@@ -57,6 +57,7 @@ STEP_UNITS = {
     "base_interface_AP214.STEP": 25.4,
     "base_interface_AP203.STEP": 25.4,
     "red_cube_blue_cylinder.step": 1000.0,
+    "as1_pe_203.stp": 25.4,
 }
 
 

@@ -271,8 +271,13 @@ def _solids(doc: Any) -> list[Solid]:
 MAX_DEPTH = 64  # assembly nesting deeper than this is a reference cycle, not a design
 
 
-def _walk(label: Any, location: Any, out: list[Solid], depth: int) -> None:
-    """Solids under one label: an assembly's components in turn, or a shape's own solids."""
+def _walk(label: Any, location: Any, out: list[Solid], depth: int, inherited: str | None = None) -> None:
+    """Solids under one label: an assembly's components in turn, or a shape's own solids.
+
+    ``inherited``: the nearest name above an unnamed shape. Some writers give a product's solid a
+    label of its own without a name, under the product's named one (CAx-IF as1_pe_203: PLATE, BOLT);
+    the solid then takes the product's name, or the name of the component that places it.
+    """
     from OCP.collections import Sequence_TDF_Label
     from OCP.TDF import TDF_Label
     from OCP.TopAbs import TopAbs_SOLID
@@ -282,6 +287,7 @@ def _walk(label: Any, location: Any, out: list[Solid], depth: int) -> None:
     if depth > MAX_DEPTH:
         raise UnreadableFileError("the CAD file's assembly tree is nested too deeply (a reference cycle?)")
     if XCAFDoc_ShapeTool.IsAssembly_s(label):
+        product = _label_name(label) or inherited
         components = Sequence_TDF_Label()
         XCAFDoc_ShapeTool.GetComponents_s(label, components, False)
         for i in range(1, components.Length() + 1):
@@ -289,10 +295,10 @@ def _walk(label: Any, location: Any, out: list[Solid], depth: int) -> None:
             referred = TDF_Label()
             if XCAFDoc_ShapeTool.GetReferredShape_s(component, referred):
                 placed = location.Multiplied(XCAFDoc_ShapeTool.GetLocation_s(component))
-                _walk(referred, placed, out, depth + 1)
+                _walk(referred, placed, out, depth + 1, product or _label_name(component))
         return
     shape = XCAFDoc_ShapeTool.GetShape_s(label)
-    own = _label_name(label)
+    own = _label_name(label) or inherited
     found = []
     explorer = TopExp_Explorer(shape, TopAbs_SOLID)
     while explorer.More():
@@ -319,7 +325,8 @@ def _label_name(label: Any) -> str | None:
     text = str(attr.Get().ToExtString()).strip()
     # OpenCASCADE's writers fill unnamed products with such placeholders, and its readers name unnamed
     # shapes by their type
-    if not text or text.lower().startswith("open cascade") or text.upper() in _PLACEHOLDER_NAMES:
+    # "=>[0:1:1:3]": the name XCAF gives a component label that the file left unnamed (the entry it refers to)
+    if not text or text.lower().startswith("open cascade") or text.upper() in _PLACEHOLDER_NAMES or text.startswith("=>["):
         return None
     return text
 

@@ -149,6 +149,18 @@ def test_assembly_densities_by_part_name(step_assembly: bytes) -> None:
     assert_close(doc["mass"], box_reference(*BOX, CORNER)["mass"] + rod["mass"] * 7.85)
 
 
+def test_a_products_unnamed_solids_take_the_products_name() -> None:
+    # CAx-IF as1_pe_203 (Pro/ENGINEER, AP203): each product's solid sits on an unnamed label of its own under the
+    # product's named one, and the components placing them are unnamed too; the file names 5 products
+    path = Path(__file__).resolve().parents[1] / "data" / "real" / "step" / "as1_pe_203.stp"
+    doc = analyze(path.read_bytes(), filename=path.name).as_dict()
+    names = [p["name"] for p in doc["parts"]]
+    base = sorted({n.split(" #")[0] for n in names})
+    assert base == ["BOLT", "L-BRACKET", "NUT", "PLATE", "ROD"]
+    assert sorted(names).count("NUT") == 1 and "NUT #8" in names and "BOLT #6" in names
+    assert not any(n.startswith("solid") for n in names)
+
+
 def test_iges_assembly_has_one_part_per_solid() -> None:
     data = write_iges([box(*BOX, CORNER), cylinder(*CYL, BASE)])
     doc = analyze(data, filename="bracket.igs").as_dict()
