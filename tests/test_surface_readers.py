@@ -176,6 +176,15 @@ def test_3mf_a_support_that_is_a_component_of_the_part_is_not_weighed(closed: bo
     assert any("prop (support)" in w and "not weighed" in w for w in doc["warnings"])
 
 
+def test_a_bare_3mf_model_part_is_named_for_what_it_is() -> None:
+    # the XML of 3D/3dmodel.model alone: no 3MF tool reads it, and "not a zip" leaves the sender guessing
+    xml = model(f'<object id="1" type="model">{mesh_xml(*cube(2.0))}</object>', '<item objectid="1"/>').encode()
+    with pytest.raises(UnreadableFileError, match=r"bare XML model .* zip the model with its _rels/\.rels"):
+        analyze(xml, filename="part.3mf")
+    with pytest.raises(UnsupportedFormatError, match=r"\.model file is the XML part inside a 3MF package"):
+        analyze(xml, filename="3dmodel.model")
+
+
 def test_3mf_production_objects_in_another_model_part_are_read() -> None:
     other = (
         f'<?xml version="1.0" encoding="UTF-8"?><model unit="millimeter" xmlns="{CORE}"><resources>'

@@ -346,10 +346,19 @@ def _b64(text: bytes) -> bytes | None:
 # --- zip packages (3MF) ------------------------------------------------------------------------------
 
 
+BARE_3MF_MODEL = (
+    "the 3MF file is a bare XML model (the 3D/3dmodel.model part of a package), not the zip package a 3MF "
+    "file is (3MF core specification, ch. 2); send the .3mf file the program wrote, or zip the model with "
+    "its _rels/.rels and [Content_Types].xml"
+)
+
+
 def _check_zip(data: bytes, ctx: _Context) -> None:
     try:
         archive = zipfile.ZipFile(io.BytesIO(data))
     except (zipfile.BadZipFile, OSError, ValueError, EOFError, NotImplementedError) as exc:
+        if ctx.fmt == "3mf" and data.lstrip(b"\xef\xbb\xbf \t\r\n").startswith(b"<"):
+            raise UnreadableFileError(BARE_3MF_MODEL, format=ctx.fmt) from None
         raise UnreadableFileError(f"the {ctx.fmt.upper()} file is not a readable zip package ({exc})", format=ctx.fmt) from None
     with archive:
         infos = archive.infolist()

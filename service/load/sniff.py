@@ -47,8 +47,9 @@ def sniff_format(filename: str | None, declared: str | None, head: bytes = b"") 
         ext = _ALIASES.get(ext, ext)
         if ext in FORMATS or ext in POINT_FORMATS:
             return ext
+        part = " (a .model file is the XML part inside a 3MF package: send the .3mf file itself)" if ext == "model" else ""
         raise UnsupportedFormatError(
-            f"cannot read files ending in .{ext}; readable formats are {', '.join(FORMATS + POINT_FORMATS)} "
+            f"cannot read files ending in .{ext}{part}; readable formats are {', '.join(FORMATS + POINT_FORMATS)} "
             "(or pass format=... if the name is misleading)",
             format=ext,
         )
