@@ -5,6 +5,7 @@ from __future__ import annotations
 import io
 import json
 import math
+import re
 import zipfile
 from collections.abc import Callable
 from pathlib import Path
@@ -68,6 +69,56 @@ def test_binary_bytes_named_obj_are_refused_in_words() -> None:
     with pytest.raises(ServiceError) as err:
         analyze(b"\x00\x01\x02binary", filename="x.obj")
     assert err.value.code in ("unreadable_file", "empty_geometry")
+
+
+# --- OFF -------------------------------------------------------------------------------------------
+# Every spelling below is the tetrahedron (0,0,0), (1,0,0), (0,1,0), (0,0,1) with outward faces: volume 1/6,
+# centre (1/4, 1/4, 1/4).
+TET_FACES = "3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n"
+TET_VERTICES = "0 0 0\n1 0 0\n0 1 0\n0 0 1\n"
+
+
+@pytest.mark.parametrize(
+    "text",
+    [
+        f"OFF\n4 4 6\n{TET_VERTICES}{TET_FACES}",
+        f"4 4 6\n{TET_VERTICES}{TET_FACES}",  # the keyword is optional
+        f"OFF 4 4 6\n{TET_VERTICES}{TET_FACES}",
+        f"OFF4 4 6\n{TET_VERTICES}{TET_FACES}",  # counts written onto the keyword (trimesh's whitespace.off)
+        f"nOFF\n3\n4 4 6\n{TET_VERTICES}{TET_FACES}",
+        f"OFF\n4 4 6\n0 0 0 1 0\n0\n0 1 0 0\n0 1\n{TET_FACES}",  # vertices over line breaks
+        f"OFF\n4 4 6\n0 0 0 1 0 0\n0 1 0\n0 0 1\n{TET_FACES}",  # two vertices on one line
+        f"OFF\n4 4 6\n{TET_VERTICES}3 0 2\n1 0.5 0.5 0.5\n3 0 1 3 7\n3\n0 3 2\n3 1 2 3\n",  # faces over lines
+        f"NOFF\n4 4 6\n{TET_VERTICES.replace(chr(10), ' 0 0 1' + chr(10))}{TET_FACES}",
+        f"appearance {{\n +texturing\n texture {{ file grid.pgm }}\n}}\nOFF\n4 4 6\n{TET_VERTICES}{TET_FACES}",
+        # 4OFF: (x, y, z) / w
+        f"4OFF\n4 4 6\n0 0 0 1\n2 0 0 2\n0 3 0 3\n0 0 0.5 0.5\n{TET_FACES}",
+    ],
+)
+def test_off_is_read_as_geomview_specifies(text: str) -> None:
+    doc = analyze(text.encode(), filename="tet.off", options=AnalysisOptions(density=1.0)).as_dict()
+    assert doc["mass"] == pytest.approx(1 / 6, rel=1e-15)
+    np.testing.assert_allclose(doc["center_of_mass"], [0.25, 0.25, 0.25], rtol=1e-15)
+
+
+@pytest.mark.parametrize(
+    ("text", "error", "words"),
+    [
+        ("OFF BINARY\n" + "x" * 40, UnsupportedFormatError, "binary OFF is not supported"),
+        (f"nOFF\n4\n4 4 6\n{TET_VERTICES}{TET_FACES}", UnsupportedFormatError, "4 dimensions; a solid needs three"),
+        ("\x01" * 10_000, UnreadableFileError, "binary data, not OFF text"),
+        (f"OFF\nfour 4 6\n{TET_VERTICES}{TET_FACES}", UnreadableFileError, "'four' where its vertex count"),
+        (f"OFF\n4 4 6\n{TET_VERTICES}3 0 2 1\n3 0 1 4\n3 0 3 2\n3 1 2 3\n", UnreadableFileError, "refers to vertex 4"),
+        (f"OFF\n4 5 6\n{TET_VERTICES}{TET_FACES}", UnreadableFileError, "ends after 4 of its 5 faces"),
+        (f"OFF\n5 4 6\n{TET_VERTICES}{TET_FACES}", UnreadableFileError, "OFF file"),
+        (f"4OFF\n4 4 6\n0 0 0 0\n1 0 0 1\n0 1 0 1\n0 0 1 1\n{TET_FACES}", UnreadableFileError, "point at infinity"),
+        ("OFF\n0 0 0\n", EmptyGeometryError, "declares 0 vertices and 0 faces"),
+    ],
+)
+def test_off_faults_are_named(text: str, error: type[ServiceError], words: str) -> None:
+    with pytest.raises(error, match=re.escape(words)) as caught:
+        analyze(text.encode(), filename="bad.off")
+    assert len(caught.value.message) < 400  # a binary "word" of megabytes is not quoted whole
 
 
 # --- guarded reader calls ----------------------------------------------------------------------------

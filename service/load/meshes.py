@@ -1,4 +1,4 @@
-"""Surface meshes and scenes: OBJ and 3MF by our own readers, PLY/OFF/glTF through trimesh.
+"""Surface meshes and scenes: OBJ, OFF and 3MF by our own readers, PLY and glTF through trimesh.
 
 Only geometry is read: materials, textures, normals and colours are skipped
 (``skip_materials``) and trimesh's processing is off (``process=False``) so
@@ -62,6 +62,11 @@ def read_surface_parts(
         if len(parts) == 1 and not groups[0][0]:
             parts = [mesh_part("body", groups[0][1], groups[0][2], length_scale, "obj")]
         return parts, None, notes
+    if fmt == "off":
+        from .off import read_off
+
+        vertices, triangles, notes = guarded_read(lambda: read_off(data), fmt)
+        return [mesh_part("body", vertices, triangles, length_scale, "off")], None, notes
     if fmt == "3mf":
         from .threemf import read_3mf
 
@@ -110,7 +115,7 @@ def mesh_part(name: str, vertices: NDArray[Any], faces: NDArray[Any], length_sca
 def read_trimesh_parts(
     data: bytes, fmt: str, length_scale: float, companions: Mapping[str, bytes] | None = None
 ) -> tuple[list[Part], str | None]:
-    """Parts of a PLY/OFF/GLB/glTF file (one per scene node) and the unit it declares."""
+    """Parts of a PLY/GLB/glTF file (one per scene node) and the unit it declares."""
     import trimesh
 
     notes = _check_gltf_document(data, fmt) if fmt in ("gltf", "glb") else []
@@ -147,13 +152,10 @@ def read_trimesh_parts(
         name = str(node) if node != geom_name or len(nodes) > 1 else str(geom_name)
         parts.append(mesh_part(name, vertices, faces, length_scale, fmt))
     if not parts:
-        # what the reader found: an OFF face split over several lines, say, is read as none
         what = " its reader could take (it found only points or lines)" if skipped else ""
         raise EmptyGeometryError(f"the {fmt.upper()} file holds no triangles{what}; a solid needs a triangle mesh", format=fmt)
     if fmt == "ply":
         notes += _ply_split_notes(scene)
-    elif fmt == "off" and len(parts) == 1:
-        notes += _off_split_notes(data, scene)
     if notes:
         first = parts[0]
         assert isinstance(first.body, MeshBody)
@@ -181,47 +183,6 @@ def _ply_split_notes(scene: Any) -> list[str]:
         if note:
             notes.append(note)
     return notes
-
-
-def _off_split_notes(data: bytes, scene: Any) -> list[str]:
-    """``polygons.fan_split_note`` on an OFF file's faces as written (trimesh keeps only its triangles)."""
-    from .polygons import fan_split_note
-
-    geoms = list(scene.geometry.values())
-    faces = _off_face_lists(data)
-    if len(geoms) != 1 or faces is None or not faces:
-        return []
-    vertices = np.asarray(geoms[0].vertices, dtype=np.float64)
-    counts = np.fromiter((len(f) for f in faces), dtype=np.int64, count=len(faces))
-    if not np.any(counts >= 4) or counts.min() < 3:
-        return []
-    corners = np.concatenate([np.asarray(f, dtype=np.int64) for f in faces])
-    if corners.min() < 0 or corners.max() >= len(vertices):
-        return []
-    note = fan_split_note(vertices, corners, counts, "off")
-    return [note] if note else []
-
-
-def _off_face_lists(data: bytes) -> list[list[int]] | None:
-    """The faces of an OFF file ("OFF", counts, vertex lines, then "k i1 ... ik [colour]" lines), or None."""
-    try:
-        lines = [ln.split("#", 1)[0].split() for ln in data.decode("utf-8", "replace").splitlines()]
-        lines = [ln for ln in lines if ln]
-        head = lines[0]
-        if not head[0].upper().endswith("OFF") and not head[0].upper().startswith("OFF"):
-            return None
-        rest = [head[0][head[0].upper().index("OFF") + 3 :], *head[1:]]
-        rest = [t for t in rest if t]
-        body = lines[1:]
-        if len(rest) < 2:
-            rest, body = body[0], body[1:]
-        n_vertices, n_faces = int(rest[0]), int(rest[1])
-        rows = body[n_vertices : n_vertices + n_faces]
-        if len(rows) != n_faces:
-            return None
-        return [[int(t) for t in row[1 : 1 + int(row[0])]] for row in rows]
-    except (ValueError, IndexError):
-        return None
 
 
 def _with_triangle_strips(scene: Any) -> None:

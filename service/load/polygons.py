@@ -2,9 +2,9 @@
 
 A face of four or more corners that are not in one plane does not define a
 surface: each way of cutting it into triangles bounds a different volume.
-Our readers (and trimesh's for PLY and OFF, and Blender) cut it as a fan
-from its first corner; the PLY and OFF faces as written are read back from
-the file (``meshes._ply_split_notes``, ``meshes._off_split_notes``); VTK cuts by ear clipping, and the two volumes differ (VTK's
+Our readers (and trimesh's for PLY, and Blender) cut it as a fan from its
+first corner; the PLY faces as written are read back from the file
+(``meshes._ply_split_notes``); VTK cuts by ear clipping, and the two volumes differ (VTK's
 ``shark.ply`` by 3.7e-5).  ``fan_split_note`` measures the difference that
 flipping each inner diagonal of every fan makes, sum over polygons of
 |det(c[i+1] - c0, c[i+2] - c0, c[i+3] - c0)| / 6, which for a quadrilateral is
