@@ -44,6 +44,16 @@ def test_every_surface_format_gives_the_box(fmt: str, ext: str) -> None:
     assert doc["source"]["triangles"] == 12 and doc["source"]["vertices"] == 8
 
 
+@pytest.mark.parametrize("filename", ["part.stl", None])
+def test_ascii_stl_in_capitals_is_read(filename: str | None) -> None:
+    # SOLID / FACET NORMAL / OUTER LOOP / VERTEX: older CAD tools write the keywords so (admesh's own block.stl)
+    data = export(box_mesh(), "stl_ascii").upper()
+    assert b"VERTEX" in data and b"vertex" not in data
+    doc = analyze(data, filename=filename).as_dict()
+    assert doc["mass"] == pytest.approx(6000, rel=1e-14)
+    np.testing.assert_allclose(doc["principal"]["moments"], BOX_MOMENTS, rtol=1e-14)
+
+
 def test_gltf_with_embedded_buffers_is_read_in_metres() -> None:
     data = export(trimesh.Scene(box_mesh()), "gltf", embed_buffers=True)
     doc = analyze(data, filename="part.gltf").as_dict()

@@ -70,7 +70,7 @@ def _from_content(head: bytes) -> str | None:
         return "off"
     if head.startswith(b"$MeshFormat"):
         return "msh"
-    if head.lstrip().startswith(b"solid"):
+    if head.lstrip()[:5].lower() == b"solid":
         return "stl"
     if b"<VTKFile" in head[:200]:
         return "vtu"

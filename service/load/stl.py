@@ -39,7 +39,7 @@ def read_stl(data: bytes | memoryview) -> tuple[NDArray[np.float64], NDArray[np.
         if 84 + 50 * count == len(buf):
             return _binary(buf, count)
     head = bytes(buf[:512]).removeprefix(b"\xef\xbb\xbf").lstrip()  # an editor's UTF-8 byte-order mark
-    if head.startswith(b"solid"):
+    if head[:5].lower() == b"solid":  # the keywords are lower case, but older CAD tools write them in capitals
         return _ascii(bytes(buf).removeprefix(b"\xef\xbb\xbf"))
     raise UnreadableFileError(
         "the STL file is neither ASCII (starting with 'solid') nor binary of consistent length; it may be truncated"
@@ -107,8 +107,10 @@ def _welded(corners: NDArray[np.float32]) -> tuple[NDArray[np.float64], NDArray[
 def _ascii(data: bytes) -> tuple[NDArray[np.float64], NDArray[np.int64]]:
     tokens = np.array(data.split())
     idx = np.flatnonzero(tokens == b"vertex")
+    if len(idx) == 0:  # SOLID / FACET NORMAL / VERTEX: admesh's own example block.stl, read by admesh and trimesh
+        idx = np.flatnonzero(np.char.lower(tokens) == b"vertex")
     if len(idx) == 0:
-        if b"facet" in data:
+        if b"facet" in data.lower():
             raise UnreadableFileError("the ASCII STL file has facets without vertices; it is corrupt")
         raise EmptyGeometryError("the STL file holds no triangles")
     if len(idx) % 3 or idx[-1] + 3 >= len(tokens):
