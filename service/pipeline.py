@@ -20,7 +20,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import NDArray
 
-from .body import BrepBody
+from .body import BrepBody, PointBody
 from .classification import Classification, classify
 from .conventions import length_scale
 from .errors import DegenerateBodyError, InvalidParameterError
@@ -152,7 +152,9 @@ def analyze_loaded(loaded: Loaded, options: AnalysisOptions, start: float | None
         frame = principal_frame(props, options.tolerance)
         cls = classify(frame)
         parts = part_results
-    warnings = list(loaded.warnings) + list(props.warnings) + _uncertain_class(cls, props.relative_error_estimate)
+    warnings = list(loaded.warnings) + list(props.warnings)
+    if np.any(props.principal_moments):  # all zero (one point, or all at one place): no margin decided the class
+        warnings += _uncertain_class(cls, props.relative_error_estimate)
     if loaded.units_from == "file":
         warnings.append(f"length unit {loaded.units!r} taken from the file")
     warnings.extend(_unit_warning(loaded))
@@ -321,9 +323,12 @@ def _uncertain_class(cls: Classification, estimate: float) -> list[str]:
 
 
 def _unit_warning(loaded: Loaded) -> list[str]:
-    """A file with no length unit, read as metres, that is implausibly large for a part: say so."""
-    if loaded.units_from != "default" or loaded.kind == "points":
+    """A file with no length unit, read as metres, that is implausibly large for a part (or atoms named by
+    their element that far apart): say so."""
+    if loaded.units_from != "default":
         return []
+    if loaded.kind == "points":
+        return _molecule_unit_warning(loaded)
     sizes = [e for e in (_extent(p.body) for p in loaded.parts) if e is not None]
     if not sizes:
         return []
@@ -334,6 +339,25 @@ def _unit_warning(loaded: Loaded) -> list[str]:
         f"the file declares no length unit and none was given, so it was read in metres: the part is "
         f"{diagonal:.4g} m across; if it was drawn in millimetres, pass units=mm (CLI: --units mm), "
         f"which divides the mass by 1e9"
+    ]
+
+
+MOLECULE_METRES_PLAUSIBLE = 1e-6
+"""Atoms named by their element further apart than this [m] were not given in metres (bonds are ~1e-10 m,
+and the largest molecules ~1e-7 m across)."""
+
+
+def _molecule_unit_warning(loaded: Loaded) -> list[str]:
+    molecule = [p.body for p in loaded.parts if p.extras.get("molecule") and isinstance(p.body, PointBody)]
+    if not molecule:
+        return []
+    x = molecule[0].positions * molecule[0].length_scale
+    span = float(np.linalg.norm(x.max(axis=0) - x.min(axis=0)))
+    if span < MOLECULE_METRES_PLAUSIBLE:
+        return []
+    return [
+        f"the points name their elements (a molecule) but no length unit was given, so the positions were read in "
+        f"metres: the atoms span {span:.4g} m; if they are in angstrom, pass units=angstrom (CLI: --units angstrom)"
     ]
 
 
@@ -462,7 +486,7 @@ def _motion(frame: PrincipalFrame, cls: Classification, options: AnalysisOptions
 
 def _source(loaded: Loaded, parts: Sequence[PartResult]) -> Source:
     """The ``source`` section: what was read, and how many elements it had."""
-    from .body import MeshBody, PointBody, VolumeBody
+    from .body import MeshBody, VolumeBody
 
     out: dict[str, Any] = {"format": loaded.format, "kind": loaded.kind, "units": loaded.units, "units_from": loaded.units_from}
     if loaded.filename is not None:

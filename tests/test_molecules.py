@@ -345,3 +345,75 @@ def test_a_points_file_entry_that_is_no_point_is_refused(client: Any, points: li
     r = client.post("/v1/analyze/mesh", files={"file": ("p.json", json.dumps(points).encode())})
     assert r.status_code == 422
     assert r.json()["error"]["code"] == "invalid_parameter" and "point 0 must be an object" in r.json()["error"]["message"]
+
+
+# --- extended XYZ comment lines as ASE reads them (ase.io.extxyz.key_val_str_to_dict), and counts ----------------
+WATER_STANDARD = STANDARD["O"] + 2 * STANDARD["H"]  # u
+
+
+def _water_rows(extra: list[str] | None = None) -> list[str]:
+    return [f"{e} {p[0]!r} {p[1]!r} {p[2]!r}" + (f" {extra[k]}" if extra else "") for k, (e, p) in enumerate(water())]
+
+
+@pytest.mark.parametrize(
+    "comment, extra, mass",
+    [
+        # a quoted value that mentions a layout is not the layout: the occupancy column is no mass
+        ('note="old Properties=species:S:1:pos:R:3:masses:R:1" Properties=species:S:1:pos:R:3:occupancy:R:1', "1.0", None),
+        ("Computed properties = energy and dipole", None, None),  # plain XYZ: only the key Properties counts
+        ("properties=species:S:1:pos:R:3:masses:R:1", "2.5", None),  # lower case: not the key, a plain comment
+        ("Properties=species:S:1:pos:R:3:mass:R:1", "2.5", None),  # ASE's masses column is 'masses'
+        ("Properties='species:S:1:pos:R:3:masses:R:1'", "2.5", 7.5),  # single quotes delimit a value too
+        ("Properties=species:S:1:pos:R:3:masses:I:1", "2", 6.0),
+    ],
+)
+def test_extended_xyz_comment_lines_are_split_as_ase_splits_them(
+    client: Any, comment: str, extra: str | None, mass: float | None
+) -> None:
+    rows = _water_rows([extra] * 3 if extra else None)
+    text = "\n".join([str(len(rows)), comment, *rows]) + "\n"
+    doc = client.post("/v1/analyze/mesh", files={"file": ("w.xyz", text.encode())}).json()
+    assert doc["mass"] == pytest.approx((WATER_STANDARD if mass is None else mass) * DALTON, rel=1e-12)
+
+
+def test_species_and_atomic_numbers_that_disagree_are_refused(client: Any) -> None:
+    rows = _water_rows(["6", "1", "1"])
+    text = "\n".join(["3", "Properties=species:S:1:pos:R:3:Z:I:1", *rows]) + "\n"
+    r = client.post("/v1/analyze/mesh", files={"file": ("w.xyz", text.encode())})
+    assert r.status_code == 422 and "species 'O' and atomic number '6'" in r.json()["error"]["message"]
+
+
+@pytest.mark.parametrize(
+    "count, message",
+    [(5, "announces 5 atoms but holds 3 atom lines"), (2, "announces 2 atoms on its first line but holds more atom lines")],
+)
+def test_an_atom_count_that_does_not_match_is_refused(client: Any, count: int, message: str) -> None:
+    text = "\n".join([str(count), "water", *_water_rows()]) + "\n\n"
+    r = client.post("/v1/analyze/mesh", files={"file": ("w.xyz", text.encode())})
+    assert r.status_code == 422 and message in r.json()["error"]["message"]
+
+
+def test_atoms_in_metres_without_a_unit_are_named_in_a_warning(client: Any) -> None:
+    body = {"points": _points(water())}  # 0.958 apart: angstrom numbers, read as metres by default
+    doc = client.post("/v1/analyze/points", json=body).json()
+    assert any("read in metres" in w and "units=angstrom" in w for w in doc["warnings"])
+    for fine in ({**body, "units": "angstrom"}, {**body, "units": "m"}):
+        assert not client.post("/v1/analyze/points", json=fine).json()["warnings"]
+
+
+def test_kilograms_beside_atoms_named_by_element_are_named_in_a_warning(client: Any) -> None:
+    points = [
+        {"element": "O", "position": [0, 0, 0]},
+        {"element": "H", "position": [0, 0.757, 0.586]},
+        {"mass": 2.014, "position": [0, -0.757, 0.586]},
+    ]
+    doc = client.post("/v1/analyze/points", json={"points": points, "units": "angstrom"}).json()
+    assert any("mass_unit=u" in w for w in doc["warnings"])
+    dalton = client.post("/v1/analyze/points", json={"points": points, "units": "angstrom", "mass_unit": "u"}).json()
+    assert dalton["mass"] == pytest.approx((STANDARD["O"] + STANDARD["H"] + 2.014) * DALTON, rel=1e-12)
+    assert not dalton["warnings"]
+
+
+def test_a_single_atom_has_no_class_margin_to_doubt(client: Any) -> None:
+    doc = client.post("/v1/analyze/points", json={"points": [{"element": "Ar", "position": [0, 0, 0]}]}).json()
+    assert not any("classification uncertain" in w for w in doc["warnings"])

@@ -12,7 +12,6 @@ from __future__ import annotations
 import csv
 import io
 import json
-import re
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, replace
 from typing import Any
@@ -80,11 +79,14 @@ def points_from_records(
 
         dalton = dalton_kg()
     masses, positions = [], []
+    given: list[float] = []  # masses the records give themselves (not their element's)
     for k, rec in enumerate(records):
         try:
             if not isinstance(rec, Mapping):
                 raise TypeError
             masses.append(_mass(rec, k, isotopes, dalton))
+            if rec.get("mass") is not None:
+                given.append(masses[-1])
             pos = [_number(x) for x in _sequence(rec["position"])]
         except (KeyError, TypeError, ValueError) as exc:
             raise InvalidParameterError(
@@ -95,7 +97,22 @@ def points_from_records(
         positions.append(pos)
     if not masses:
         raise EmptyGeometryError("no points were given; send at least one point mass")
-    return PointBody(np.array(masses), np.array(positions).reshape(-1, 3), length_scale)
+    body = PointBody(np.array(masses), np.array(positions).reshape(-1, 3), length_scale)
+    if given and len(given) < len(masses) and dalton is None and max(given) > _ATOMIC_KG:
+        # atoms named by element weigh ~1e-26 kg: a mass of grams or kilograms beside them was meant in dalton
+        body = replace(
+            body,
+            warnings=(
+                f"the points mix masses given in kg (the largest {max(given):.4g} kg) with atoms named by their element "
+                f"(about 1e-26 kg each), so those atoms weigh next to nothing; if the masses are in dalton (u), pass "
+                "mass_unit=u",
+            ),
+        )
+    return body
+
+
+_ATOMIC_KG = 1e-20
+"""Heavier than any atom or molecule a points request describes atom by atom (a dalton is 1.66e-27 kg)."""
 
 
 def read_points_file(data: bytes, fmt: str, length_scale: float = 1.0, *, isotopes: str = Isotopes.STANDARD) -> PointBody:
@@ -192,6 +209,8 @@ def _xyz_records(text: str) -> tuple[list[Any], list[str]]:
     # lines end at \n, \r\n or \r only: str.splitlines also splits at form feeds and other
     # separators, which a comment line may hold
     lines = text.replace("\r\n", "\n").replace("\r", "\n").split("\n")
+    while lines and not lines[-1].strip():  # the end of the last line is not another line
+        lines.pop()
     try:
         count = int(lines[0].split()[0])
     except (IndexError, ValueError):
@@ -212,6 +231,12 @@ def _xyz_records(text: str) -> tuple[list[Any], list[str]]:
                 "element": element_symbol(fields[layout.species]),
                 "position": [float(x) for x in fields[layout.pos : layout.pos + 3]],
             }
+            if layout.number is not None and _bare(record["element"]) != element_symbol(fields[layout.number]):
+                raise UnreadableFileError(
+                    f"XYZ line {k + 3} names two elements: species {fields[layout.species]!r} and atomic number "
+                    f"{fields[layout.number]!r} (Z); fix the file so that both columns agree",
+                    line=k + 3,
+                )
             if layout.mass is not None:
                 record["mass"] = float(fields[layout.mass])
         except ValueError:
@@ -220,11 +245,25 @@ def _xyz_records(text: str) -> tuple[list[Any], list[str]]:
             ) from None
         records.append(record)
     warnings = []
-    if any(line.strip() for line in lines[2 + count :]):
+    after = [line for line in lines[2 + count :] if line.strip()]
+    if after and not after[0].split()[0].isdigit():
+        # the next frame would start with its atom count: this is an atom line the first count left out
+        raise UnreadableFileError(
+            f"the XYZ file announces {count} atoms on its first line but holds more atom lines (line "
+            f"{lines.index(after[0], 2 + count) + 1}: {after[0].strip()[:80]!r}); fix the count",
+            line=lines.index(after[0], 2 + count) + 1,
+        )
+    if after:
         warnings.append(
             f"the XYZ file goes on after its first frame of {count} atoms (a trajectory?); only the first frame was analysed"
         )
     return records, warnings
+
+
+def _bare(symbol: str) -> str:
+    """The element of a symbol as an XYZ species column may write it ("13C" -> "C", "D" -> "H", "cl" -> "Cl")."""
+    letters = symbol.strip().lstrip("0123456789")
+    return "H" if letters.upper() in ("D", "T") else letters.capitalize()
 
 
 @dataclass(frozen=True, slots=True)
@@ -236,40 +275,92 @@ class _XyzLayout:
     mass: int | None = None
     width: int = 4
     reads: str = "'element x y z'"
+    number: int | None = None  # an atomic-number column (Z) beside the species, which must agree with it
 
 
-_PROPERTIES = re.compile(r"(?:^|\s)properties\s*=\s*(\"?)(?P<spec>[^\s\"]*)\1", re.IGNORECASE)
+_DELIMITERS = {'"': '"', "'": "'", "{": "}", "[": "]"}
+
+
+def _key_values(comment: str) -> dict[str, str]:
+    """The ``key=value`` pairs of an extended XYZ comment line, as ASE's ``key_val_str_to_dict`` splits them.
+
+    Pairs are separated by white space; a value (or key) may be quoted with double or single quotes or
+    bracketed with {} or [], inside which white space and ``=`` are text; a backslash escapes the next
+    character; a key without ``=`` stands alone. So ``note="... Properties=..."`` is the key ``note``.
+    """
+    pairs: list[list[list[str]]] = [[[]]]
+    closing: str | None = None
+    escaped = False
+    for char in comment.strip():
+        if escaped:
+            pairs[-1][-1].append(char)
+            escaped = False
+        elif char == "\\":
+            escaped = True
+        elif closing is not None:
+            if char == closing:
+                closing = None
+            else:
+                pairs[-1][-1].append(char)
+        elif char in _DELIMITERS:
+            closing = _DELIMITERS[char]
+        elif char.isspace():
+            if pairs[-1][-1]:
+                pairs.append([[]])
+        elif char == "=":
+            if pairs[-1] == [[]] and len(pairs) > 1:  # "key = value": the '=' joins the key before it
+                del pairs[-1]
+            pairs[-1].append([])
+        else:
+            pairs[-1][-1].append(char)
+    out = {}
+    for pair in pairs:
+        if pair and pair[0]:
+            out["".join(pair[0])] = "=".join("".join(part) for part in pair[1:]) if len(pair) > 1 else "T"
+    return out
 
 
 def _xyz_layout(comment: str) -> _XyzLayout:
-    """The columns of an extended XYZ file's ``Properties=`` (name:type:count triples); plain XYZ without one."""
-    found = _PROPERTIES.search(comment)
-    if found is None:
+    """The columns of an extended XYZ file's ``Properties`` (name:type:count triples); plain XYZ without one.
+
+    As ASE reads it: the key is ``Properties`` exactly (a comment that merely says "properties = energy"
+    is plain XYZ), the masses column is ``masses`` (another column is not a mass), and an atomic-number
+    column ``Z`` beside ``species`` must name the same elements.
+    """
+    spec = _key_values(comment).get("Properties")
+    if spec is None:
         return _XyzLayout()
-    fields = found.group("spec").split(":")
+    shown = spec[:120]
+    fields = spec.split(":")
     if len(fields) % 3 or not fields[0]:
-        raise UnreadableFileError(f"the extended XYZ Properties= {found.group('spec')[:120]!r} is not name:type:count triples")
+        raise UnreadableFileError(f"the extended XYZ Properties={shown!r} is not name:type:count triples")
     columns: dict[str, tuple[str, int, int]] = {}
     width = 0
     for name, kind, number in zip(fields[0::3], fields[1::3], fields[2::3]):
         if not number.isdigit() or kind.upper() not in ("S", "R", "I", "L"):
-            raise UnreadableFileError(f"the extended XYZ Properties= {found.group('spec')[:120]!r} has a bad column {name!r}")
+            raise UnreadableFileError(f"the extended XYZ Properties={shown!r} has a bad column {name!r}")
         columns[name] = (kind.upper(), width, int(number))
         width += int(number)
     species = columns.get("species") or columns.get("Z")
+    numbers = columns.get("Z") if "species" in columns else None
     pos = columns.get("pos")
-    mass = columns.get("masses") or columns.get("mass")
-    if species is None or species[2] != 1 or pos is None or pos[:3:2] != ("R", 3) or (mass is not None and mass[:3:2] != ("R", 1)):
+    mass = columns.get("masses")
+    if species is None or species[2] != 1 or pos is None or pos[:3:2] != ("R", 3):
         raise UnsupportedFormatError(
-            f"the extended XYZ file's columns ({found.group('spec')[:120]}) name no element column ('species:S:1' or "
+            f"the extended XYZ file's columns ({shown}) name no element column ('species:S:1' or "
             "'Z:I:1') and position column ('pos:R:3'); write the file with both",
             format="xyz",
         )
+    if mass is not None and (mass[0] not in ("R", "I") or mass[2] != 1):
+        raise UnreadableFileError(f"the extended XYZ Properties={shown!r} has a masses column that is not one number per atom")
     names = {species[1]: "element", pos[1]: "x y z", **({} if mass is None else {mass[1]: "mass"})}
+    if numbers is not None:
+        names[numbers[1]] = "atomic number"
     return _XyzLayout(
         species[1],
         pos[1],
         None if mass is None else mass[1],
         width,
         f"{width} columns as its Properties= says ({', '.join(f'{names[c]} in column {c + 1}' for c in sorted(names))})",
+        None if numbers is None or numbers[2] != 1 else numbers[1],
     )
