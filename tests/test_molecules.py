@@ -303,6 +303,7 @@ def test_extended_xyz_columns_are_read_where_properties_puts_them(client: Any) -
     assert doc["mass"] == expected["mass"]
     assert doc["center_of_mass"] == expected["center_of_mass"]
     assert doc["inertia_tensor"] == expected["inertia_tensor"]
+    assert any("periodic cell (pbc='T T T')" in w for w in doc["warnings"])  # analysed without its images
 
 
 def test_an_extended_xyz_masses_column_is_in_daltons(client: Any) -> None:

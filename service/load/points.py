@@ -253,6 +253,12 @@ def _xyz_records(text: str) -> tuple[list[Any], list[str]]:
             f"{lines.index(after[0], 2 + count) + 1}: {after[0].strip()[:80]!r}); fix the count",
             line=lines.index(after[0], 2 + count) + 1,
         )
+    pbc = _key_values(lines[1]).get("pbc", "") if len(lines) > 1 else ""
+    if any(flag in ("T", "t", "True", "true", "1") for flag in pbc.split()):
+        warnings.append(
+            f"the XYZ file describes a periodic cell (pbc={pbc!r}); its {count} atoms were analysed as one isolated "
+            "cluster, without their periodic images"
+        )
     if after:
         warnings.append(
             f"the XYZ file goes on after its first frame of {count} atoms (a trajectory?); only the first frame was analysed"
