@@ -36,7 +36,7 @@ from numpy.typing import NDArray
 
 from .blocks import for_each_block
 from .body import MeshBody
-from .errors import NotWatertightError, ZeroVolumeError
+from .errors import InvalidMeshError, NotWatertightError, ZeroVolumeError
 from .integrals import CHUNK, gather_corners, local_origin, point_records
 from .seams import merge_seams
 from .tolerances import EPS
@@ -166,7 +166,8 @@ def _orient_outward(
         # another is a second body there, not a cavity), as when all its faces see the local origin from outside;
         # nesting decides only where the file's windings disagree with each other
         return faces, []
-    depth = _nesting_depth(vertices - local_origin(vertices), faces, label, count)  # formed again: not held above
+    shifted = vertices - local_origin(vertices)  # formed again: not held above
+    depth = _nesting_depth(shifted, faces, label, count)
     if isinstance(depth, str):  # nesting undecidable: keep the file's orientation
         if total < 0 and np.all(vol <= 0):
             return faces[:, [0, 2, 1]], [INVERTED]
@@ -174,6 +175,16 @@ def _orient_outward(
             f"the {count} shells are kept as the file winds them ({depth}, so nesting was not tested); "
             f"{int(np.count_nonzero(vol < 0))} of them enclose negative volume (cavities)"
         ]
+    crossing = _crossing_shell(shifted, faces, label, count, depth)
+    del shifted
+    if crossing is not None:
+        raise InvalidMeshError(
+            f"the mesh's shells cross each other: a shell of {crossing[0]} faces lies partly inside and partly "
+            f"outside another (its largest face inside {crossing[1]} other shell(s), one of its vertices inside "
+            f"{crossing[2]}), so it is neither a cavity nor a body of its own and the windings define no volume; "
+            "join the shells into one closed surface (a boolean union) or send them as separate parts",
+            faces=crossing[0],
+        )
     want_positive = depth % 2 == 0
     flip_shell = ((vol > 0) != want_positive) & ~flat
     if not np.any(flip_shell):
@@ -305,3 +316,50 @@ def _nesting_depth(
 
 
 _NESTING_ATTEMPTS = 4
+_CROSSING_SAMPLES = 24  # vertices of each nested shell tested against the shells around it
+
+
+def _crossing_shell(
+    x: NDArray[np.float64], faces: NDArray[np.int64], label: NDArray[np.int64], count: int, depth: NDArray[np.int64]
+) -> tuple[int, int, int] | None:
+    """A nested shell whose vertices are not all as deep as its test point: (its faces, its depth, a
+    vertex's depth), or None.
+
+    The depth of a shell comes from one point of it; a shell inside another lies wholly inside only if
+    the two do not cross, which a few of its vertices (its extremes along each axis, and an even
+    spread of the rest) show: a vertex clearly inside a different number of shells means they cross.
+    Vertices on another shell (touching shells) decide nothing.
+    """
+    nested = np.flatnonzero(depth > 0)
+    if len(nested) == 0:
+        return None
+    order = np.argsort(label, kind="stable")
+    bounds = np.searchsorted(label[order], np.arange(count + 1))
+    lo = np.full((count, 3), np.inf)
+    hi = np.full((count, 3), -np.inf)
+    for k in range(3):
+        for corner in range(3):
+            coord = x[faces[:, corner], k]
+            np.minimum.at(lo[:, k], label, coord)
+            np.maximum.at(hi[:, k], label, coord)
+    for t in nested.tolist():
+        used = np.unique(faces[order[bounds[t] : bounds[t + 1]]])
+        ends = np.concatenate([used[np.argmin(x[used], axis=0)], used[np.argmax(x[used], axis=0)]])
+        spread = used[np.linspace(0, len(used) - 1, min(len(used), _CROSSING_SAMPLES - len(ends))).astype(np.int64)]
+        points = x[np.unique(np.concatenate([ends, spread]))]
+        found = np.zeros(len(points), dtype=np.int64)
+        decided = np.ones(len(points), dtype=bool)
+        for other in range(count):
+            if other == t:
+                continue
+            near = np.all(lo[other] <= points, axis=1) & np.all(hi[other] >= points, axis=1)
+            if not np.any(near):
+                continue
+            w = winding_numbers(x, faces[order[bounds[other] : bounds[other + 1]]], points[near])
+            clear = np.abs(w - np.round(w)) <= 0.25  # NaN (on the other shell) is not clear
+            decided[np.flatnonzero(near)[~clear]] = False
+            found[np.flatnonzero(near)[clear]] += np.round(w[clear]) != 0
+        wrong = decided & (found != depth[t])
+        if np.any(wrong):
+            return int(bounds[t + 1] - bounds[t]), int(depth[t]), int(found[np.flatnonzero(wrong)[0]])
+    return None

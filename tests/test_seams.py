@@ -8,7 +8,7 @@ import pytest
 from benchmarks.cases import box, icosahedron
 from benchmarks.exact import exact_solid
 from inertia.body import MeshBody, Part
-from inertia.errors import NotWatertightError, ZeroVolumeError
+from inertia.errors import InvalidMeshError, NotWatertightError, ZeroVolumeError
 from inertia.mass import mass_properties
 from inertia.pipeline import analyze
 from inertia.seams import join_open_parts, merge_seams
@@ -130,6 +130,31 @@ def test_a_shell_inside_another_without_a_bounding_box_hint_is_a_cavity() -> Non
     assert fixed.mass == pytest.approx(64 - sphere_volume, rel=1e-14)
     assert both.mass == pytest.approx(64 + sphere_volume, rel=1e-14)
     assert any("winding corrected" in w for w in fixed.warnings)
+
+
+@pytest.mark.parametrize("shift", [(0.3, 0.2, 0.1), (1.0, 0.5, 0.25), (0.0, 0.0, 0.0)])
+def test_an_inward_shell_that_crosses_its_outer_shell_is_refused(shift: tuple[float, float, float]) -> None:
+    # admesh's conveyor/merge.stl: a closed shell and an inverted copy of it moved a little; the inverted one's
+    # largest face is inside the other, so by one test point it is a cavity, and the two volumes all but cancel
+    # (the refinement then divided by a volume of rounding size). A moved copy crosses the shell it is "in";
+    # an unmoved one lies on it (every test point on the other shell): undecided, and left as the file winds it
+    v, f = box(4.0, 3.0, 2.0)
+    copy = v + np.asarray(shift)
+    both = MeshBody(np.vstack([v, copy]), np.vstack([f, f[:, [0, 2, 1]] + len(v)]))
+    if shift == (0.0, 0.0, 0.0):
+        with pytest.raises(ZeroVolumeError):
+            mass_properties(both, density=1.0)
+        return
+    with pytest.raises(InvalidMeshError, match="shells cross each other"):
+        mass_properties(both, density=1.0)
+
+
+def test_a_cavity_within_its_shell_is_still_a_cavity_when_its_vertices_are_tested() -> None:
+    # every vertex of the cavity is inside the box: the crossing test leaves it a cavity
+    bv, bf = box(4.0, 4.0, 4.0, origin=(-2.0, -2.0, -2.0))
+    sv, sf = sphere_shell(1.9)
+    props = mass_properties(MeshBody(np.vstack([bv, sv]), np.vstack([bf[:, [0, 2, 1]], sf + 8])), density=1.0)
+    assert props.mass == pytest.approx(64 - float(exact_solid(sv, sf)[0]), rel=1e-14)
 
 
 @pytest.mark.parametrize("centre", [(0.0, 0.0, 0.0), (1.2, 0.9, -1.1)])
