@@ -65,6 +65,13 @@ def test_obj_quads_negative_indices_and_colours_read_exactly() -> None:
     assert doc["mass"] == pytest.approx(6000, rel=1e-15)
 
 
+def test_an_mni_object_file_is_named_for_what_it_is() -> None:
+    # brain-imaging surfaces (MNI/BIC, read by VTK's vtkMNIObjectReader) are also called .obj: no "v" lines
+    text = b"P 0.3 0.3 0.4 10 1 4\n 0 0 0\n 1 0 0\n 0 1 0\n 0 0 1\n"
+    with pytest.raises(UnsupportedFormatError, match=r"MNI object file .* not a Wavefront OBJ"):
+        analyze(text, filename="surface.obj")
+
+
 def test_binary_bytes_named_obj_are_refused_in_words() -> None:
     with pytest.raises(ServiceError) as err:
         analyze(b"\x00\x01\x02binary", filename="x.obj")

@@ -26,7 +26,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
-from ..errors import EmptyGeometryError, UnreadableFileError
+from ..errors import EmptyGeometryError, UnreadableFileError, UnsupportedFormatError
 from .polygons import fan_split_note, fan_triangles
 
 __all__ = ["read_obj"]
@@ -117,6 +117,7 @@ def read_obj(data: bytes) -> tuple[list[tuple[str, NDArray[np.float64], NDArray[
         elif head == "g":
             group_name, part = " ".join(tokens[1:]), -1
     if not v_rows:
+        _refuse_mni(lines)
         raise EmptyGeometryError("the OBJ file has no vertices (v lines); send a mesh with geometry", format="obj")
     vertices = _vertices(v_rows, v_line, lines)
     if not f_rows:
@@ -132,6 +133,30 @@ def read_obj(data: bytes) -> tuple[list[tuple[str, NDArray[np.float64], NDArray[
             parts.append((name, vertices, tris))
     note = fan_split_note(vertices, idx, corners, "obj")
     return parts, [note] if note else []
+
+
+def _refuse_mni(lines: list[str]) -> None:
+    """An MNI/BIC object file (brain-imaging surfaces, also named .obj) is not Wavefront OBJ: say which it is.
+
+    Its first line is ``P`` with the surface's five shading numbers and its point count (or ``L`` for
+    lines); Wavefront OBJ has no such statement.
+    """
+    first = next((line.split() for line in lines if line.strip()), [])
+    if first[:1] in (["P"], ["L"]) and len(first) >= 3 and all(_is_number(t) for t in first[1:]):
+        raise UnsupportedFormatError(
+            "the .obj file is an MNI object file (brain-imaging surfaces; its first line is "
+            f"{' '.join(first[:7])!r}), not a Wavefront OBJ; convert it to STL, PLY or Wavefront OBJ first "
+            "(VTK's vtkMNIObjectReader reads it)",
+            format="obj",
+        )
+
+
+def _is_number(text: str) -> bool:
+    try:
+        float(text)
+    except ValueError:
+        return False
+    return True
 
 
 def _vertices(rows: list[list[str]], line_nos: list[int], lines: list[str]) -> NDArray[np.float64]:
