@@ -387,6 +387,14 @@ def gltf_box_doc() -> dict[str, Any]:
     return cast("dict[str, Any]", json.loads(data["model.gltf"]))
 
 
+def test_gltf_without_a_scene_places_nothing() -> None:
+    doc = gltf_box_doc()
+    doc.pop("scenes")
+    doc.pop("scene", None)
+    with pytest.raises(EmptyGeometryError, match="has no scene, so its meshes are placed nowhere"):
+        analyze(json.dumps(doc).encode(), filename="library.gltf")
+
+
 def test_gltf_mirrored_node_is_read_outward() -> None:
     doc = gltf_box_doc()
     for node in doc["nodes"]:
@@ -417,6 +425,15 @@ def _draco_without_fallback(doc: dict[str, Any]) -> None:
         (_draco_without_fallback, "mesh 'box' only with KHR_draco_mesh_compression"),
         (lambda d: d["meshes"][0].update(weights=[0.5]), "morph"),
         (lambda d: [n.update(skin=0) for n in d["nodes"] if "mesh" in n], "skinned"),
+        # an optional extension: ignored, the box would weigh once instead of once per instance
+        (
+            lambda d: [
+                n.update(extensions={"EXT_mesh_gpu_instancing": {"attributes": {"TRANSLATION": 0}}})
+                for n in d["nodes"]
+                if "mesh" in n
+            ],
+            "by EXT_mesh_gpu_instancing (one mesh drawn at many places)",
+        ),
     ],
 )
 def test_gltf_geometry_trimesh_would_misread_is_refused(change: Callable[[dict[str, Any]], object], words: str) -> None:

@@ -270,7 +270,9 @@ def _check_gltf_document(data: bytes, fmt: str) -> list[str]:
     """Refuse what trimesh's glTF reader would read as other geometry than the file's; notes on what is left out.
 
     glTF 2.0 specification: required extensions that change the geometry
-    (Draco or meshopt compression, quantized positions), sparse accessors
+    (Draco or meshopt compression, quantized positions), meshes placed many
+    times by EXT_mesh_gpu_instancing (an optional extension, so a reader that
+    ignores it draws each mesh once), sparse accessors
     (section 3.6.2.3; trimesh does not apply them), triangle fans (mode 6),
     skinned meshes (posed by their joints, section 3.7.3: the node's own
     transform is ignored) and morph targets with non-zero default weights
@@ -363,6 +365,30 @@ def _check_gltf_document(data: bytes, fmt: str) -> list[str]:
                         f"stores mesh {label!r} with a sparse accessor, which this service does not "
                         "apply; export it without sparse storage"
                     )
+    scenes = doc.get("scenes")
+    if meshes and not (isinstance(scenes, list) and scenes):
+        raise EmptyGeometryError(
+            f"the {fmt.upper()} file has no scene, so its meshes are placed nowhere (glTF 2.0 section 3.5: without "
+            "scenes the file is a library of objects); export it with a scene that holds the part's nodes",
+            format=fmt,
+        )
+    instanced = [
+        n.get("name") or f"node {k}"
+        for k, n in enumerate(nodes)
+        if isinstance(n, dict)
+        and "mesh" in n
+        and isinstance(n.get("extensions"), dict)
+        and "EXT_mesh_gpu_instancing" in n["extensions"]
+    ]
+    if instanced:
+        # the extension draws the node's mesh once per instance (its TRANSLATION/ROTATION/SCALE accessors):
+        # read without it, each such mesh would weigh once, with no word
+        raise refuse(
+            f"places {', '.join(repr(str(n)) for n in instanced[:3])}{' and others' if len(instanced) > 3 else ''} "
+            "by EXT_mesh_gpu_instancing (one mesh drawn at many places), which this service does not apply; "
+            "export the instances as ordinary nodes (e.g. Blender's glTF exporter without GPU instances)",
+            extensions=["EXT_mesh_gpu_instancing"],
+        )
     if any(isinstance(n, dict) and "skin" in n and "mesh" in n for n in nodes):
         raise refuse(
             "holds a skinned mesh, whose shape is set by its joints (the node's own transform is "
