@@ -50,6 +50,10 @@ class MeshBody:
         float32 (binary STL), 2**-53 by default; each stored coordinate x may be
         |x| x this from the value the exporter had (``mass`` refuses a body whose
         volume or moments are within what that resolution can change).
+    assumed_error : relative bound on how far the mass and moments may be from the
+        file's body because of what the reader assumed and a warning names (3MF
+        rotations written to few digits, taken as rotations; overlapping pieces
+        weighed each in full); it enters the result's error estimate.
     """
 
     vertices: NDArray[np.float64]
@@ -59,6 +63,7 @@ class MeshBody:
     warnings: tuple[str, ...] = ()
     welded: bool = False
     coordinate_eps: float = 2.0**-53
+    assumed_error: float = 0.0
 
     def __post_init__(self) -> None:
         v = _frozen(self.vertices, np.float64)

@@ -239,6 +239,7 @@ def join_open_parts(parts: list[Part], tolerances: Tolerances = DEFAULT_TOLERANC
             scales.copy().pop(),
             name,
             (*(w for b in member_bodies for w in b.warnings), note),
+            assumed_error=max(b.assumed_error for b in member_bodies if isinstance(b, MeshBody)),
         )
         joined[open_ids[members[0]]] = Part(name, body)
         drop.update(open_ids[m] for m in members[1:])

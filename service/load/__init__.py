@@ -289,7 +289,7 @@ def load_points(
 def _rescaled(part: Part, scale: float) -> Part:
     body = part.body
     if isinstance(body, MeshBody):
-        new: Body = MeshBody(body.vertices, body.faces, scale, body.name, body.warnings, body.welded, body.coordinate_eps)
+        new: Body = replace(body, length_scale=scale)
     elif isinstance(body, VolumeBody):
         new = VolumeBody(body.points, body.tets, body.cell_density, scale, body.name, body.warnings, body.cells, body.tet_cells)
     else:

@@ -71,7 +71,7 @@ def read_surface_parts(
         from .threemf import read_3mf
 
         model = guarded_read(lambda: read_3mf(data), fmt)
-        parts = [mesh_part(name, v, f, length_scale, "3mf") for name, v, f in model.parts]
+        parts = [mesh_part(name, v, f, length_scale, "3mf", model.assumed.get(name, 0.0)) for name, v, f in model.parts]
         return parts, model.unit, model.notes
     parts, unit = read_trimesh_parts(data, fmt, length_scale, companions)
     return parts, unit, []
@@ -83,8 +83,11 @@ def _compact(vertices: NDArray[np.float64], faces: NDArray[np.int64]) -> tuple[N
     return vertices[used], renumbered.reshape(faces.shape).astype(np.int64)
 
 
-def mesh_part(name: str, vertices: NDArray[Any], faces: NDArray[Any], length_scale: float, fmt: str) -> Part:
-    """A checked part: (n, 3) finite vertices, (m, 3) faces within range, or an ``UnreadableFileError``."""
+def mesh_part(
+    name: str, vertices: NDArray[Any], faces: NDArray[Any], length_scale: float, fmt: str, assumed_error: float = 0.0
+) -> Part:
+    """A checked part: (n, 3) finite vertices, (m, 3) faces within range, or an ``UnreadableFileError``;
+    ``assumed_error``: see ``MeshBody``."""
     v = np.asarray(vertices, dtype=np.float64)
     f = np.asarray(faces)
     if v.ndim != 2 or v.shape[1] != 3:
@@ -109,7 +112,7 @@ def mesh_part(name: str, vertices: NDArray[Any], faces: NDArray[Any], length_sca
             part=name,
         )
     # non-finite coordinates: MeshBody refuses them as invalid_parameter (API.md)
-    return Part(name, MeshBody(v, f.astype(np.int64), length_scale, name))
+    return Part(name, MeshBody(v, f.astype(np.int64), length_scale, name, assumed_error=assumed_error))
 
 
 def read_trimesh_parts(

@@ -101,6 +101,8 @@ class ThreeMF:
     parts: list[tuple[str, NDArray[np.float64], NDArray[np.int64]]]
     unit: str
     notes: list[str] = field(default_factory=list)
+    assumed: dict[str, float] = field(default_factory=dict)
+    """Per part, the relative error bound of what its notes assume (``body.MeshBody.assumed_error``)."""
 
 
 @dataclass
@@ -268,6 +270,7 @@ class _Reader:
     def flatten(self, root: _Part) -> ThreeMF:
         parts: list[tuple[str, NDArray[np.float64], NDArray[np.int64]]] = []
         notes: list[str] = []
+        assumed: dict[str, float] = {}
         counts: dict[str, int] = {}
         for path, object_id, transform, label in root.items:
             obj = self.object(path, object_id, "a build item")
@@ -288,6 +291,9 @@ class _Reader:
             pieces = list(self.meshes(path, obj, transform, 0, placed, left_out))
             if placed:
                 notes.append(_rotation_note(name, placed))
+                # as written, a placement M = R (I + E) with |E| about off / 2 scales volumes by det(I + E) and
+                # moments by that times lengths squared: within 3 off of the rotation's numbers
+                assumed[name] = max(assumed.get(name, 0.0), 3 * max(off for off, _ in placed))
             if left_out:
                 notes.append(
                     f"3MF object {name!r} has components that are not of type 'model' ({', '.join(left_out[:8])}): "
@@ -300,8 +306,10 @@ class _Reader:
             parts.append((name, np.concatenate(verts), np.concatenate([f + o for (_, f), o in zip(pieces, offsets)])))
             if len(pieces) > 1 and _overlapping(pieces):
                 notes.append(_overlap_note(f"the components of 3MF object {name!r}"))
+                assumed[name] = 1.0  # the overlap's size is not known: the numbers may be off by their own order
         if len(parts) > 1 and _overlapping([(v, f) for _, v, f in parts]):
             notes.append(_overlap_note("the 3MF file's build items"))
+            assumed.update((name, 1.0) for name, _, _ in parts)
         if not parts:
             if notes:
                 raise EmptyGeometryError(
@@ -310,7 +318,7 @@ class _Reader:
                     format="3mf",
                 )
             raise EmptyGeometryError("the 3MF file's build holds no objects; add a build item", format="3mf")
-        return ThreeMF(parts, root.unit, notes)
+        return ThreeMF(parts, root.unit, notes, assumed)
 
     def meshes(
         self,
@@ -414,7 +422,8 @@ def _winding(points: NDArray[np.float64], v: NDArray[np.float64], f: NDArray[np.
 def _overlap_note(what: str) -> str:
     return (
         f"{what} overlap: the 3MF specification unites overlapping volumes (ch. 4.2 and 3.4.3), but they were "
-        "weighed each in full, so the overlap counts twice and the mass is too large"
+        "weighed each in full, so the overlap counts twice and the mass is too large (by an amount not measured: "
+        "the error estimate is 1)"
     )
 
 

@@ -29,7 +29,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from ..body import Body, PointBody
+from ..body import Body, MeshBody, PointBody
 from ..conventions import DEFAULT_DENSITY
 from ..errors import InvalidParameterError
 from ..integrals import Sums
@@ -138,13 +138,18 @@ def _properties(
         inertia=InertiaTensor(tensor * inertia_scale, "centre_of_mass", com * L),
         principal_moments=refined.moments * inertia_scale,
         principal_axes=refined.axes,
-        relative_error_estimate=float(refined.estimate + 8 * EPS),
+        # what a reader assumed (and a warning names) bounds the error too
+        relative_error_estimate=max(float(refined.estimate + 8 * EPS), *(_assumed(body) for body, _ in parts)),
         volume=material.volume,
         density=material.density,
         area=material.area,
         warnings=tuple(warnings) + refined.warnings,
         mesh_vertices=whole.referenced_points if single and whole.kind == "apex" else None,
     )
+
+
+def _assumed(body: Body) -> float:
+    return body.assumed_error if isinstance(body, MeshBody) else 0.0
 
 
 def _one_part(
