@@ -344,6 +344,40 @@ def test_3mf_must_fail_rules(resources: str, build: str, words: str) -> None:
     assert words in err.value.message and "3MF" in err.value.message
 
 
+MAT = "http://schemas.microsoft.com/3dmanufacturing/material/2015/02"
+BEAM = "http://schemas.microsoft.com/3dmanufacturing/beamlattice/2017/02"
+
+
+def test_3mf_property_entries_without_their_prefix_are_named() -> None:
+    # lib3mf's multiprop-opaque.3mf: <multi> written in the core namespace, so the group counts no entries
+    m = mesh_xml(*cube(1.0))
+    group = (
+        '<m:colorgroup id="5"><m:color color="#FF0000"/></m:colorgroup>'
+        '<m:multiproperties id="6" pids="5"><multi pindices="0"/></m:multiproperties>'
+    )
+    data = package(model(f'{group}<object id="1" type="model">{m}</object>', '<item objectid="1"/>', ns=f' xmlns:m="{MAT}"'))
+    with pytest.raises(UnreadableFileError, match="<multi> elements of resource 6 are in the namespace"):
+        analyze(data, filename="multi.3mf")
+
+
+def test_3mf_beam_lattice_is_named_before_its_open_clipping_mesh() -> None:
+    # lib3mf's Box_Attributes_Positive.3mf: an open mesh (the lattice's clipping mesh) before the lattice object
+    v, f = cube(1.0)
+    lattice = (
+        f'<object id="2" type="model"><mesh>{mesh_xml(v, f)[6:-7]}<b:beamlattice minlength="0.1" radius="0.1" '
+        'clippingmode="inside" clippingmesh="1"><b:beams/></b:beamlattice></mesh></object>'
+    )
+    data = package(
+        model(
+            f'<object id="1" type="model">{mesh_xml(v, f[:-1])}</object>{lattice}',
+            '<item objectid="2"/>',
+            ns=f' xmlns:b="{BEAM}"',
+        )
+    )
+    with pytest.raises(UnsupportedFormatError, match="carries a beam lattice"):
+        analyze(data, filename="lattice.3mf")
+
+
 def test_3mf_open_model_object_is_refused_by_the_specification() -> None:
     v, f = cube(1.0)
     data = package(model(f'<object id="1" type="model" name="lid">{mesh_xml(v, f[:-1])}</object>', '<item objectid="1"/>'))

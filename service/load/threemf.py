@@ -563,8 +563,13 @@ def _parse_model(model: Any, path: str, is_root: bool, reader: _Reader) -> _Part
             raise _invalid(f"the required extension prefix {prefix!r} is not declared", "chapter 3.4")
         if ns not in _SUPPORTED:
             raise UnsupportedFormatError(
-                f"the 3MF file requires the extension {ns}, which this service does not implement (beam lattices, "
-                "volumetric or boolean geometry change the solid); export the part as a plain mesh",
+                f"the 3MF file requires the extension {ns}, which this service does not implement"
+                + (
+                    " (its content is encrypted)"
+                    if "securecontent" in ns
+                    else " (beam lattices, volumetric or boolean geometry change the solid)"
+                )
+                + "; export the part as a plain mesh",
                 format="3mf",
                 extension=ns,
             )
@@ -656,6 +661,8 @@ def _known_extension(ns: str) -> bool:
 def _parse_resources(resources: Any, part: _Part, is_root: bool) -> None:
     ids: set[int] = set()
     property_sizes: dict[int, tuple[str, int]] = {}
+    unclosed: NotWatertightError | None = None  # the first open model object, refused once every resource is read:
+    # a later one may say more about the file (a beam lattice whose clipping mesh the open object is)
     for res in resources:
         if not isinstance(res.tag, str):
             continue
@@ -678,12 +685,26 @@ def _parse_resources(resources: Any, part: _Part, is_root: bool) -> None:
         elif tag == f"{{{CORE}}}object":
             obj = _parse_object(res, where, property_sizes, part)
             part.objects[obj.id] = obj
+            if obj.type == "model" and obj.triangles is not None and unclosed is None:
+                try:
+                    _check_closed(obj)
+                except NotWatertightError as exc:
+                    unclosed = exc
+    if unclosed is not None:
+        raise unclosed
 
 
 def _check_property(res: Any, tag: str, where: str, sizes: dict[int, tuple[str, int]], part: _Part, ids: set[int]) -> int:
     child = _PROPERTY_TAGS[tag]
     ns = CORE if child == "base" else MAT
     entries = [c for c in res if c.tag == f"{{{ns}}}{child}"]
+    astray = [c for c in res if isinstance(c.tag, str) and c.tag.endswith(f"}}{child}") and c.tag != f"{{{ns}}}{child}"]
+    if astray and not entries:
+        raise _invalid(
+            f"the <{child}> elements of {where} are in the namespace {astray[0].tag[1:].split('}')[0]!r}, not in "
+            f"{ns!r} where they belong (written without their prefix, e.g. m:{child}), so the group holds no entries",
+            "materials extension" if ns == MAT else "chapter 5",
+        )
     for entry in entries:
         if child == "base" and (not entry.get("name") or not entry.get("displaycolor")):
             raise _invalid(f"a base material of {where} lacks its name or displaycolor", "chapter 5.1")
@@ -784,8 +805,6 @@ def _parse_object(res: Any, where: str, sizes: dict[int, tuple[str, int]], part:
                 format="3mf",
             )
         obj.vertices, obj.triangles = _parse_mesh(mesh, oid, object_pid, sizes)
-        if kind == "model":
-            _check_closed(obj)
     else:
         for comp in comps[0]:
             if comp.tag != f"{{{CORE}}}component":
