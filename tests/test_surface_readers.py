@@ -2,10 +2,12 @@
 
 from __future__ import annotations
 
+import base64
 import io
 import json
 import math
 import re
+import struct
 import zipfile
 from collections.abc import Callable
 from pathlib import Path
@@ -424,6 +426,71 @@ def gltf_box_doc() -> dict[str, Any]:
     return cast("dict[str, Any]", json.loads(data["model.gltf"]))
 
 
+_INSTANCES = (
+    np.array([[10, 0, 0], [0, 5, 0]], dtype="<f4").tobytes()  # TRANSLATION
+    + np.array([[0, 0, 0, 32767], [0, 0, 23170, 23170]], dtype="<i2").tobytes()  # ROTATION, normalized int16
+    + np.array([[1, 1, 1], [2, 2, 2]], dtype="<f4").tobytes()  # SCALE
+)
+
+
+def _with_instances(doc: dict[str, Any], node_translation: list[float], buffer: int | None = None, at: int = 0) -> bytes:
+    """The box drawn by EXT_mesh_gpu_instancing twice: at T (10, 0, 0); and turned 90 degrees about z (a quaternion
+    in normalized int16, as glTF-Transform writes it), scaled by 2 and moved by (0, 5, 0); the node itself moved.
+    The instance data in a new buffer (a data URI), or in ``buffer`` from byte ``at``."""
+    if buffer is None:
+        uri = "data:application/octet-stream;base64," + base64.b64encode(_INSTANCES).decode()
+        doc["buffers"].append({"byteLength": len(_INSTANCES), "uri": uri})
+        buffer = len(doc["buffers"]) - 1
+    first_view = len(doc["bufferViews"])
+    doc["bufferViews"] += [
+        {"buffer": buffer, "byteOffset": at, "byteLength": 24},
+        {"buffer": buffer, "byteOffset": at + 24, "byteLength": 16},
+        {"buffer": buffer, "byteOffset": at + 40, "byteLength": 24},
+    ]
+    first = len(doc["accessors"])
+    doc["accessors"] += [
+        {"bufferView": first_view, "componentType": 5126, "count": 2, "type": "VEC3"},
+        {"bufferView": first_view + 1, "componentType": 5122, "normalized": True, "count": 2, "type": "VEC4"},
+        {"bufferView": first_view + 2, "componentType": 5126, "count": 2, "type": "VEC3"},
+    ]
+    doc["extensionsUsed"] = ["EXT_mesh_gpu_instancing"]
+    node = next(n for n in doc["nodes"] if "mesh" in n)
+    node["translation"] = node_translation
+    node["extensions"] = {
+        "EXT_mesh_gpu_instancing": {"attributes": {"TRANSLATION": first, "ROTATION": first + 1, "SCALE": first + 2}}
+    }
+    return json.dumps(doc).encode()
+
+
+def test_gltf_instances_are_each_weighed_where_they_are_drawn() -> None:
+    # the 1 x 2 x 3 box (centre (0.5, 1, 1.5), volume 6) at (10, 0, 0): centre (10.5, 1, 1.5); scaled by 2 (volume
+    # 48, centre (1, 2, 3)), turned by 90 degrees about z ((x, y) -> (-y, x): (-2, 1, 3)) and moved by (0, 5, 0):
+    # (-2, 6, 3); then both by the node's (0, 0, 100). The instances alone are drawn, not the node's own mesh.
+    data = _with_instances(gltf_box_doc(), [0.0, 0.0, 100.0])
+    doc = analyze(data, filename="instanced.gltf", options=AnalysisOptions(density=1.0)).as_dict()
+    assert doc["mass"] == pytest.approx(54.0, rel=1e-12)
+    expected = (6 * np.array([10.5, 1, 101.5]) + 48 * np.array([-2, 6, 103])) / 54
+    np.testing.assert_allclose(doc["center_of_mass"], expected, rtol=1e-12)
+    assert any("2 instance(s) of 1 mesh node(s) placed by EXT_mesh_gpu_instancing" in w for w in doc["warnings"])
+
+
+def test_glb_instances_are_read_from_its_binary_chunk() -> None:
+    glb = trimesh.Scene(trimesh.Trimesh(*box(1.0, 2.0, 3.0), process=False)).export(file_type="glb")
+    json_length = int.from_bytes(glb[12:16], "little")
+    doc = json.loads(glb[20 : 20 + json_length])
+    binary = glb[20 + json_length + 8 :]
+    binary += b"\0" * (-len(binary) % 4)
+    doc["buffers"][0]["byteLength"] = len(binary) + len(_INSTANCES)
+    text = _with_instances(doc, [0.0, 0.0, 100.0], buffer=0, at=len(binary))
+    text += b" " * (-len(text) % 4)
+    chunks = struct.pack("<II", len(text), 0x4E4F534A) + text + struct.pack("<II", len(binary) + len(_INSTANCES), 0x004E4942)
+    data = struct.pack("<4sII", b"glTF", 2, 12 + len(chunks) + len(binary) + len(_INSTANCES)) + chunks + binary + _INSTANCES
+    doc_out = analyze(data, filename="instanced.glb", options=AnalysisOptions(density=1.0)).as_dict()
+    assert doc_out["mass"] == pytest.approx(54.0, rel=1e-12)
+    expected = (6 * np.array([10.5, 1, 101.5]) + 48 * np.array([-2, 6, 103])) / 54
+    np.testing.assert_allclose(doc_out["center_of_mass"], expected, rtol=1e-12)
+
+
 def test_gltf_without_a_scene_places_nothing() -> None:
     doc = gltf_box_doc()
     doc.pop("scenes")
@@ -462,15 +529,6 @@ def _draco_without_fallback(doc: dict[str, Any]) -> None:
         (_draco_without_fallback, "mesh 'box' only with KHR_draco_mesh_compression"),
         (lambda d: d["meshes"][0].update(weights=[0.5]), "morph"),
         (lambda d: [n.update(skin=0) for n in d["nodes"] if "mesh" in n], "skinned"),
-        # an optional extension: ignored, the box would weigh once instead of once per instance
-        (
-            lambda d: [
-                n.update(extensions={"EXT_mesh_gpu_instancing": {"attributes": {"TRANSLATION": 0}}})
-                for n in d["nodes"]
-                if "mesh" in n
-            ],
-            "by EXT_mesh_gpu_instancing (one mesh drawn at many places)",
-        ),
     ],
 )
 def test_gltf_geometry_trimesh_would_misread_is_refused(change: Callable[[dict[str, Any]], object], words: str) -> None:

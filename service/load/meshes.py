@@ -122,6 +122,11 @@ def read_trimesh_parts(
     import trimesh
 
     notes = _check_gltf_document(data, fmt) if fmt in ("gltf", "glb") else []
+    if fmt in ("gltf", "glb"):  # instances of EXT_mesh_gpu_instancing as nodes, which trimesh draws
+        from .instancing import expand_instances
+
+        data, placed = expand_instances(data, fmt, _gltf_document(data, fmt), companions)
+        notes += placed
     # the upload's own files, and nothing else: a name outside them (a texture that did not come along, a path)
     # is not found, never looked for on disk; images are not needed for the geometry (skip_materials)
     kwargs: dict[str, Any] = {"resolver": trimesh.resolvers.ZipResolver(dict(companions or {}))}
@@ -273,9 +278,7 @@ def _check_gltf_document(data: bytes, fmt: str) -> list[str]:
     """Refuse what trimesh's glTF reader would read as other geometry than the file's; notes on what is left out.
 
     glTF 2.0 specification: required extensions that change the geometry
-    (Draco or meshopt compression, quantized positions), meshes placed many
-    times by EXT_mesh_gpu_instancing (an optional extension, so a reader that
-    ignores it draws each mesh once), sparse accessors
+    (Draco or meshopt compression, quantized positions), sparse accessors
     (section 3.6.2.3; trimesh does not apply them), triangle fans (mode 6),
     skinned meshes (posed by their joints, section 3.7.3: the node's own
     transform is ignored) and morph targets with non-zero default weights
@@ -374,23 +377,6 @@ def _check_gltf_document(data: bytes, fmt: str) -> list[str]:
             f"the {fmt.upper()} file has no scene, so its meshes are placed nowhere (glTF 2.0 section 3.5: without "
             "scenes the file is a library of objects); export it with a scene that holds the part's nodes",
             format=fmt,
-        )
-    instanced = [
-        n.get("name") or f"node {k}"
-        for k, n in enumerate(nodes)
-        if isinstance(n, dict)
-        and "mesh" in n
-        and isinstance(n.get("extensions"), dict)
-        and "EXT_mesh_gpu_instancing" in n["extensions"]
-    ]
-    if instanced:
-        # the extension draws the node's mesh once per instance (its TRANSLATION/ROTATION/SCALE accessors):
-        # read without it, each such mesh would weigh once, with no word
-        raise refuse(
-            f"places {', '.join(repr(str(n)) for n in instanced[:3])}{' and others' if len(instanced) > 3 else ''} "
-            "by EXT_mesh_gpu_instancing (one mesh drawn at many places), which this service does not apply; "
-            "export the instances as ordinary nodes (e.g. Blender's glTF exporter without GPU instances)",
-            extensions=["EXT_mesh_gpu_instancing"],
         )
     if any(isinstance(n, dict) and "skin" in n and "mesh" in n for n in nodes):
         raise refuse(
