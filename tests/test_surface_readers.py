@@ -491,6 +491,13 @@ def test_glb_instances_are_read_from_its_binary_chunk() -> None:
     np.testing.assert_allclose(doc_out["center_of_mass"], expected, rtol=1e-12)
 
 
+def test_gltf_positions_without_a_buffer_view_are_zeros_and_said_so() -> None:
+    doc = gltf_box_doc()
+    doc["accessors"][doc["meshes"][0]["primitives"][0]["attributes"]["POSITION"]].pop("bufferView")
+    with pytest.raises(EmptyGeometryError, match="positions without a buffer view, which glTF reads as all zero"):
+        analyze(json.dumps(doc).encode(), filename="zeros.gltf")
+
+
 def test_gltf_without_a_scene_places_nothing() -> None:
     doc = gltf_box_doc()
     doc.pop("scenes")

@@ -360,6 +360,20 @@ def _check_gltf_document(data: bytes, fmt: str) -> list[str]:
                     "not decode; export it without mesh compression",
                     extensions=compressed,
                 )
+            if (
+                not compressed
+                and isinstance(position, int)
+                and 0 <= position < len(accessors)
+                and isinstance(accessors[position], dict)
+                and "bufferView" not in accessors[position]
+                and "sparse" not in accessors[position]
+            ):
+                # an accessor without a buffer view holds zeros (section 3.6.2.3): every corner at the origin
+                raise EmptyGeometryError(
+                    f"the {fmt.upper()} file's mesh {label!r} has positions without a buffer view, which glTF reads as "
+                    "all zero (section 3.6.2.3): every corner is at the origin and the mesh bounds no volume",
+                    format=fmt,
+                )
             for key in (position, prim.get("indices")):
                 if (
                     isinstance(key, int)
