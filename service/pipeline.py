@@ -223,6 +223,11 @@ def _v11_sections(
         from .rotational import rotational_constants
 
         out["rotational_constants"] = rotational_constants(frame.moments, cls.rotor == RotorClass.LINEAR)
+        if options.mass is not None:
+            warnings.append(
+                f"the atoms' masses were scaled to the requested total of {options.mass:g} kg, so the rotational "
+                "constants are those of that scaled body, not of the molecule"
+            )
         if out["rotational_constants"] is None:
             warnings.append(
                 "rotational constants need positive principal moments; a single atom (or atoms all at one place) has none"

@@ -418,3 +418,13 @@ def test_kilograms_beside_atoms_named_by_element_are_named_in_a_warning(client: 
 def test_a_single_atom_has_no_class_margin_to_doubt(client: Any) -> None:
     doc = client.post("/v1/analyze/points", json={"points": [{"element": "Ar", "position": [0, 0, 0]}]}).json()
     assert not any("classification uncertain" in w for w in doc["warnings"])
+
+
+def test_a_requested_total_mass_says_the_constants_are_not_the_molecules() -> None:
+    # the CLI's --mass (the points request has no total mass)
+    from inertia.pipeline import AnalysisOptions, analyze_points
+
+    plain = analyze_points(_points(water()), AnalysisOptions(units="angstrom")).as_dict()
+    scaled = analyze_points(_points(water()), AnalysisOptions(units="angstrom", mass=1.0)).as_dict()
+    assert not plain["warnings"]
+    assert any("rotational constants are those of that scaled body" in w for w in scaled["warnings"])
