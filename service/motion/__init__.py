@@ -164,7 +164,7 @@ def predict_motion(
     times = None if given_times is None else units.times(given_times)
     chosen.check(motion_rotor(frame, classification, exact_moments))
     setup = decide_regime(frame, classification, units.angular_velocity(omega), tolerances, exact_moments)
-    motion = precession_quantities(setup, chosen.name, tolerances)
+    motion = precession_quantities(setup, chosen.name, tolerances, classification.tolerance)
     if times is None:
         motion = units.restore(motion, None)
         return replace(motion, diagnostics=MotionDiagnostics(elapsed_s=time.perf_counter() - started))

@@ -16,7 +16,9 @@ from .symmetric import SymmetricTop
 __all__ = ["precession_quantities"]
 
 
-def precession_quantities(setup: Setup, method: MotionMethod, tol: Tolerances) -> FreeMotion:
+def precession_quantities(setup: Setup, method: MotionMethod, tol: Tolerances, tolerance: float = 0.0) -> FreeMotion:
+    """The precession section's quantities; ``tolerance``: the request's relative tolerance, within which
+    the state counts as on the separatrix (2 E I2 = |M|^2 within tolerance: no period, API.md)."""
     problem = setup.problem
     # M = I Omega and E = Omega.I Omega/2 of the state as given, with the reported moments (API.md);
     # the ideal top's moments only shape the motion that follows
@@ -59,7 +61,8 @@ def precession_quantities(setup: Setup, method: MotionMethod, tol: Tolerances) -
             period=2.0 * np.pi / abs(spin) if spin != 0.0 else None,
         )
     if setup.regime is Regime.ASYMMETRIC:
-        return _asymmetric_quantities(base, AsymmetricTop.from_initial(problem.moments, problem.omega_body, tol.separatrix_rel))
+        near = max(tol.separatrix_rel, tolerance)
+        return _asymmetric_quantities(base, AsymmetricTop.from_initial(problem.moments, problem.omega_body, near), tol)
     return base
 
 
@@ -86,7 +89,7 @@ def _labelled_quantities(base: FreeMotion, setup: Setup) -> FreeMotion:
     )
 
 
-def _asymmetric_quantities(base: FreeMotion, top: AsymmetricTop) -> FreeMotion:
+def _asymmetric_quantities(base: FreeMotion, top: AsymmetricTop, tol: Tolerances) -> FreeMotion:
     if top.separatrix and AsymmetricTop.from_initial(top.moments, top.omega_body, 0.0).separatrix:
         warning = (
             "Omega starts on the separatrix (2 E I2 = |M|^2 exactly): the motion approaches "
@@ -94,11 +97,19 @@ def _asymmetric_quantities(base: FreeMotion, top: AsymmetricTop) -> FreeMotion:
         )
         return replace(base, warnings=(*base.warnings, warning))
     if top.separatrix:
-        warning = (
-            "Omega starts within rounding of the separatrix (2 E I2 = |M|^2 to ~1e-15 relative), so no "
-            "period is reported: it is finite, but it and the distance to the separatrix are set by the "
-            "last digits of the input; the trajectory is the motion of the numbers as given"
-        )
+        exact = AsymmetricTop.from_initial(top.moments, top.omega_body, tol.separatrix_rel)
+        if exact.separatrix:
+            warning = (
+                "Omega starts within rounding of the separatrix (2 E I2 = |M|^2 to ~1e-15 relative), so no "
+                "period is reported: it is finite, but it and the distance to the separatrix are set by the "
+                "last digits of the input; the trajectory is the motion of the numbers as given"
+            )
+        else:
+            warning = (
+                "Omega starts within the tolerance of the separatrix (2 E I2 = |M|^2 within it), so no period is "
+                "reported (API.md): the motion as given has a finite one, which grows without bound as the state "
+                "nears the separatrix; the trajectory is the motion of the numbers as given"
+            )
         return replace(base, warnings=(*base.warnings, warning))
     period = top.period
     flip = 0.5 * period if base.stable is False else None

@@ -121,15 +121,33 @@ def test_within_1e_12_of_the_separatrix(side: Any) -> None:
     omega = (1.0, 0.4, np.sqrt((1.0 + side * 1e-12) / 3.0))  # I3 (I3 - I2) W3^2 - I1 (I2 - I1) W1^2 = +-1e-12
     # principal = input frame: a rotated input would perturb omega_body by ~1e-16, i.e. the
     # 1e-12 distance to the separatrix by ~1e-4 and the period with it (conditioning of the problem)
-    motion = _predict(moments, omega, rotation=np.eye(3), duration=1e5, samples=20001)
+    # a tolerance below the distance: with the default 1e-6 the state is on the separatrix (API.md), no period
+    assert _predict(moments, omega, rotation=np.eye(3)).period is None
+    motion = _predict(moments, omega, rotation=np.eye(3), tolerance=1e-13, duration=1e5, samples=20001)
     expected = ll_period(moments, omega)
     assert abs(motion.period - expected) <= 1e-12 * expected
     assert motion.diagnostics.energy_drift <= 1e-12 and motion.diagnostics.momentum_drift <= 1e-12
     # up to the first approach to x2: beyond, any 1e-16 difference grows like exp(rate t)
     t = np.linspace(0.0, 20.0, 41)
-    short = _predict(moments, omega, rotation=np.eye(3), duration=20.0, samples=41)
+    short = _predict(moments, omega, rotation=np.eye(3), tolerance=1e-13, duration=20.0, samples=41)
     w_ref, _ = euler_reference(moments, omega, t)
     assert np.max(np.abs(short.trajectory.omega_body - w_ref)) <= 1e-8
+
+
+@pytest.mark.parametrize("eps, on", [(1e-8, True), (1e-7, True), (3e-7, True), (3e-6, False), (1e-5, False)])
+def test_within_the_requested_tolerance_of_the_separatrix_there_is_no_period(eps: float, on: bool) -> None:
+    # API.md: "On the separatrix itself (2E I2 = |M|^2 within tolerance) ... period is absent and a warning says
+    # why". I = (1, 2, 3), Omega = (sqrt 3 (1 + eps), 0.1, 1): the relative distance |2E I2 - M^2| / M^2 is about
+    # eps / 2, within the default tolerance 1e-6 up to eps = 2e-6
+    moments = (1.0, 2.0, 3.0)
+    omega = (np.sqrt(3.0) * (1 + eps), 0.1, 1.0)
+    W1, W2, W3 = omega
+    m2 = (1 * W1) ** 2 + (2 * W2) ** 2 + (3 * W3) ** 2
+    two_e_i2 = 2 * (1 * W1**2 + 2 * W2**2 + 3 * W3**2)
+    assert bool(abs(two_e_i2 - m2) / m2 <= 1e-6) is on
+    motion = _predict(moments, omega, rotation=np.eye(3))
+    assert (motion.period is None) is on
+    assert any("within the tolerance of the separatrix" in w for w in motion.warnings) is on
 
 
 def test_started_1e_9_off_the_intermediate_axis() -> None:
