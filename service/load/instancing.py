@@ -88,7 +88,7 @@ def _instance_matrices(doc: Any, ext: Any, buffers: _Buffers, label: str, fmt: s
         raise UnreadableFileError(f"the {fmt.upper()} file's {EXTENSION} of {label!r} has no attributes", format=fmt)
     columns = {
         name: _accessor(doc, attributes[name], buffers, fmt) if name in attributes else None
-        for name, width in (("TRANSLATION", 3), ("ROTATION", 4), ("SCALE", 3))
+        for name in ("TRANSLATION", "ROTATION", "SCALE")
     }
     counts = {len(v) for v in columns.values() if v is not None}
     if len(counts) != 1:
