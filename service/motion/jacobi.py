@@ -40,12 +40,14 @@ which keeps both Pi - u and |m x e_a| away from cancellation.  M in space is
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from fractions import Fraction
 
 import numpy as np
 from numpy.typing import NDArray
 
+from ..errors import MotionError
 from . import quaternions as quat
 from .elliptic import (
     complete_third_kind_rj,
@@ -81,7 +83,26 @@ def _energy_gaps(moments: Array, omega_body: Array) -> tuple[float, float, float
     p3, p1 = I3 * (I3 - I2) * W3 * W3, I1 * (I2 - I1) * W1 * W1
     D1 = I2 * (I2 - I1) * W2 * W2 + I3 * (I3 - I1) * W3 * W3
     D3 = I1 * (I3 - I1) * W1 * W1 + I2 * (I3 - I2) * W2 * W2
-    return float(D1), float(p3 - p1), float(D3), float(p3 + p1)
+    D2 = p3 - p1
+    if D2 != 0 and abs(D2) < Fraction(_NORMAL_FLOOR) * max(D1, D3):
+        # k'^2 = |D2| / D1 (or / D3) would leave float64's normal range: the period came out non-finite, or the
+        # state was taken for one exactly on the separatrix, whose motion it leaves after its first approach
+        raise MotionError(
+            f"Omega starts about 1e{_log10(abs(D2) / max(D1, D3)):.0f} (relative) from the separatrix but not on it: float64 "
+            "cannot represent so small a distance, which sets the period and the flips; tilt Omega further from "
+            "the intermediate axis (more than ~1e-150 of its size), or put it on the separatrix exactly",
+            parameter="omega",
+        )
+    return float(D1), float(D2), float(D3), float(p3 + p1)
+
+
+def _log10(x: Fraction) -> float:
+    """log10 of a positive fraction that may be far below float64's range."""
+    return math.log10(x.numerator) - math.log10(x.denominator)
+
+
+_NORMAL_FLOOR = 1e-300
+"""Smallest distance to the separatrix, relative to M^2 - 2 E I1 or 2 E I3 - M^2, whose k'^2 is a normal float64."""
 
 
 @dataclass(frozen=True, slots=True)

@@ -9,6 +9,7 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 from inertia.conventions import orient_axes
+from inertia.errors import MotionError
 from inertia.motion import Regime, predict_motion
 from tests.support.motion import body, euler_reference, ll_period, quaternion_matrix
 
@@ -148,6 +149,16 @@ def test_within_the_requested_tolerance_of_the_separatrix_there_is_no_period(eps
     motion = _predict(moments, omega, rotation=np.eye(3))
     assert (motion.period is None) is on
     assert any("within the tolerance of the separatrix" in w for w in motion.warnings) is on
+
+
+@pytest.mark.parametrize("tilt", [1e-155, 1e-170, 1e-300])
+def test_a_distance_to_the_separatrix_float64_cannot_hold_is_refused(tilt: float) -> None:
+    # I = (3, 4, 6), Omega = (0, 1, tilt): 2E I2 - M^2 = -I3 (I3 - I2) tilt^2, ~1e-310 and below, exactly; k'^2 left
+    # float64's normal range (a non-finite period: a 500), or rounded to 0 (taken for the separatrix: a trajectory
+    # that never flipped, where the body flips every ~2400 s)
+    with pytest.raises(MotionError, match="from the separatrix but not on it"):
+        _predict((3.0, 4.0, 6.0), (0.0, 1.0, tilt), rotation=np.eye(3))
+    assert _predict((3.0, 4.0, 6.0), (0.0, 1.0, 1e-150), rotation=np.eye(3)).period > 0
 
 
 def test_started_1e_9_off_the_intermediate_axis() -> None:
