@@ -27,11 +27,13 @@ from numpy.typing import NDArray
 
 from ..errors import InputTooLargeError, UnreadableFileError, UnsupportedFormatError
 
-__all__ = ["EXTENSION", "MAX_INSTANCED_TRIANGLES", "expand_instances"]
+__all__ = ["EXTENSION", "MAX_INSTANCED_TRIANGLES", "MAX_INSTANCES", "expand_instances"]
 
 EXTENSION = "EXT_mesh_gpu_instancing"
 MAX_INSTANCED_TRIANGLES = 20_000_000
 """Triangles the instances may expand to (each instance is a copy of its mesh)."""
+MAX_INSTANCES = 10_000
+"""Instances in one file (each becomes a part of its own, a few milliseconds each)."""
 
 _COMPONENTS = {5120: "<i1", 5121: "<u1", 5122: "<i2", 5123: "<u2", 5125: "<u4", 5126: "<f4"}
 _NORMALIZED = {5120: 127.0, 5121: 255.0, 5122: 32767.0, 5123: 65535.0}
@@ -62,10 +64,11 @@ def expand_instances(data: bytes, fmt: str, doc: Any, companions: Mapping[str, b
         label = node.get("name") or f"node {k}"
         matrices = _instance_matrices(doc, node["extensions"][EXTENSION], buffers, str(label), fmt)
         triangles += len(matrices) * _mesh_triangles(doc, node["mesh"])
-        if triangles > MAX_INSTANCED_TRIANGLES:
+        if triangles > MAX_INSTANCED_TRIANGLES or count_all + len(matrices) > MAX_INSTANCES:
             raise InputTooLargeError(
-                f"the {fmt.upper()} file's {EXTENSION} instances expand to more than {MAX_INSTANCED_TRIANGLES} "
-                "triangles, more than one request analyses; send fewer instances",
+                f"the {fmt.upper()} file's {EXTENSION} instances expand to more than {MAX_INSTANCES} parts or "
+                f"{MAX_INSTANCED_TRIANGLES} triangles, more than one request analyses; send fewer instances",
+                limit_instances=MAX_INSTANCES,
                 limit_triangles=MAX_INSTANCED_TRIANGLES,
             )
         first = len(nodes)
@@ -209,9 +212,10 @@ def _accessor(doc: Any, index: Any, buffers: _Buffers, fmt: str) -> NDArray[np.f
     dtype = np.dtype(_COMPONENTS[component])
     item = dtype.itemsize * width
     stride = int(view.get("byteStride") or item)
-    start = int(view.get("byteOffset", 0)) + int(acc.get("byteOffset", 0))
+    view_start = int(view.get("byteOffset", 0))
+    start = view_start + int(acc.get("byteOffset", 0))
     end = start + (count - 1) * stride + item if count else start
-    if start < 0 or stride < item or end > len(raw) or end > start + int(view.get("byteLength", len(raw))):
+    if start < view_start or stride < item or end > len(raw) or end > view_start + int(view.get("byteLength", len(raw))):
         raise UnreadableFileError(f"the {fmt.upper()} file's accessor {index} runs past its buffer", format=fmt)
     values = np.empty((count, width), dtype=np.float64)
     for k in range(width):  # each component: a strided view of the buffer, copied out

@@ -37,6 +37,7 @@ _GEOMETRY_EXTENSIONS = {
 # glTF extensions that change nothing in the geometry we read: materials (KHR_techniques_webgl: shaders, carried
 # over from glTF 1.0), textures, lights, metadata
 _HARMLESS_GLTF_EXTENSIONS = (
+    "EXT_mesh_gpu_instancing",  # applied before the file is read (``instancing``)
     "KHR_techniques_webgl",
     "KHR_technique_webgl",
     "KHR_materials_",
@@ -125,7 +126,7 @@ def read_trimesh_parts(
     if fmt in ("gltf", "glb"):  # instances of EXT_mesh_gpu_instancing as nodes, which trimesh draws
         from .instancing import expand_instances
 
-        data, placed = expand_instances(data, fmt, _gltf_document(data, fmt), companions)
+        data, placed = guarded_read(lambda: expand_instances(data, fmt, _gltf_document(data, fmt), companions), fmt)
         notes += placed
     # the upload's own files, and nothing else: a name outside them (a texture that did not come along, a path)
     # is not found, never looked for on disk; images are not needed for the geometry (skip_materials)
