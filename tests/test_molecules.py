@@ -366,6 +366,7 @@ def _water_rows(extra: list[str] | None = None) -> list[str]:
         ("Properties=species:S:1:pos:R:3:mass:R:1", "2.5", None),  # ASE's masses column is 'masses'
         ("Properties='species:S:1:pos:R:3:masses:R:1'", "2.5", 7.5),  # single quotes delimit a value too
         ("Properties=species:S:1:pos:R:3:masses:I:1", "2", 6.0),
+        ('comment="" Properties=species:S:1:pos:R:3:masses:R:1', "2.5", 7.5),  # an empty value ends its pair
     ],
 )
 def test_extended_xyz_comment_lines_are_split_as_ase_splits_them(
@@ -392,6 +393,19 @@ def test_an_atom_count_that_does_not_match_is_refused(client: Any, count: int, m
     text = "\n".join([str(count), "water", *_water_rows()]) + "\n\n"
     r = client.post("/v1/analyze/mesh", files={"file": ("w.xyz", text.encode())})
     assert r.status_code == 422 and message in r.json()["error"]["message"]
+
+
+def test_a_word_after_the_atoms_is_not_an_atom_the_count_left_out(client: Any) -> None:
+    text = "\n".join(["3", "water", *_water_rows(), "END"]) + "\n"
+    doc = client.post("/v1/analyze/mesh", files={"file": ("w.xyz", text.encode())}).json()
+    assert doc["mass"] == pytest.approx(WATER_STANDARD * DALTON, rel=1e-12)
+    assert any("goes on after its first frame" in w for w in doc["warnings"])
+
+
+def test_a_lattice_without_pbc_is_periodic_as_ase_reads_it(client: Any) -> None:
+    text = "\n".join(["3", 'Lattice="20 0 0 0 20 0 0 0 20" Properties=species:S:1:pos:R:3', *_water_rows()]) + "\n"
+    doc = client.post("/v1/analyze/mesh", files={"file": ("w.xyz", text.encode())}).json()
+    assert any("periodic cell" in w for w in doc["warnings"])
 
 
 def test_atoms_in_metres_without_a_unit_are_named_in_a_warning(client: Any) -> None:

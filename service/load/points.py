@@ -246,14 +246,15 @@ def _xyz_records(text: str) -> tuple[list[Any], list[str]]:
         records.append(record)
     warnings = []
     after = [line for line in lines[2 + count :] if line.strip()]
-    if after and not after[0].split()[0].isdigit():
+    if after and _is_atom_line(after[0], layout):
         # the next frame would start with its atom count: this is an atom line the first count left out
         raise UnreadableFileError(
             f"the XYZ file announces {count} atoms on its first line but holds more atom lines (line "
             f"{lines.index(after[0], 2 + count) + 1}: {after[0].strip()[:80]!r}); fix the count",
             line=lines.index(after[0], 2 + count) + 1,
         )
-    pbc = _key_values(lines[1]).get("pbc", "") if len(lines) > 1 else ""
+    info = _key_values(lines[1]) if len(lines) > 1 else {}
+    pbc = info.get("pbc", "T T T" if "Lattice" in info else "")  # ASE: a Lattice without pbc is periodic
     if any(flag in ("T", "t", "True", "true", "1") for flag in pbc.split()):
         warnings.append(
             f"the XYZ file describes a periodic cell (pbc={pbc!r}); its {count} atoms were analysed as one isolated "
@@ -264,6 +265,19 @@ def _xyz_records(text: str) -> tuple[list[Any], list[str]]:
             f"the XYZ file goes on after its first frame of {count} atoms (a trajectory?); only the first frame was analysed"
         )
     return records, warnings
+
+
+def _is_atom_line(line: str, layout: _XyzLayout) -> bool:
+    """Whether a line reads as an atom of this layout (as many fields, numbers where the position is): not a
+    next frame's count line, nor a trailing word such as END."""
+    fields = line.split()
+    if len(fields) < layout.width:
+        return False
+    try:
+        [float(x) for x in fields[layout.pos : layout.pos + 3]]
+    except ValueError:
+        return False
+    return True
 
 
 def _bare(symbol: str) -> str:
@@ -297,6 +311,7 @@ def _key_values(comment: str) -> dict[str, str]:
     pairs: list[list[list[str]]] = [[[]]]
     closing: str | None = None
     escaped = False
+    quoted = False  # the current key or value opened a quote: it has begun, even if empty ('comment=""')
     for char in comment.strip():
         if escaped:
             pairs[-1][-1].append(char)
@@ -310,13 +325,16 @@ def _key_values(comment: str) -> dict[str, str]:
                 pairs[-1][-1].append(char)
         elif char in _DELIMITERS:
             closing = _DELIMITERS[char]
+            quoted = True
         elif char.isspace():
-            if pairs[-1][-1]:
+            if pairs[-1][-1] or quoted:
                 pairs.append([[]])
+                quoted = False
         elif char == "=":
             if pairs[-1] == [[]] and len(pairs) > 1:  # "key = value": the '=' joins the key before it
                 del pairs[-1]
             pairs[-1].append([])
+            quoted = False
         else:
             pairs[-1][-1].append(char)
     out = {}
