@@ -91,6 +91,7 @@ TET_VERTICES = "0 0 0\n1 0 0\n0 1 0\n0 0 1\n"
     "text",
     [
         f"OFF\n4 4 6\n{TET_VERTICES}{TET_FACES}",
+        f"OFF\n4 4 6\n# a comment\x0cwith a form feed\n{TET_VERTICES}{TET_FACES}",  # no line break in a comment
         f"4 4 6\n{TET_VERTICES}{TET_FACES}",  # the keyword is optional
         f"OFF 4 4 6\n{TET_VERTICES}{TET_FACES}",
         f"OFF4 4 6\n{TET_VERTICES}{TET_FACES}",  # counts written onto the keyword (trimesh's whitespace.off)
@@ -122,6 +123,7 @@ def test_off_is_read_as_geomview_specifies(text: str) -> None:
         (f"OFF\n5 4 6\n{TET_VERTICES}{TET_FACES}", UnreadableFileError, "OFF file"),
         (f"4OFF\n4 4 6\n0 0 0 0\n1 0 0 1\n0 1 0 1\n0 0 1 1\n{TET_FACES}", UnreadableFileError, "point at infinity"),
         ("OFF\n0 0 0\n", EmptyGeometryError, "declares 0 vertices and 0 faces"),
+        (f"OFF\n4 4 6\n{TET_VERTICES}3 0 2 99999999999999999999\n{TET_FACES[8:]}", UnreadableFileError, "99999999999999999999"),
     ],
 )
 def test_off_faults_are_named(text: str, error: type[ServiceError], words: str) -> None:

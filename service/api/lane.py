@@ -34,6 +34,8 @@ __all__ = ["POINTS_PATH", "SmallPointsLane"]
 
 POINTS_PATH = "/v1/analyze/points"
 _HEADERS = [(b"content-type", b"application/json")]
+MAX_LANE_BYTES = 1 << 20
+"""A body larger than this is no small job (1,000 points take ~100 kB): it goes on to FastAPI unparsed here."""
 
 
 def _route_path(scope: Scope) -> str:
@@ -64,12 +66,16 @@ class SmallPointsLane:
             return
         messages: list[Message] = []
         chunks: list[bytes] = []
+        size = 0
         while True:
             message = await receive()
             messages.append(message)
             if message["type"] != "http.request":
                 break  # a disconnect: FastAPI sees it, as it would have
             chunks.append(message.get("body", b""))
+            size += len(chunks[-1])
+            if size > MAX_LANE_BYTES:
+                break  # a large request: the route and the compute pool take it, parsed once
             if not message.get("more_body", False):
                 job = _small_job(b"".join(chunks))
                 if job is not None and await _answered(job, send):

@@ -57,7 +57,8 @@ def _lines(data: bytes) -> list[tuple[int, list[str]]]:
         data = data[3:]
     text = data.decode("utf-8", errors="replace")
     out = []
-    for number, line in enumerate(text.splitlines(), start=1):
+    # lines end at \n, \r\n or \r only: str.splitlines also splits at form feeds and other separators
+    for number, line in enumerate(text.replace("\r\n", "\n").replace("\r", "\n").split("\n"), start=1):
         if "#" in line:
             line = line.split("#", 1)[0]
         tokens = line.split()
@@ -246,7 +247,7 @@ def _faces(lines: list[tuple[int, list[str]]], at: int, n: int, n_vertices: int)
     try:
         idx = np.array(corners, dtype=np.int64)
     except (ValueError, OverflowError):
-        bad = next(c for c in corners if not c.lstrip("-").isdigit())
+        bad = next((c for c in corners if not c.lstrip("-").isdigit() or abs(int(c)) >= 2**63), corners[0])
         raise _fail(f"has {_shown(bad)}, which is not a vertex number, in a face") from None
     if len(idx) and (idx.min() < 0 or idx.max() >= n_vertices):
         k = int(idx.min()) if idx.min() < 0 else int(idx.max())

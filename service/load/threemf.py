@@ -291,9 +291,9 @@ class _Reader:
             pieces = list(self.meshes(path, obj, transform, 0, placed, left_out))
             if placed:
                 notes.append(_rotation_note(name, placed))
-                # as written, a placement M = R (I + E) with |E| about off / 2 scales volumes by det(I + E) and
-                # moments by that times lengths squared: within 3 off of the rotation's numbers
-                assumed[name] = max(assumed.get(name, 0.0), 3 * max(off for off, _ in placed))
+                # as written, a placement M = R (I + E) with entries of E up to about off / 2 scales volumes by
+                # det(I + E) (up to 1.5 off) and lengths by up to 1.5 off: moments within 5 off of the rotation's
+                assumed[name] = max(assumed.get(name, 0.0), 5 * max(off for off, _ in placed))
             if left_out:
                 notes.append(
                     f"3MF object {name!r} has components that are not of type 'model' ({', '.join(left_out[:8])}): "

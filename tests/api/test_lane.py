@@ -19,7 +19,7 @@ from fastapi.testclient import TestClient
 from starlette.responses import Response
 
 from inertia.api import Settings, create_app
-from inertia.api.lane import POINTS_PATH, SmallPointsLane
+from inertia.api.lane import MAX_LANE_BYTES, POINTS_PATH, SmallPointsLane
 
 from .test_points_inline import BODIES, TRIANGLE, _untimed
 
@@ -87,6 +87,14 @@ def test_everything_else_is_left_to_fastapi(
 ) -> None:
     _, _, alone = clients
     assert alone.post(POINTS_PATH, content=body, headers={"content-type": content_type}).status_code == 404
+
+
+def test_a_large_body_is_passed_on_unparsed(clients: tuple[TestClient, TestClient, TestClient]) -> None:
+    # past MAX_LANE_BYTES no job is small: parsing it here would only be done again by the route
+    _, _, alone = clients
+    body = json.dumps({"points": [{"mass": 1.0, "position": [k, 0.5, 0.25]} for k in range(30_000)]}).encode()
+    assert len(body) > MAX_LANE_BYTES
+    assert alone.post(POINTS_PATH, content=body, headers={"content-type": "application/json"}).status_code == 404
 
 
 def test_the_guard_still_stands_in_front(clients: tuple[TestClient, TestClient, TestClient]) -> None:
