@@ -181,7 +181,7 @@ def _orient_outward(
         raise InvalidMeshError(
             f"the mesh's shells cross each other: a shell of {crossing[0]} faces lies partly inside and partly "
             f"outside another (its largest face inside {crossing[1]} other shell(s), one of its vertices inside "
-            f"{crossing[2]}), so it is neither a cavity nor a body of its own and the windings define no volume; "
+            f"{crossing[2]}), so it is neither a cavity nor a body of its own and its winding defines no volume; "
             "join the shells into one closed surface (a boolean union) or send them as separate parts",
             faces=crossing[0],
         )
@@ -322,17 +322,16 @@ _CROSSING_SAMPLES = 24  # vertices of each nested shell tested against the shell
 def _crossing_shell(
     x: NDArray[np.float64], faces: NDArray[np.int64], label: NDArray[np.int64], count: int, depth: NDArray[np.int64]
 ) -> tuple[int, int, int] | None:
-    """A nested shell whose vertices are not all as deep as its test point: (its faces, its depth, a
-    vertex's depth), or None.
+    """A shell whose vertices are not all as deep as its test point: (its faces, its depth, a vertex's depth),
+    or None.
 
-    The depth of a shell comes from one point of it; a shell inside another lies wholly inside only if
-    the two do not cross, which a few of its vertices (its extremes along each axis, and an even
-    spread of the rest) show: a vertex clearly inside a different number of shells means they cross.
-    Vertices on another shell (touching shells) decide nothing.
+    The depth of a shell comes from one point of it; a shell lies wholly inside the shells around it (or
+    wholly outside them) only if it crosses none of them, which a few of its vertices (its extremes along
+    each axis, and an even spread of the rest) show: a vertex clearly inside a different number of shells
+    means they cross. Vertices on another shell (touching shells) decide nothing. Only the shells whose
+    bounding boxes hold such a vertex are evaluated, within the nesting test's work limit (beyond it
+    nothing is refused).
     """
-    nested = np.flatnonzero(depth > 0)
-    if len(nested) == 0:
-        return None
     order = np.argsort(label, kind="stable")
     bounds = np.searchsorted(label[order], np.arange(count + 1))
     lo = np.full((count, 3), np.inf)
@@ -342,24 +341,32 @@ def _crossing_shell(
             coord = x[faces[:, corner], k]
             np.minimum.at(lo[:, k], label, coord)
             np.maximum.at(hi[:, k], label, coord)
-    for t in nested.tolist():
+    sizes = np.diff(bounds)
+    spent = 0
+    for t in range(count):
         used = np.unique(faces[order[bounds[t] : bounds[t + 1]]])
         ends = np.concatenate([used[np.argmin(x[used], axis=0)], used[np.argmax(x[used], axis=0)]])
         spread = used[np.linspace(0, len(used) - 1, min(len(used), _CROSSING_SAMPLES - len(ends))).astype(np.int64)]
         points = x[np.unique(np.concatenate([ends, spread]))]
+        # the shells whose boxes hold each point, all at once (points x shells)
+        near = np.all((lo[None, :, :] <= points[:, None, :]) & (hi[None, :, :] >= points[:, None, :]), axis=2)
+        near[:, t] = False
+        per_shell = near.sum(axis=0)
+        others = np.flatnonzero(per_shell)
+        if len(others) == 0:
+            continue
+        spent += int(per_shell[others] @ sizes[others])
+        if spent > NESTING_WORK_LIMIT:
+            return None
         found = np.zeros(len(points), dtype=np.int64)
         decided = np.ones(len(points), dtype=bool)
-        for other in range(count):
-            if other == t:
-                continue
-            near = np.all(lo[other] <= points, axis=1) & np.all(hi[other] >= points, axis=1)
-            if not np.any(near):
-                continue
-            w = winding_numbers(x, faces[order[bounds[other] : bounds[other + 1]]], points[near])
+        for other in others.tolist():
+            inside = np.flatnonzero(near[:, other])
+            w = winding_numbers(x, faces[order[bounds[other] : bounds[other + 1]]], points[inside])
             clear = np.abs(w - np.round(w)) <= 0.25  # NaN (on the other shell) is not clear
-            decided[np.flatnonzero(near)[~clear]] = False
-            found[np.flatnonzero(near)[clear]] += np.round(w[clear]) != 0
+            decided[inside[~clear]] = False
+            found[inside[clear]] += np.round(w[clear]) != 0
         wrong = decided & (found != depth[t])
         if np.any(wrong):
-            return int(bounds[t + 1] - bounds[t]), int(depth[t]), int(found[np.flatnonzero(wrong)[0]])
+            return int(sizes[t]), int(depth[t]), int(found[np.flatnonzero(wrong)[0]])
     return None

@@ -149,6 +149,15 @@ def test_an_inward_shell_that_crosses_its_outer_shell_is_refused(shift: tuple[fl
         mass_properties(both, density=1.0)
 
 
+def test_an_inward_shell_that_crosses_from_outside_is_refused_too() -> None:
+    # its largest face's centre is outside the box (depth 0: by one point a body of its own), but a corner is in
+    bv, bf = box(1.0, 1.0, 1.0)
+    cv, cf = box(1.1, 0.6, 0.6, origin=(0.6, 0.2, 0.2))
+    body = MeshBody(np.vstack([bv, cv]), np.vstack([bf, cf[:, [0, 2, 1]] + len(bv)]))
+    with pytest.raises(InvalidMeshError, match="shells cross each other"):
+        mass_properties(body, density=1.0)
+
+
 def test_a_cavity_within_its_shell_is_still_a_cavity_when_its_vertices_are_tested() -> None:
     # every vertex of the cavity is inside the box: the crossing test leaves it a cavity
     bv, bf = box(4.0, 4.0, 4.0, origin=(-2.0, -2.0, -2.0))
