@@ -236,6 +236,10 @@ class MotionDiagnosticsSection(Section):
     elapsed_s: float = field(metadata=doc("[s]"))
     energy_drift: float | None = field(default=None, metadata=doc("max |E(t) - E(0)| / E(0) over the trajectory [1]"))
     momentum_drift: float | None = field(default=None, metadata=doc("max |M(t) - M(0)| / |M(0)| over the trajectory [1]"))
+    relative_error_estimate: float | None = field(
+        default=None,
+        metadata=doc("bound on the trajectory's error: omega(t) relative to |omega|, and the attitude quaternion [1]"),
+    )
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)

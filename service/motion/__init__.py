@@ -100,7 +100,7 @@ from ..errors import InvalidParameterError
 from ..principal import PrincipalFrame
 from ..tolerances import DEFAULT_TOLERANCES, Tolerances
 from . import quaternions as quat
-from .accuracy import departure_warning, phase_warnings, unstable_axis_warnings
+from .accuracy import departure, departure_warning, phase_bound, phase_warnings, unstable_axis_warnings
 from .invariants import RigidProblem, invariant_drifts
 from .methods import CAPABILITIES, EXACT_REST, method_for
 from .quantities import precession_quantities
@@ -173,15 +173,19 @@ def predict_motion(
     # a body at rest stays at rest: no method needs to integrate that
     propagator = EXACT_REST if setup.regime is Regime.REST else chosen
     omega_body, attitude = propagator.propagate(setup, times, tolerances)
-    if propagator is not EXACT_REST:  # a numerical method: how far it is from the exact motion
-        exact_omega, _ = EXACT_REST.propagate(setup, times, tolerances)
+    # the trajectory's error bound: the closed forms' phase rounding, and a numerical method's measured departure
+    # from them (of Omega and of the attitude, which the invariant drifts do not see)
+    error = phase_bound(setup, motion, float(times[-1]))
+    if propagator is not EXACT_REST:
+        exact_omega, exact_attitude = EXACT_REST.propagate(setup, times, tolerances)
         speed = float(np.linalg.norm(setup.problem.omega_body))
         notes += departure_warning(chosen.name.value, omega_body, exact_omega, speed)
+        error += departure(omega_body, exact_omega, attitude, exact_attitude, speed)
     motion = replace(motion, warnings=(*motion.warnings, *notes))
     trajectory = _trajectory(setup.problem, times, omega_body, attitude)
     energy_drift, momentum_drift = invariant_drifts(setup.problem, trajectory.omega_body, trajectory.quaternion)
     motion = units.restore(replace(motion, trajectory=trajectory), given_times)
-    diagnostics = MotionDiagnostics(time.perf_counter() - started, energy_drift, momentum_drift)
+    diagnostics = MotionDiagnostics(time.perf_counter() - started, energy_drift, momentum_drift, min(error, 1.0))
     return replace(motion, diagnostics=diagnostics)
 
 

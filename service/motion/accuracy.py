@@ -35,7 +35,9 @@ __all__ = [
     "NUMERICAL_WARN",
     "phase_warnings",
     "unstable_axis_warnings",
+    "departure",
     "departure_warning",
+    "phase_bound",
 ]
 
 Array = NDArray[np.float64]
@@ -75,6 +77,20 @@ def _phase_rate(setup: Setup, motion: FreeMotion) -> tuple[float, float]:
         rates += [top.rate, abs(at_zero), abs(by_reference + (at_zero - by_reference) / (1.0 + top.b))]
         amplitude = max(1.0, float(np.max(top.amplitudes)) / speed)
     return max(rates), amplitude
+
+
+def phase_bound(setup: Setup, motion: FreeMotion, duration: float) -> float:
+    """Bound on the exact method's error of Omega(t) (relative to |Omega|) and of the attitude at ``duration``."""
+    rate, amplitude = _phase_rate(setup, motion)
+    return PHASE_ERROR_PER_RADIAN * (1.0 + rate * duration) * amplitude
+
+
+def departure(omega_body: Array, exact_omega_body: Array, quaternion: Array, exact_quaternion: Array, speed: float) -> float:
+    """A numerical trajectory's largest departure from the exact one: of Omega (relative to |Omega|) and of the
+    attitude (the distance of the unit quaternions, q and -q being one rotation)."""
+    omega = float(np.max(np.abs(omega_body - exact_omega_body))) / speed if speed > 0 else 0.0
+    apart = np.minimum(np.linalg.norm(quaternion - exact_quaternion, axis=1), np.linalg.norm(quaternion + exact_quaternion, axis=1))
+    return max(omega, float(np.max(apart)) if len(apart) else 0.0)
 
 
 def phase_warnings(setup: Setup, motion: FreeMotion, duration: float) -> tuple[str, ...]:

@@ -63,15 +63,23 @@ class MotionDiagnostics:
     energy_drift : max over samples of |E(t) - E(0)| / E(0) (None without a trajectory).
     momentum_drift : max over samples of |M(t) - M(0)| / |M(0)|, M in the input
         frame reconstructed from the reported quaternion and omega_body.
+    relative_error_estimate : bound on the trajectory's error, of Omega(t) relative
+        to |Omega| and of the attitude quaternion: the closed forms' phase rounding,
+        plus a numerical method's measured departure from them (None without a
+        trajectory). The drifts cannot see a trajectory at the wrong place on its orbit.
     """
 
     elapsed_s: float
     energy_drift: float | None = None
     momentum_drift: float | None = None
+    relative_error_estimate: float | None = None
 
     def section(self) -> MotionDiagnosticsSection:
         return MotionDiagnosticsSection(
-            elapsed_s=self.elapsed_s, energy_drift=self.energy_drift, momentum_drift=self.momentum_drift
+            elapsed_s=self.elapsed_s,
+            energy_drift=self.energy_drift,
+            momentum_drift=self.momentum_drift,
+            relative_error_estimate=self.relative_error_estimate,
         )
 
     def as_dict(self) -> dict[str, Any]:

@@ -161,7 +161,7 @@ def test_as_dict_is_json_and_has_a_trajectory_only_when_asked() -> None:
     with_traj = _predict((1.0, 2.0, 3.0), (0.3, 0.2, 1.0), duration=10.0, samples=5).as_dict()
     text = json.dumps(with_traj, allow_nan=False)
     assert set(json.loads(text)["trajectory"]) == {"t", "omega_body", "omega", "quaternion"}
-    assert set(with_traj["diagnostics"]) == {"elapsed_s", "energy_drift", "momentum_drift"}
+    assert set(with_traj["diagnostics"]) == {"elapsed_s", "energy_drift", "momentum_drift", "relative_error_estimate"}
     without = _predict((1.0, 2.0, 3.0), (0.3, 0.2, 1.0)).as_dict()
     assert "trajectory" not in without and set(without["diagnostics"]) == {"elapsed_s"}
 
