@@ -273,13 +273,7 @@ def _nesting_depth(
     A shell's test point is the centroid of its largest triangle; only shells
     whose bounding box holds that point are evaluated.
     """
-    lo = np.full((count, 3), np.inf)
-    hi = np.full((count, 3), -np.inf)
-    for k in range(3):
-        for corner in range(3):
-            coord = x[faces[:, corner], k]
-            np.minimum.at(lo[:, k], label, coord)
-            np.maximum.at(hi[:, k], label, coord)
+    lo, hi = _shell_boxes(x, faces, label, count)
     tri = x[faces]
     area = np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]), axis=1)
     by_shell = np.lexsort((-area, label))  # per shell, its faces from the largest down
@@ -315,6 +309,20 @@ def _nesting_depth(
     return "shells touch or overlap"
 
 
+def _shell_boxes(
+    x: NDArray[np.float64], faces: NDArray[np.int64], label: NDArray[np.int64], count: int
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Each shell's bounding box: (count, 3) lower and upper corners."""
+    lo = np.full((count, 3), np.inf)
+    hi = np.full((count, 3), -np.inf)
+    for k in range(3):
+        for corner in range(3):
+            coord = x[faces[:, corner], k]
+            np.minimum.at(lo[:, k], label, coord)
+            np.maximum.at(hi[:, k], label, coord)
+    return lo, hi
+
+
 _NESTING_ATTEMPTS = 4
 _CROSSING_SAMPLES = 24  # vertices of each nested shell tested against the shells around it
 
@@ -334,13 +342,7 @@ def _crossing_shell(
     """
     order = np.argsort(label, kind="stable")
     bounds = np.searchsorted(label[order], np.arange(count + 1))
-    lo = np.full((count, 3), np.inf)
-    hi = np.full((count, 3), -np.inf)
-    for k in range(3):
-        for corner in range(3):
-            coord = x[faces[:, corner], k]
-            np.minimum.at(lo[:, k], label, coord)
-            np.maximum.at(hi[:, k], label, coord)
+    lo, hi = _shell_boxes(x, faces, label, count)
     sizes = np.diff(bounds)
     spent = 0
     for t in range(count):
