@@ -137,13 +137,17 @@ def _count(words: list[tuple[int, str]], i: int, lines: list[tuple[int, list[str
     if i >= len(words):
         raise _fail(f"ends before its {what}")
     k, token = words[i]
-    line_no = lines[k][0]
+    return _natural(token, lines[k][0], f"its {what}")
+
+
+def _natural(token: str, line_no: int, what: str) -> int:
+    """A count of the file, ``what`` it is named in a message."""
     try:
         value = int(token)
     except ValueError:
-        raise _fail(f"has {_shown(token)} where its {what} belongs", line_no) from None
+        raise _fail(f"has {_shown(token)} where {what} belongs", line_no) from None
     if value < 0:
-        raise _fail(f"gives a negative {what} ({value})", line_no)
+        raise _fail(f"gives {what} as {value}, a negative number", line_no)
     return value
 
 
@@ -201,16 +205,6 @@ def _by_number(
     return block[:, :coordinates], at
 
 
-def _corner_count(token: str, line_no: int) -> int:
-    try:
-        value = int(token)
-    except ValueError:
-        raise _fail(f"has {_shown(token)} where a face's number of corners belongs", line_no) from None
-    if value < 0:
-        raise _fail(f"gives a face a negative number of corners ({value})", line_no)
-    return value
-
-
 def _numbers(tokens: list[str], line_no: int | None) -> list[float]:
     out = []
     for token in tokens:
@@ -234,7 +228,7 @@ def _faces(lines: list[tuple[int, list[str]]], at: int, n: int, n_vertices: int)
             raise _fail(f"ends after {len(counts)} of its {n} faces", lines[-1][0])
         line_no, tokens = lines[at]
         at += 1
-        size = _corner_count(tokens[0], line_no)
+        size = _natural(tokens[0], line_no, "a face's number of corners")
         taken = tokens[1 : 1 + size]
         while len(taken) < size:  # the vertex numbers go on on the next line
             if at >= len(lines):
