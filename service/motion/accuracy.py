@@ -95,9 +95,8 @@ def departure(omega_body: Array, exact_omega_body: Array, quaternion: Array, exa
 
 def phase_warnings(setup: Setup, motion: FreeMotion, duration: float) -> tuple[str, ...]:
     """Warn, or refuse (``MotionError``), when the phase error at ``duration`` (computation units) is large."""
-    rate, amplitude = _phase_rate(setup, motion)
-    turned = rate * duration
-    bound = PHASE_ERROR_PER_RADIAN * (1.0 + turned) * amplitude
+    turned = _phase_rate(setup, motion)[0] * duration
+    bound = phase_bound(setup, motion, duration)
     if bound >= PHASE_REFUSE:
         raise MotionError(
             f"over this duration the motion turns through about {turned:.2g} rad, and float64 cannot place "
