@@ -15,9 +15,9 @@ from numpy.typing import NDArray
 
 from .blocks import for_each_block
 
-__all__ = ["two_sum", "two_prod", "rotated"]
+__all__ = ["SPLIT", "rotated", "two_prod", "two_sum"]
 
-_SPLIT = 134217729.0  # 2^27 + 1, Dekker's splitting constant for float64
+SPLIT = 134217729.0  # 2^27 + 1, Dekker's splitting constant for float64
 
 # The same operations on Python floats (the small point-set path) or on arrays
 Real = TypeVar("Real", float, NDArray[np.float64])
@@ -31,10 +31,10 @@ def two_sum(a: NDArray[np.float64], b: NDArray[np.float64]) -> tuple[NDArray[np.
 
 def two_prod(a: Real | float, b: Real) -> tuple[Real, Real]:
     p = a * b
-    ca = _SPLIT * a
+    ca = SPLIT * a
     ah = ca - (ca - a)
     al = a - ah
-    cb = _SPLIT * b
+    cb = SPLIT * b
     bh = cb - (cb - b)
     bl = b - bh
     return p, ((ah * bh - p) + ah * bl + al * bh) + al * bl  # Dekker 1971

@@ -18,7 +18,7 @@ from numpy.typing import NDArray
 
 from .tolerances import DEFAULT_TOLERANCES, Tolerances
 
-__all__ = ["jacobi_eigh"]
+__all__ = ["jacobi_eigh", "jacobi_lists"]
 
 _PAIRS = ((0, 1), (0, 2), (1, 2))
 
@@ -34,7 +34,12 @@ def jacobi_eigh(
     a_pp - t a_pq, a_qq + t a_pq, which change a diagonal entry by exactly the
     amount the rotation moves between the two.
     """
-    m = np.asarray(matrix, dtype=np.float64).tolist()
+    values, v = jacobi_lists(np.asarray(matrix, dtype=np.float64).tolist(), tolerances)
+    return np.array(values), np.array(v).T.copy()
+
+
+def jacobi_lists(m: list[list[float]], tolerances: Tolerances = DEFAULT_TOLERANCES) -> tuple[list[float], list[list[float]]]:
+    """``jacobi_eigh`` on Python floats: the eigenvalues, and the eigenvectors as the *columns* of ``v``."""
     # Python floats: the same IEEE binary64 operations as numpy's, without its overhead per call on a 3x3.
     # Symmetrised without overflow: an entry equal to its mirror stays itself (even above 9e307, where x + x
     # is inf); otherwise 0.5 x + 0.5 y is the rounded mean, as 0.5 (x + y) is wherever that does not overflow
@@ -48,8 +53,7 @@ def jacobi_eigh(
             break
         for p, q in _PAIRS:
             _rotate(a, v, p, q)
-    values = [math.ldexp(a[i][i], exponent) for i in range(3)]
-    return np.array(values), np.array(v).T.copy()
+    return [math.ldexp(a[i][i], exponent) for i in range(3)], v
 
 
 # The negligibility test multiplies two diagonal entries: entries beyond 2**±480 would overflow to inf (every

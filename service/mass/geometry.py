@@ -50,6 +50,13 @@ class Geometry:
         self.blocks = blocks  # volume cells other than linear tetrahedra: (type, nodes, weight), by quadrature
         self._small: tuple[list[float], list[list[float]]] | None = None  # a small point set as Python floats
 
+    def small_lists(self) -> tuple[list[float], list[list[float]]]:
+        """A point set's masses and points as Python floats (made once)."""
+        if self._small is None:
+            assert self.weight is not None
+            self._small = (self.weight.tolist(), self.points.tolist())
+        return self._small
+
     @property
     def referenced_points(self) -> int:
         return len(self.points)
@@ -62,10 +69,7 @@ class Geometry:
     def sums(self, origin: NDArray[np.float64], rotation: NDArray[np.float64] | None) -> Sums:
         """The integrals about ``origin`` in the frame ``rotation`` (columns), or raise on overflow."""
         if self.kind == "points" and len(self.points) <= small_points.SMALL_POINTS:  # the same sums without numpy's overheads
-            assert self.weight is not None
-            if self._small is None:
-                self._small = (self.weight.tolist(), self.points.tolist())
-            found = small_points.small_point_sums(*self._small, origin, rotation)
+            found = small_points.small_point_sums(*self.small_lists(), origin, rotation)
             if found is None:
                 raise InvalidParameterError(_OVERFLOW)
             return found

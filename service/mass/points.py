@@ -24,10 +24,10 @@ import math
 import numpy as np
 from numpy.typing import NDArray
 
-from ..ddouble import two_prod
+from ..ddouble import SPLIT
 from ..integrals import IJ, Sums
 
-__all__ = ["SMALL_POINTS", "small_point_sums"]
+__all__ = ["SMALL_POINTS", "Moments", "as_sums", "point_moments", "small_point_sums"]
 
 SMALL_POINTS = 16
 """Point sets up to this size are summed here (numpy wins above a few dozen points)."""
@@ -64,55 +64,95 @@ def _shifted(points: list[list[float]], origin: list[float]) -> list[list[float]
 
 
 def _rotated(points: list[list[float]], origin: list[float], rotation: list[list[float]]) -> list[list[float]]:
-    """``ddouble.rotated``: (points - origin) @ rotation, each coordinate rounded once from double-double."""
+    """``ddouble.rotated``: (points - origin) @ rotation, each coordinate rounded once from double-double.
+
+    ``ddouble.two_prod`` is written out in place (Dekker's TwoProduct, the same operations): a call per
+    product would cost more than the product.
+    """
+    split = SPLIT
     neg = [-origin[0], -origin[1], -origin[2]]
+    # the rotation's entries split once (Dekker): r, its high and low halves
+    parts: list[list[tuple[float, float, float]]] = []
+    for i in range(3):
+        halves = []
+        for j in range(3):
+            r = rotation[i][j]
+            cr = split * r
+            rh = cr - (cr - r)
+            halves.append((r, rh, r - rh))
+        parts.append(halves)
     out = []
     for p in points:
         d_hi = [0.0, 0.0, 0.0]
         d_lo = [0.0, 0.0, 0.0]
+        d_split = [(0.0, 0.0)] * 3
         for i in range(3):
             a, b = p[i], neg[i]
             s = a + b
             bb = s - a
             d_hi[i] = s
             d_lo[i] = (a - (s - bb)) + (b - bb)
+            cs = split * s
+            sh = cs - (cs - s)
+            d_split[i] = (sh, s - sh)
         row = []
         for j in range(3):
-            hi, lo = two_prod(rotation[0][j], d_hi[0])
-            lo = lo + rotation[0][j] * d_lo[0]
+            r, rh, rl = parts[0][j]
+            d = d_hi[0]
+            dh, dl = d_split[0]
+            hi = r * d
+            lo = ((rh * dh - hi) + rh * dl + rl * dh) + rl * dl
+            lo = lo + r * d_lo[0]
             for i in (1, 2):
-                q, e = two_prod(rotation[i][j], d_hi[i])
+                r, rh, rl = parts[i][j]
+                d = d_hi[i]
+                dh, dl = d_split[i]
+                q = r * d
+                e = ((rh * dh - q) + rh * dl + rl * dh) + rl * dl
                 s = hi + q
                 bb = s - hi
                 e2 = (hi - (s - bb)) + (q - bb)
                 hi = s
-                lo = lo + (e + e2 + rotation[i][j] * d_lo[i])
+                lo = lo + (e + e2 + r * d_lo[i])
             row.append(hi + lo)
         out.append(row)
     return out
+
+
+Moments = tuple[list[float], list[list[float]], list[float], float]
+"""m1, m2, the m2 diagonal summed as ``m (x x)``, and the total mass."""
+
+
+def point_moments(
+    masses: list[float], points: list[list[float]], origin: list[float], rotation: list[list[float]] | None
+) -> Moments | None:
+    """The point sums about ``origin`` in the frame ``rotation`` as Python floats: m1, m2, the m2
+    diagonal's terms summed as ``m (x x)`` (the error scale), and the total mass; None if not finite."""
+    x = _shifted(points, origin) if rotation is None else _rotated(points, origin, rotation)
+    # under eight points numpy's pairwise sum is a plain one from 0.0: every sum in one loop
+    found = _short_sums(masses, x) if len(masses) < 8 else _long_sums(masses, x)
+    m1, m2, diag, total = found
+    if not all(math.isfinite(v) for v in (*m1, *m2[0], *m2[1], *m2[2], *diag, total)):
+        return None
+    return found
 
 
 def small_point_sums(
     masses: list[float], points: list[list[float]], origin: NDArray[np.float64], rotation: NDArray[np.float64] | None
 ) -> Sums | None:
     """``integrals.point_sums`` of the points about ``origin`` in the frame ``rotation``; None if not finite."""
-    o = origin.tolist()
-    x = _shifted(points, o) if rotation is None else _rotated(points, o, rotation.tolist())
-    if len(masses) < 8:  # numpy's pairwise sum is then a plain one from 0.0: every sum in one loop
-        m1, m2, diag, total = _short_sums(masses, x)
-    else:
-        m1, m2, diag, total = _long_sums(masses, x)
-    if not all(math.isfinite(v) for v in (*m1, *m2[0], *m2[1], *m2[2], *diag, total)):
-        return None
+    found = point_moments(masses, points, origin.tolist(), None if rotation is None else rotation.tolist())
+    return None if found is None else as_sums(found, len(masses))
+
+
+def as_sums(found: Moments, n: int) -> Sums:
+    """``point_moments``' lists as ``integrals.point_sums`` returns them."""
+    m1, m2, diag, total = found
     m2_array = np.array(m2)
-    n = len(masses)
     return Sums(total, np.array(m1), m2_array, total, np.abs(m2_array), 0.0, np.array(diag), float(n), n, 1)
 
 
-_Moments = tuple[list[float], list[list[float]], list[float], float]
-
-
-def _short_sums(masses: list[float], x: list[list[float]]) -> _Moments:
+def _short_sums(masses: list[float], x: list[list[float]]) -> Moments:
     """The sums of fewer than eight points, each accumulated in point order from 0.0 (``_pairwise``)."""
     a0 = a1 = a2 = s00 = s11 = s22 = s01 = s02 = s12 = d0 = d1 = d2 = total = 0.0
     for m, (x0, x1, x2) in zip(masses, x):
@@ -133,7 +173,7 @@ def _short_sums(masses: list[float], x: list[list[float]]) -> _Moments:
     return [a0, a1, a2], [[s00, s01, s02], [s01, s11, s12], [s02, s12, s22]], [d0, d1, d2], total
 
 
-def _long_sums(masses: list[float], x: list[list[float]]) -> _Moments:
+def _long_sums(masses: list[float], x: list[list[float]]) -> Moments:
     m1 = [0.0, 0.0, 0.0]
     for m, xi in zip(masses, x):
         m1[0] += m * xi[0]

@@ -30,11 +30,12 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..blocks import for_each_block
-from ..eigen import jacobi_eigh
+from ..eigen import jacobi_eigh, jacobi_lists
 from ..errors import InsufficientPrecisionError, ZeroVolumeError
 from ..integrals import Sums, local_origin, point_records
 from ..surface import twice_areas
 from ..tolerances import EPS, Tolerances
+from . import points as small_points
 from .geometry import Geometry
 
 __all__ = ["FRAME_SETTLED", "MAX_PASSES", "Refined", "refine"]
@@ -81,6 +82,10 @@ class Refined:
 
 def refine(geometry: Geometry, tolerances: Tolerances) -> Refined:
     """Multi-pass integration: a coarse pass, then passes in the principal frame until it settles."""
+    if geometry.kind == "points" and len(geometry.points) <= small_points.SMALL_POINTS:
+        found = _refine_few_points(geometry, tolerances)
+        if found is not None:
+            return found
     origin = local_origin(geometry.points)
     s = geometry.sums(origin, None)
     _check_volume(s, geometry.kind)
@@ -95,7 +100,7 @@ def refine(geometry: Geometry, tolerances: Tolerances) -> Refined:
         tensor_body = _inertia_from_covariance(cov_body)
         values, v_body = jacobi_eigh(tensor_body, tolerances)
         com = com + rotation @ c_body
-        settled = _offdiagonal_ratio(tensor_body) <= FRAME_SETTLED
+        settled = _offdiagonal_ratio(tensor_body.tolist()) <= FRAME_SETTLED
         top = float(np.abs(values).max())
         step = float(np.max(np.abs(values - previous)) / top) if top > 0 else 0.0
         rotation = rotation @ v_body.T
@@ -103,8 +108,21 @@ def refine(geometry: Geometry, tolerances: Tolerances) -> Refined:
         if settled:
             break
     _check_volume(s, geometry.kind)
+    return _finished(geometry, s, com, rotation, values, None if settled else step)
+
+
+def _finished(
+    geometry: Geometry,
+    s: Sums,
+    com: NDArray[np.float64],
+    rotation: NDArray[np.float64],
+    values: NDArray[np.float64],
+    step: float | None,
+) -> Refined:
+    """The final pass's error bound (at least the last ``step`` where the frame did not settle), the
+    moments' checks, and the tensor in the input frame."""
     estimate, errors = _error_estimate(s, values)
-    if not settled:
+    if step is not None:
         estimate = max(estimate, step)
     values, warnings = _physical_moments(geometry, values, errors)
     if geometry.kind == "apex":
@@ -112,6 +130,60 @@ def refine(geometry: Geometry, tolerances: Tolerances) -> Refined:
     tensor = rotation @ np.diag(values) @ rotation.T
     tensor = 0.5 * (tensor + tensor.T)
     return Refined(s, com, tensor, values, rotation.T.copy(), estimate, warnings)
+
+
+def _list_tensor(found: small_points.Moments) -> tuple[list[float], list[list[float]]]:
+    """``_covariance`` then ``_inertia_from_covariance`` on Python floats, the same operations."""
+    m1, m2, _, total = found
+    c = [m1[0] / total, m1[1] / total, m1[2] / total]
+    cov = [[m2[i][j] - total * (c[i] * c[j]) for j in range(3)] for i in range(3)]
+    tensor = [[-x for x in row] for row in cov]
+    for i in range(3):
+        j, k = (i + 1) % 3, (i + 2) % 3
+        tensor[i][i] = cov[j][j] + cov[k][k]
+    return c, tensor
+
+
+def _refine_few_points(geometry: Geometry, tolerances: Tolerances) -> Refined | None:
+    """``refine`` for a few point masses, bit for bit, on Python floats.
+
+    A handful of points is a few dozen flops per pass; numpy's fixed cost per call (and the ``Sums``
+    of every pass) was most of the time.  The operations and their order are ``refine``'s: the
+    sums are ``points.point_moments``, the eigen-kernel ``jacobi_lists``; the 3 x 3 products stay
+    numpy's (its BLAS may fuse their multiply-adds).  None where a number is not finite: ``refine``
+    then decides, with its own errors.
+    """
+    masses, points = geometry.small_lists()
+    origin = [lo + 0.5 * (hi - lo) for lo, hi in ((min(column), max(column)) for column in zip(*points))]
+    found = small_points.point_moments(masses, points, origin, None)
+    if found is None:
+        return None
+    c, tensor = _list_tensor(found)
+    values, v = jacobi_lists(tensor, tolerances)
+    rotation = np.asfortranarray(v)  # columns: axes in the input frame, laid out as ``refine``'s vectors.T
+    com = np.array([o + x for o, x in zip(origin, c)])
+    previous = values
+    step = None
+    for _ in range(MAX_PASSES - 1):
+        found = small_points.point_moments(masses, points, com.tolist(), v)
+        if found is None:
+            return None
+        c_body, tensor_body = _list_tensor(found)
+        values, v_body = jacobi_lists(tensor_body, tolerances)
+        if not all(map(math.isfinite, values)):
+            return None
+        com = com + rotation @ np.array(c_body)
+        settled = _offdiagonal_ratio(tensor_body) <= FRAME_SETTLED
+        top = max(map(abs, values))
+        moved = max(abs(a - b) for a, b in zip(values, previous))
+        step = moved / top if top > 0 else 0.0
+        rotation = rotation @ np.asfortranarray(v_body)  # the strides of ``refine``'s v_body.T: the same BLAS kernel
+        v = rotation.tolist()
+        previous = values
+        if settled:
+            step = None
+            break
+    return _finished(geometry, small_points.as_sums(found, len(masses)), com, rotation, np.array(values), step)
 
 
 def _physical_moments(
@@ -237,16 +309,16 @@ def _check_resolution(
 _TINY = float(np.finfo(np.float64).tiny)
 
 
-def _offdiagonal_ratio(t: NDArray[np.float64]) -> float:
+def _offdiagonal_ratio(t: list[list[float]]) -> float:
     worst = 0.0
     for i, j in ((0, 1), (0, 2), (1, 2)):
-        product = abs(float(t[i, i]) * float(t[j, j]))  # Python floats: an overflow is inf, without a warning
+        product = abs(t[i][i] * t[j][j])  # Python floats: an overflow is inf, without a warning
         if math.isfinite(product) and product >= _TINY:
             scale = math.sqrt(product)
         else:  # beyond ~1e154 or below ~1e-154 the product leaves float64's range; the root of each does not
-            scale = math.sqrt(abs(float(t[i, i]))) * math.sqrt(abs(float(t[j, j])))
-        if t[i, j] != 0.0:
-            worst = max(worst, abs(t[i, j]) / scale if scale > 0 else math.inf)
+            scale = math.sqrt(abs(t[i][i])) * math.sqrt(abs(t[j][j]))
+        if t[i][j] != 0.0:
+            worst = max(worst, abs(t[i][j]) / scale if scale > 0 else math.inf)
     return worst
 
 
