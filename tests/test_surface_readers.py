@@ -98,6 +98,8 @@ TET_VERTICES = "0 0 0\n1 0 0\n0 1 0\n0 0 1\n"
         f"nOFF\n3\n4 4 6\n{TET_VERTICES}{TET_FACES}",
         f"OFF\n4 4 6\n0 0 0 1 0\n0\n0 1 0 0\n0 1\n{TET_FACES}",  # vertices over line breaks
         f"OFF\n4 4 6\n0 0 0 1 0 0\n0 1 0\n0 0 1\n{TET_FACES}",  # two vertices on one line
+        f"OFF\n4 4\n6\n{TET_VERTICES}{TET_FACES}",  # NEdges on a line of its own
+        f"OFF\n4\n4\n6\n{TET_VERTICES}{TET_FACES}",  # every count on a line of its own
         f"OFF\n4 4 6\n{TET_VERTICES}3 0 2\n1 0.5 0.5 0.5\n3 0 1 3 7\n3\n0 3 2\n3 1 2 3\n",  # faces over lines
         f"NOFF\n4 4 6\n{TET_VERTICES.replace(chr(10), ' 0 0 1' + chr(10))}{TET_FACES}",
         f"appearance {{\n +texturing\n texture {{ file grid.pgm }}\n}}\nOFF\n4 4 6\n{TET_VERTICES}{TET_FACES}",

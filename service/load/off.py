@@ -118,6 +118,8 @@ def read_off(data: bytes) -> tuple[NDArray[np.float64], NDArray[np.int64], list[
             f"the OFF file declares {n_vertices} vertices and {n_faces} faces; a solid needs both", format="off"
         )
     at = words[i + 1][0] + 1  # the vertices start on the line after the counts (NEdges, if there, ends it)
+    if _edges_alone(words, i, lines, at):
+        at += 1  # "NVertices NFaces", then NEdges on a line of its own: the header's third number, as Geomview reads it
     coordinates = 3 + homogeneous
     vertices, corners, counts = _geometry(lines, at, n_vertices, n_faces, coordinates, per_vertex)
     if homogeneous:
@@ -130,6 +132,19 @@ def read_off(data: bytes) -> tuple[NDArray[np.float64], NDArray[np.int64], list[
         raise EmptyGeometryError("the OFF file's faces have fewer than three corners each; a solid needs polygons", format="off")
     note = fan_split_note(vertices, corners, counts, "off")
     return vertices, triangles, [note] if note else []
+
+
+def _edges_alone(words: list[tuple[int, str]], i: int, lines: list[tuple[int, list[str]]], at: int) -> bool:
+    """The line after a counts line without NEdges holds one whole number and nothing else: NEdges.
+
+    Geomview reads the header as numbers in order, so the count of edges may sit on its own line; no
+    vertex line holds a single whole number (three coordinates at least, unless a vertex runs over
+    lines, which no writer we know of does in its first line).
+    """
+    if (i + 2 < len(words) and words[i + 2][0] == words[i + 1][0]) or at >= len(lines):
+        return False  # NEdges is on the counts' line
+    tokens = lines[at][1]
+    return len(tokens) == 1 and tokens[0].isdigit()
 
 
 def _count(words: list[tuple[int, str]], i: int, lines: list[tuple[int, list[str]]], what: str) -> int:
