@@ -78,6 +78,31 @@ def test_the_part_collapses_within_the_range() -> None:
     assert refused and refused == list(range(refused[0], refused[-1] + 1)) and refused[0] <= 7
 
 
+@pytest.mark.parametrize("offset", [1e3, 1e5, 1e6, 4e6])
+def test_float32_part_on_whole_units_far_away_is_exact_without_a_warning(offset: float) -> None:
+    """A box from offset to offset + (1, 2, 3), stored exactly in float32 (steps of 1/4 at 4e6): the polyhedron
+    read is the part (API.md: "exactly the polyhedron that was read ... float32 for binary STL")."""
+    corners, faces = box(1.0, 2.0, 3.0)
+    vertices = corners - corners.min(axis=0) + offset
+    assert np.array_equal(vertices.astype(np.float32), vertices)
+    for data, name in ((stl_bytes(vertices, faces), "part.stl"), (_ascii_stl(vertices, faces), "part_ascii.stl")):
+        result = analyze(data, filename=name)
+        # mass 1000 * 6; I = m (b^2 + c^2) / 12 and its cyclic companions
+        assert result.props.mass == pytest.approx(6000.0, rel=1e-15)
+        assert np.sort(result.props.principal_moments) == pytest.approx([2500.0, 5000.0, 6500.0], rel=1e-14)
+        assert not any("float32" in w for w in result.warnings), result.warnings
+
+
+def _ascii_stl(vertices: np.ndarray, faces: np.ndarray) -> bytes:
+    facets = "".join(
+        "facet normal 0 0 0\nouter loop\n"
+        + "".join(f"vertex {float(x)!r} {float(y)!r} {float(z)!r}\n" for x, y, z in vertices[f])
+        + "endloop\nendfacet\n"
+        for f in faces
+    )
+    return f"solid part\n{facets}endsolid part\n".encode()
+
+
 def test_zero_volume_float32_shells_are_refused_not_flipped_into_a_body() -> None:
     vertices, faces = flat_shells(1e4)
     with pytest.raises(InsufficientPrecisionError, match="float32"):

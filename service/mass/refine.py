@@ -281,6 +281,8 @@ def _check_resolution(
     if not ratio >= _RESOLUTION_WARN:
         return ()
     float32 = geometry.coordinate_eps >= 2.0**-24
+    if float32 and _on_coarse_grid(x, geometry.coordinate_eps):
+        return ()  # the stored values are the exporter's own: the polyhedron read is the part
     cause = (
         f"the file's float32 coordinates, {float(np.abs(x).max()):.3g} units from the origin, are resolved "
         f"only to {delta:.3g} units"
@@ -304,6 +306,37 @@ def _check_resolution(
         f"{cause}: the stored polyhedron is integrated exactly, but it may differ from the exported part by up "
         f"to {ratio:.2g} of its volume or a principal moment; export in float64 or nearer the origin to avoid it",
     )
+
+
+_GRID_EVIDENCE_BITS = 12
+"""Bits of chance (one in 4,096) against rounded coordinates all falling on ``_on_coarse_grid``'s grid."""
+
+
+def _on_coarse_grid(x: NDArray[np.float64], eps: float) -> bool:
+    """The coordinates evidently were not rounded to their storage: they lie on a grid coarser than it.
+
+    The resolution check assumes each stored coordinate was rounded from the exporter's value.  A
+    part drawn on whole units (a box from 1,000,000 to 1,000,003 in float32, whose step there is
+    1/16) uses fewer bits than its storage has: those values were stored exactly, the polyhedron
+    read is the part, and its numbers are exact (API.md: "exactly the polyhedron that was read").
+    A rounded value falls on a grid of 2**j storage steps once in 2**j, so each distinct value of
+    a coordinate on it is j bits of evidence; ``_GRID_EVIDENCE_BITS`` of them decide.  Dividing by a
+    power of two is exact, so the test is too.
+    """
+    largest = float(np.abs(x).max())
+    if largest == 0.0:
+        return False
+    step = math.ldexp(eps, math.frexp(largest)[1])  # largest < 2^e, where a stored step is eps 2^e
+    scaled = x / step
+    if not np.all(scaled == np.floor(scaled)):
+        return False  # a value finer than the largest one's step: nothing coarser to go by
+    whole = scaled.astype(np.int64)  # |scaled| <= 1 / eps: exact
+    nonzero = whole[whole != 0]
+    if len(nonzero) == 0:
+        return False
+    j = int(np.min(nonzero & -nonzero)).bit_length() - 1  # trailing zero bits common to every value
+    distinct = sum(len(np.unique(column[column != 0])) for column in whole.T)
+    return j * distinct >= _GRID_EVIDENCE_BITS
 
 
 _TINY = float(np.finfo(np.float64).tiny)
