@@ -32,7 +32,9 @@ service's own error escapes.
 from __future__ import annotations
 
 import argparse
+import functools
 import io
+import itertools
 import json
 from dataclasses import dataclass
 from pathlib import Path
@@ -179,8 +181,19 @@ def reference(path: Path, rel: str, companions: tuple[str, ...]) -> tuple[float,
     scene = trimesh.load_scene(io.BytesIO(path.read_bytes()), file_type=ext, process=False, **kwargs)
     skip = _NOT_WEIGHED.get(rel, ())
     verts, faces, offset = [], [], 0
+    edges, root = scene.graph.transforms, scene.graph.base_frame
     for node in scene.graph.nodes_geometry:
-        transform, name = scene.graph[node]
+        if ext in ("gltf", "glb"):
+            # the edges' matrices multiplied from the root, as glTF composes nodes: trimesh's graph[node] snaps a
+            # world matrix within 1e-5 of a rotation to it and drops edges within 1e-8 of the identity (a 3MF
+            # rotation written to few digits is snapped by our reader too, with a warning)
+            chain: list[Any] = edges.shortest_path(root, node)
+            transform = functools.reduce(
+                np.matmul, (edges.edge_data[pair].get("matrix", np.eye(4)) for pair in itertools.pairwise(chain)), np.eye(4)
+            )
+            name = edges.node_data[node]["geometry"]
+        else:
+            transform, name = scene.graph[node]
         geom = scene.geometry[name]
         if not isinstance(geom, trimesh.Trimesh) or any(str(name).endswith(s) or str(node) == s for s in skip):
             continue

@@ -521,6 +521,74 @@ def test_gltf_mirrored_node_is_read_outward() -> None:
     assert not any("winding" in w for w in res["warnings"])
 
 
+def _mesh_node(doc: dict[str, Any]) -> dict[str, Any]:
+    node = next(n for n in doc["nodes"] if "mesh" in n)
+    node.pop("matrix", None)
+    return cast("dict[str, Any]", node)
+
+
+@pytest.mark.parametrize("scale", [1.000004, 1 + 2e-9, 0.9999999])
+def test_gltf_node_scale_near_one_is_applied(scale: float) -> None:
+    # trimesh's scene graph snaps a world matrix within 1e-5 of a rotation to that rotation and drops one
+    # within 1e-8 of the identity; glTF applies the scale: the 1 x 2 x 3 box's volume is 6 s^3
+    doc = gltf_box_doc()
+    _mesh_node(doc)["scale"] = [scale, scale, scale]
+    res = analyze(json.dumps(doc).encode(), filename="scaled.gltf", options=AnalysisOptions(density=1.0)).as_dict()
+    assert res["mass"] == pytest.approx(6 * scale**3, rel=1e-14)
+    np.testing.assert_allclose(res["center_of_mass"], np.array([0.5, 1.0, 1.5]) * scale, rtol=1e-14)
+
+
+def test_gltf_camera_nodes_keep_their_meshes_and_children() -> None:
+    # a camera on the node that holds the box, and on a parent moving a second box by (10, 0, 0): glTF places
+    # both (a node may hold a camera, a mesh and children); trimesh's reader skips a camera node and its subtree
+    doc = gltf_box_doc()
+    node = _mesh_node(doc)
+    node["camera"] = 0
+    doc["cameras"] = [{"type": "perspective", "perspective": {"yfov": 0.8, "znear": 0.1}}]
+    doc["nodes"].append({"camera": 0, "translation": [10.0, 0.0, 0.0], "children": [len(doc["nodes"]) + 1]})
+    doc["nodes"].append({"mesh": node["mesh"]})
+    doc["scenes"][doc.get("scene", 0)]["nodes"].append(len(doc["nodes"]) - 2)
+    res = analyze(json.dumps(doc).encode(), filename="cameras.gltf", options=AnalysisOptions(density=1.0)).as_dict()
+    assert res["mass"] == pytest.approx(12.0, rel=1e-14)
+    np.testing.assert_allclose(res["center_of_mass"], [5.5, 1.0, 1.5], rtol=1e-14)
+
+
+def _with_morph_target(doc: dict[str, Any]) -> None:
+    """A morph target on the box that moves every corner by (0, 0, 1): weighed, the box moves by w."""
+    prim = doc["meshes"][0]["primitives"][0]
+    count = doc["accessors"][prim["attributes"]["POSITION"]]["count"]
+    moved = np.tile(np.array([0.0, 0.0, 1.0], dtype="<f4"), (count, 1)).tobytes()
+    doc["buffers"].append(
+        {"byteLength": len(moved), "uri": "data:application/octet-stream;base64," + base64.b64encode(moved).decode()}
+    )
+    doc["bufferViews"].append({"buffer": len(doc["buffers"]) - 1, "byteLength": len(moved)})
+    doc["accessors"].append(
+        {
+            "bufferView": len(doc["bufferViews"]) - 1,
+            "componentType": 5126,
+            "count": count,
+            "type": "VEC3",
+            "min": [0.0, 0.0, 1.0],
+            "max": [0.0, 0.0, 1.0],
+        }
+    )
+    prim["targets"] = [{"POSITION": len(doc["accessors"]) - 1}]
+
+
+def test_gltf_node_morph_weights_override_the_meshes() -> None:
+    # glTF 2.0 section 3.7.2.2: a node's weights, where given, replace its mesh's
+    doc = gltf_box_doc()
+    _with_morph_target(doc)
+    _mesh_node(doc)["weights"] = [1.0]
+    with pytest.raises(UnsupportedFormatError, match="morph-target weights"):
+        analyze(json.dumps(doc).encode(), filename="morphed.gltf")
+    doc["meshes"][0]["weights"] = [1.0]
+    _mesh_node(doc)["weights"] = [0.0]  # the node draws the stored positions
+    res = analyze(json.dumps(doc).encode(), filename="rest.gltf", options=AnalysisOptions(density=1.0)).as_dict()
+    assert res["mass"] == pytest.approx(6.0, rel=1e-14)
+    np.testing.assert_allclose(res["center_of_mass"], [0.5, 1.0, 1.5], rtol=1e-14)
+
+
 def _draco_without_fallback(doc: dict[str, Any]) -> None:
     """Draco used but not required, and no uncompressed positions: read without it, every corner is at 0."""
     doc["extensionsUsed"] = ["KHR_draco_mesh_compression"]

@@ -27,7 +27,7 @@ from numpy.typing import NDArray
 
 from ..errors import InputTooLargeError, UnreadableFileError, UnsupportedFormatError
 
-__all__ = ["EXTENSION", "MAX_INSTANCED_TRIANGLES", "MAX_INSTANCES", "expand_instances"]
+__all__ = ["EXTENSION", "MAX_INSTANCED_TRIANGLES", "MAX_INSTANCES", "expand_instances", "with_document"]
 
 EXTENSION = "EXT_mesh_gpu_instancing"
 MAX_INSTANCED_TRIANGLES = 20_000_000
@@ -81,7 +81,7 @@ def expand_instances(data: bytes, fmt: str, doc: Any, companions: Mapping[str, b
         f"{count_all} instance(s) of {len(instanced)} mesh node(s) placed by {EXTENSION} were weighed, each as its "
         "node's transform times the instance's"
     )
-    return _with_document(data, fmt, doc), [note]
+    return with_document(data, fmt, doc), [note]
 
 
 def _instance_matrices(doc: Any, ext: Any, buffers: _Buffers, label: str, fmt: str) -> NDArray[np.float64]:
@@ -239,7 +239,7 @@ def _glb_binary(data: bytes) -> bytes:
     return data[at + 8 : at + 8 + length]
 
 
-def _with_document(data: bytes, fmt: str, doc: Any) -> bytes:
+def with_document(data: bytes, fmt: str, doc: Any) -> bytes:
     """The file with ``doc`` as its JSON (a GLB keeps its other chunks as they are)."""
     text = json.dumps(doc, separators=(",", ":")).encode()
     if fmt != "glb":

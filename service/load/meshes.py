@@ -12,10 +12,12 @@ triangles' winding reversed, as the glTF 2.0 specification (section 3.7.4,
 from __future__ import annotations
 
 import io
+import itertools
 import json
 import random
 from collections.abc import Callable, Mapping
 from dataclasses import replace
+from functools import partial
 from typing import Any
 
 import numpy as np
@@ -124,9 +126,14 @@ def read_trimesh_parts(
 
     notes = _check_gltf_document(data, fmt) if fmt in ("gltf", "glb") else []
     if fmt in ("gltf", "glb"):  # instances of EXT_mesh_gpu_instancing as nodes, which trimesh draws
-        from .instancing import expand_instances
+        from .instancing import expand_instances, with_document
 
-        data, placed = guarded_read(lambda: expand_instances(data, fmt, _gltf_document(data, fmt), companions), fmt)
+        doc = _gltf_document(data, fmt)
+        cameras = _without_cameras(doc)
+        original = data
+        data, placed = guarded_read(lambda: expand_instances(original, fmt, doc, companions), fmt)
+        if cameras and not placed:  # expand_instances wrote the document only where it placed instances
+            data = with_document(data, fmt, doc)
         notes += placed
     # the upload's own files, and nothing else: a name outside them (a texture that did not come along, a path)
     # is not found, never looked for on disk; images are not needed for the geometry (skip_materials)
@@ -145,7 +152,7 @@ def read_trimesh_parts(
     skipped = 0
     nodes = guarded_read(lambda: sorted(scene.graph.nodes_geometry, key=str), fmt)  # node order is not stable
     for node in nodes:
-        transform, geom_name = scene.graph[node]
+        transform, geom_name = guarded_read(partial(_placement, scene.graph, node), fmt)
         geom = scene.geometry.get(geom_name)
         if not isinstance(geom, trimesh.Trimesh) or len(geom.faces) == 0:
             skipped += 1
@@ -170,6 +177,44 @@ def read_trimesh_parts(
         assert isinstance(first.body, MeshBody)
         parts[0] = Part(first.name, replace(first.body, warnings=(*first.body.warnings, *notes)))
     return parts, _declared_unit(scene, fmt)
+
+
+def _placement(graph: Any, node: Any) -> tuple[NDArray[np.float64], Any]:
+    """A node's world matrix and geometry, the product of the transforms from the root as the file gives them.
+
+    trimesh's own lookup (``graph[node]``) leaves out every transform within 1e-8 of the identity and
+    replaces a world matrix within 1e-5 of a rotation by that rotation (``repair_rigid``): a node scaled
+    by 1.000004 came back 1.2e-5 light, without a word.  glTF composes its nodes' matrices exactly
+    (glTF 2.0 section 3.5.3), and so does this.
+    """
+    forest = graph.transforms
+    path = forest.shortest_path(graph.base_frame, node) if node != graph.base_frame else [node]
+    matrix = np.eye(4)
+    for parent, child in itertools.pairwise(path):
+        edge = forest.edge_data.get((parent, child))
+        if edge is None:
+            raise UnreadableFileError(f"the scene's node {str(node)!r} is not below its root", node=str(node))
+        if "matrix" in edge:
+            matrix = matrix @ np.asarray(edge["matrix"], dtype=np.float64)
+    return matrix, forest.node_data[node].get("geometry")
+
+
+def _without_cameras(doc: Any) -> bool:
+    """Take the cameras off the document's nodes; whether there were any.
+
+    A camera places no geometry, but trimesh's reader skips a node that holds one, with its mesh, and
+    leaves the node's children outside the scene (glTF 2.0 section 3.5.7 lets a node hold a camera,
+    a mesh and children together).
+    """
+    nodes = doc.get("nodes") if isinstance(doc, dict) else None
+    if not isinstance(nodes, list):
+        return False
+    found = False
+    for node in nodes:
+        if isinstance(node, dict) and "camera" in node:
+            del node["camera"]
+            found = True
+    return found
 
 
 def _ply_split_notes(scene: Any) -> list[str]:
@@ -325,8 +370,9 @@ def _check_gltf_document(data: bytes, fmt: str) -> list[str]:
         if not isinstance(mesh, dict):
             continue
         label = mesh.get("name") or f"mesh {mi}"
-        weights = mesh.get("weights")
-        if isinstance(weights, list) and any(isinstance(w, (int, float)) and w != 0 for w in weights):
+        # a node's weights override its mesh's (section 3.7.2.2); a mesh no node draws has no shape to weigh
+        drawn = [n.get("weights", mesh.get("weights")) for n in nodes if isinstance(n, dict) and n.get("mesh") == mi]
+        if any(isinstance(w, list) and any(isinstance(x, (int, float)) and x != 0 for x in w) for w in drawn):
             raise refuse(
                 f"gives mesh {label!r} morph-target weights, so its shape is not the stored positions; "
                 "export it with the morph applied"
