@@ -67,3 +67,24 @@ def test_an_external_reference_is_a_file_that_cannot_be_read(tmp_path: Path) -> 
     )
     assert out.returncode == 3, out.stderr
     assert json.loads(out.stderr)["error"]["code"] == "external_reference"
+
+
+@pytest.mark.parametrize("failure", [ValueError("No path from world->1!"), SystemExit(1), RecursionError()])
+def test_a_readers_own_failure_is_an_unreadable_file_on_the_command_line_too(
+    failure: BaseException, tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # what a library throws while reading is the file's fault, in the same envelope as over HTTP: never a traceback
+    import inertia.load as load
+    from inertia.cli import main
+
+    def fail(*args: object, **kwargs: object) -> None:
+        raise failure
+
+    monkeypatch.setattr(load, "_load_path", fail)
+    monkeypatch.setattr(load, "_load_beside", fail)
+    path = tmp_path / "box.stl"
+    path.write_bytes(b"solid x\nendsolid x\n")
+    assert main(["analyze", str(path), "--json"]) == 3
+    error = json.loads(capsys.readouterr().err)["error"]
+    assert error["code"] == "unreadable_file"
+    assert "could not be read" in error["message"] or "too deeply" in error["message"]

@@ -9,10 +9,10 @@ A mesh job names a file that the parent process wrote into a private folder
 also puts its own temporary files there (``tempfile.tempdir``), so a killed
 worker leaves nothing behind that the parent does not remove.
 
-The job boundary classifies what the readers still let through: any failure
-while a client's file is being read (a library's ``SystemExit``, an
+What the readers still let through is classified by ``load.load_body``: any
+failure while a client's file is being read (a library's ``SystemExit``, an
 ``IndexError`` in a parser, a too-deep ``RecursionError``) is that file's
-``unreadable_file`` (422); running out of the job's memory allowance is
+``unreadable_file`` (422). Running out of the job's memory allowance is
 ``payload_too_large`` (413). A failure after loading is a bug and stays one.
 """
 
@@ -28,7 +28,7 @@ from contextlib import contextmanager
 from dataclasses import dataclass
 from typing import Any
 
-from ..errors import InvalidParameterError, ServiceError, UnreadableFileError
+from ..errors import InvalidParameterError, ServiceError
 from ..pipeline import AnalysisOptions, analyze_loaded, analyze_points, precession
 from .transport import PayloadTooLargeError
 
@@ -141,28 +141,9 @@ def _read_files(files: tuple[tuple[str, str], ...]) -> list[tuple[str, bytes]]:
 def _load(source: bytes | str | tuple[tuple[str, str], ...], filename: str | None, options: AnalysisOptions) -> Any:
     from ..load import load_body
 
-    try:
-        if isinstance(source, tuple):
-            return load_body(_read_files(source), format=options.format, units=options.units, isotopes=options.isotopes)
-        return load_body(source, filename=filename, format=options.format, units=options.units, isotopes=options.isotopes)
-    except (ServiceError, MemoryError):
-        raise
-    except RecursionError:
-        raise UnreadableFileError(
-            "the file nests its structure too deeply to read; no mesh file needs that", reason="RecursionError"
-        ) from None
-    except (Exception, SystemExit) as exc:  # a reader's own failure on this file, untranslated below load/
-        log.warning("unclassified reader failure on %r, reported as unreadable_file", filename, exc_info=exc)
-        raise UnreadableFileError(
-            f"the file could not be read ({type(exc).__name__}: {_first_line(exc)}); check that it is a valid "
-            "file of its format, or export it again",
-            reason=type(exc).__name__,
-        ) from None
-
-
-def _first_line(exc: BaseException) -> str:
-    text = str(exc).strip()
-    return (text.splitlines()[0] if text else "no message")[:160]
+    if isinstance(source, tuple):
+        return load_body(_read_files(source), format=options.format, units=options.units, isotopes=options.isotopes)
+    return load_body(source, filename=filename, format=options.format, units=options.units, isotopes=options.isotopes)
 
 
 def run_job(job: Job) -> dict[str, Any]:

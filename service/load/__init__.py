@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import logging
 import os
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, replace
@@ -9,7 +10,7 @@ from urllib.parse import unquote
 
 from ..body import Body, BrepBody, MeshBody, Part, PointBody, VolumeBody, stored_eps
 from ..conventions import length_scale
-from ..errors import EmptyGeometryError, ExternalReferenceError, UnreadableFileError
+from ..errors import EmptyGeometryError, ExternalReferenceError, ServiceError, UnreadableFileError
 from ..vocabulary import Isotopes, MassUnit, SourceKind, UnitsFrom
 from .guard import check_upload, plain_name
 from .sniff import CAD_FORMATS, FORMATS, POINT_FORMATS, SCENE_FORMATS, SURFACE_FORMATS, VOLUME_FORMATS, sniff_format
@@ -18,6 +19,8 @@ from .upload import pick_model_file, unpack_zip
 XYZ_UNIT = "angstrom"  # the XYZ format's length unit (coordinates in angstrom, as chemistry programs write them)
 
 __all__ = ["Loaded", "load_body", "load_points", "FORMATS", "SURFACE_FORMATS", "VOLUME_FORMATS", "SCENE_FORMATS"]
+
+log = logging.getLogger("inertia.load")
 
 
 @dataclass(frozen=True, slots=True)
@@ -72,7 +75,41 @@ def load_body(
         model's own folder, where they are named by a plain file name: what a
         user's own files on their own disk need.  Off by default, and never
         set by the server, whose uploads name nothing outside themselves.
+
+    A reader's own failure that no reader translated (a library's exception,
+    or its ``sys.exit``) is ``unreadable_file`` naming it, and logged: the
+    server, the command line and the library answer it alike.
     """
+    try:
+        return _load_body(source, filename, format, units, isotopes, companions_beside)
+    except (ServiceError, MemoryError):
+        raise
+    except RecursionError:
+        raise UnreadableFileError(
+            "the file nests its structure too deeply to read; no mesh file needs that", reason="RecursionError"
+        ) from None
+    except (Exception, SystemExit) as exc:  # a reader's own failure on this file, untranslated below
+        log.warning("unclassified reader failure on %r, reported as unreadable_file", filename, exc_info=exc)
+        raise UnreadableFileError(
+            f"the file could not be read ({type(exc).__name__}: {_first_line(exc)}); check that it is a valid "
+            "file of its format, or export it again",
+            reason=type(exc).__name__,
+        ) from None
+
+
+def _first_line(exc: BaseException) -> str:
+    text = str(exc).strip()
+    return (text.splitlines()[0] if text else "no message")[:160]
+
+
+def _load_body(
+    source: bytes | str | os.PathLike[str] | Sequence[tuple[str, bytes]],
+    filename: str | None,
+    format: str | None,
+    units: str | None,
+    isotopes: str,
+    companions_beside: bool,
+) -> Loaded:
     if not isinstance(source, (bytes, bytearray, memoryview, str, os.PathLike)):
         return _load_files(list(source), format, units, isotopes)
     zipped = (format or "").lower().lstrip(".") == "zip"
