@@ -85,6 +85,9 @@ def integrate_scipy(
     """
     name, order = _SCIPY_METHODS[method]
     duration = float(t[-1])
+    if duration == 0.0:  # the scaled time underflowed: the body turns by nothing a float64 holds, and scipy
+        # returns no samples for an empty interval
+        return np.tile(np.asarray(problem.omega_body, dtype=np.float64), (len(t), 1)), np.tile([1.0, 0.0, 0.0, 0.0], (len(t), 1))
     estimate = max_body_rate(problem) * duration * rtol ** (-1.0 / order)
     if estimate > max_steps:
         raise MotionError(

@@ -144,3 +144,14 @@ def test_power_of_two_units_change_the_motion_exactly(
     assert np.array_equal(scaled.trajectory.omega_body, np.ldexp(base.trajectory.omega_body, b))
     assert np.array_equal(scaled.trajectory.omega, np.ldexp(base.trajectory.omega, b))
     assert np.array_equal(scaled.trajectory.quaternion, base.trajectory.quaternion)
+
+
+@pytest.mark.parametrize("method", ["exact", "dop853", "rk45", "splitting"])
+def test_a_duration_whose_turn_underflows_is_a_still_trajectory(method: str) -> None:
+    # |omega| 1e-150 rad/s for 1e-200 s turns the body by 1e-350 rad, below float64: every sample is the start
+    # (scipy's solvers return no samples for the empty interval the scaled time becomes)
+    result = precession(principal_moments=[1, 2, 3], omega=[1e-150, 0, 1e-150], duration=1e-200, samples=5, method=method)
+    doc = result.as_dict()["precession"]["trajectory"]
+    assert doc["t"] == pytest.approx([0, 2.5e-201, 5e-201, 7.5e-201, 1e-200], rel=1e-15)
+    assert all(q == [1.0, 0.0, 0.0, 0.0] for q in doc["quaternion"])
+    assert all(w == [1e-150, 0.0, 1e-150] for w in doc["omega_body"])
