@@ -86,11 +86,14 @@ def phase_bound(setup: Setup, motion: FreeMotion, duration: float) -> float:
 
 
 def departure(omega_body: Array, exact_omega_body: Array, quaternion: Array, exact_quaternion: Array, speed: float) -> float:
-    """A numerical trajectory's largest departure from the exact one: of Omega (relative to |Omega|) and of the
-    attitude (the distance of the unit quaternions, q and -q being one rotation)."""
+    """A numerical trajectory's largest departure from the exact one, relative to |Omega|: of Omega in the body
+    frame and in space, and of the attitude (the distance of the unit quaternions, q and -q being one rotation).
+
+    Omega in space is R(q) Omega_body; two rotations whose quaternions are d apart differ by an angle of up to
+    about 2 d, so it departs by up to Omega_body's departure plus twice the quaternions' distance."""
     omega = float(np.max(np.abs(omega_body - exact_omega_body))) / speed if speed > 0 else 0.0
     apart = np.minimum(np.linalg.norm(quaternion - exact_quaternion, axis=1), np.linalg.norm(quaternion + exact_quaternion, axis=1))
-    return max(omega, float(np.max(apart)) if len(apart) else 0.0)
+    return omega + 2.0 * (float(np.max(apart)) if len(apart) else 0.0)
 
 
 def phase_warnings(setup: Setup, motion: FreeMotion, duration: float) -> tuple[str, ...]:
