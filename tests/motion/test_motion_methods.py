@@ -141,7 +141,8 @@ def test_exact_path_agrees_with_dop853(moments: Any, omega: Any) -> None:
 def _turned(axis: np.ndarray, angle: float, v: np.ndarray) -> np.ndarray:
     """v turned by ``angle`` about ``axis`` (Rodrigues)."""
     k = axis / np.linalg.norm(axis)
-    return v * np.cos(angle) + np.cross(k, v) * np.sin(angle) + k * np.dot(k, v) * (1 - np.cos(angle))
+    turned: np.ndarray = v * np.cos(angle) + np.cross(k, v) * np.sin(angle) + k * np.dot(k, v) * (1 - np.cos(angle))
+    return turned
 
 
 @pytest.mark.parametrize("omega", [[0.3, 0.4, 1.0], [1.0, 0.4, 0.3], [0.2, -1.0, 0.5]])
