@@ -166,7 +166,7 @@ def analyze_loaded(loaded: Loaded, options: AnalysisOptions, start: float | None
         reference = props.about(np.asarray(options.reference) * length_scale(loaded.units))
     motion = None
     if options.omega is not None:
-        motion = _motion(frame, cls, options)
+        motion = _motion(frame, cls, options, moment_error=props.relative_error_estimate)
         warnings.extend(motion.warnings)
     extra = _v11_sections(loaded, props, frame, cls, reference, parts, options, warnings)
     if parts is not None:
@@ -474,8 +474,11 @@ def _combined(loaded: Loaded, parts: Sequence[PartResult], options: AnalysisOpti
     )
 
 
-def _motion(frame: PrincipalFrame, cls: Classification, options: AnalysisOptions, exact_moments: bool = False) -> FreeMotion:
-    """The torque-free motion; ``exact_moments``: the moments are the caller's numbers, not computed ones."""
+def _motion(
+    frame: PrincipalFrame, cls: Classification, options: AnalysisOptions, exact_moments: bool = False, moment_error: float = 0.0
+) -> FreeMotion:
+    """The torque-free motion; ``exact_moments``: the moments are the caller's numbers, not computed ones;
+    ``moment_error``: the relative error bound of computed ones, which the trajectory's estimate carries."""
     from .motion import predict_motion
 
     return predict_motion(
@@ -486,6 +489,7 @@ def _motion(frame: PrincipalFrame, cls: Classification, options: AnalysisOptions
         samples=options.samples,
         method=options.method,
         exact_moments=exact_moments,
+        moment_error=moment_error,
     )
 
 
@@ -574,6 +578,12 @@ def precession(
         frame = PrincipalFrame.from_tensor(np.diag(moments), tolerance)
         estimate, notes = 8 * EPS, ()  # the moments as given: only the motion's own arithmetic
     cls = classify(frame)
-    motion = _motion(frame, cls, options, exact_moments=principal_moments is not None)
+    motion = _motion(
+        frame,
+        cls,
+        options,
+        exact_moments=principal_moments is not None,
+        moment_error=estimate if inertia_tensor is not None else 0.0,
+    )
     warnings = tuple(dict.fromkeys((*notes, *motion.warnings)))
     return PrecessionResult(frame, cls, motion, Diagnostics(time.perf_counter() - start, max(estimate, 8 * EPS)), warnings)

@@ -89,6 +89,7 @@ References: Landau & Lifshitz, Mechanics §§33-37; Celledoni, Fasso, Safstrom
 
 from __future__ import annotations
 
+import math
 import time
 from dataclasses import replace
 
@@ -96,7 +97,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..classification import Classification
-from ..errors import InvalidParameterError
+from ..errors import InvalidParameterError, MotionError
 from ..principal import PrincipalFrame
 from ..tolerances import DEFAULT_TOLERANCES, Tolerances
 from . import quaternions as quat
@@ -138,6 +139,7 @@ def predict_motion(
     method: MotionMethod | str = MotionMethod.EXACT,
     tolerances: Tolerances = DEFAULT_TOLERANCES,
     exact_moments: bool = False,
+    moment_error: float = 0.0,
 ) -> FreeMotion:
     """Torque-free motion of the body from its initial angular velocity.
 
@@ -149,6 +151,9 @@ def predict_motion(
     exact_moments : the frame's moments are exact numbers (principal moments given by the
         caller), not computed ones: moments then get a degenerate top's closed form only where
         they are equal, not merely within rounding (``MOTION_ROUNDING``) of each other.
+    moment_error : relative error bound of the frame's moments (the mass stage's or the tensor's
+        estimate; 0 for exact moments): the trajectory's estimate includes how far the motion moves
+        when a moment moves by it (``_moment_departure``).
 
     Raises ``InvalidParameterError`` for malformed input and ``MotionError``
     when the method cannot treat this body or this horizon.
@@ -169,24 +174,74 @@ def predict_motion(
         motion = units.restore(motion, None)
         return replace(motion, diagnostics=MotionDiagnostics(elapsed_s=time.perf_counter() - started))
     notes = phase_warnings(setup, motion, float(times[-1]))  # refuses a horizon whose phase float64 cannot place
-    notes += unstable_axis_warnings(setup, float(times[-1]), units.omega)
+    unstable = unstable_axis_warnings(setup, float(times[-1]), units.omega)
+    notes += unstable
     # a body at rest stays at rest: no method needs to integrate that
     propagator = EXACT_REST if setup.regime is Regime.REST else chosen
     omega_body, attitude = propagator.propagate(setup, times, tolerances)
     # the trajectory's error bound: the closed forms' phase rounding, and a numerical method's measured departure
     # from them (of Omega and of the attitude, which the invariant drifts do not see)
     error = phase_bound(setup, motion, float(times[-1]))
+    exact_omega, exact_attitude = omega_body, attitude
+    speed = float(np.linalg.norm(setup.problem.omega_body))
     if propagator is not EXACT_REST:
         exact_omega, exact_attitude = EXACT_REST.propagate(setup, times, tolerances)
-        speed = float(np.linalg.norm(setup.problem.omega_body))
         notes += departure_warning(chosen.name.value, omega_body, exact_omega, speed)
         error += departure(omega_body, exact_omega, attitude, exact_attitude, speed)
+    if moment_error > 0.0 and setup.regime is not Regime.REST:
+        moved = (frame, classification, units.angular_velocity(omega), times, tolerances, moment_error)
+        error += _moment_departure(*moved, exact_omega, exact_attitude, speed)
+        i1, i3 = float(frame.moments[0]), float(frame.moments[2])
+        if error > LOST and i1 > 0.0:  # no prediction: Omega(t) may be anywhere its energy allows, |Omega(t)|
+            error = max(error, 2.0 * math.sqrt(i3 / i1))  # <= sqrt(2E / I1) <= sqrt(I3 / I1) |Omega(0)|
+    if unstable:  # the rounding's tilt turns Omega over within the duration: it may be anywhere, even -Omega
+        error = max(error, 2.0)
     motion = replace(motion, warnings=(*motion.warnings, *notes))
     trajectory = _trajectory(setup.problem, times, omega_body, attitude)
     energy_drift, momentum_drift = invariant_drifts(setup.problem, trajectory.omega_body, trajectory.quaternion)
     motion = units.restore(replace(motion, trajectory=trajectory), given_times)
-    diagnostics = MotionDiagnostics(time.perf_counter() - started, energy_drift, momentum_drift, min(error, 1.0))
+    diagnostics = MotionDiagnostics(time.perf_counter() - started, energy_drift, momentum_drift, error)
     return replace(motion, diagnostics=diagnostics)
+
+
+LOST = 0.1
+"""A departure (relative to |Omega|) beyond which the trajectory is no prediction of the body's motion."""
+
+
+def _moment_departure(
+    frame: PrincipalFrame,
+    classification: Classification,
+    omega: Array,
+    times: Array,
+    tolerances: Tolerances,
+    relative: float,
+    omega_body: Array,
+    attitude: Array,
+    speed: float,
+) -> float:
+    """How far the exact motion moves when one moment moves by its error bound, either way (the largest).
+
+    The trajectory is the motion of the moments computed, and the body's own moments may differ from
+    them by ``relative``.  Mostly that moves the phase by about as much; but near the separatrix it can
+    put the state on its other side (the body then circulates about the other axis), and for a pair of
+    moments equal to rounding it decides whether Omega turns over at all, so the trajectory may be no
+    prediction of the body's motion at all: the departure, measured, says so.
+    """
+    worst = 0.0
+    moments = np.asarray(frame.moments, dtype=np.float64)
+    for k in range(3):
+        for sign in (1.0, -1.0):
+            moved = moments.copy()
+            moved[k] *= 1.0 + sign * relative
+            if not moved[0] <= moved[1] <= moved[2]:
+                continue  # a pair that would swap: the other pair's moves cover that side
+            try:
+                setup = decide_regime(replace(frame, moments=moved), classification, omega, tolerances, exact_moments=True)
+                other_omega, other_attitude = EXACT_REST.propagate(setup, times, tolerances)
+            except MotionError:
+                continue  # a moved state float64 cannot place (within ~1e-150 of the separatrix)
+            worst = max(worst, departure(other_omega, omega_body, other_attitude, attitude, speed))
+    return worst
 
 
 # -- input validation ---------------------------------------------------------------

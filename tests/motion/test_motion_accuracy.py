@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import re
 import warnings
+from fractions import Fraction
 from types import SimpleNamespace
 from typing import Any
 
@@ -17,9 +18,10 @@ import numpy as np
 import pytest
 from fastapi.testclient import TestClient
 
-from inertia import precession
+from inertia import analyze_points, precession
 from inertia.errors import MotionError
 from inertia.motion import predict_motion
+from inertia.options import AnalysisOptions
 from tests.support.motion import body, elliptic_reference
 
 MOMENTS, OMEGA = (1.0, 2.0, 3.0), (1.0, 0.01, 0.5)
@@ -111,3 +113,37 @@ def test_the_trajectory_error_estimate_covers_the_error(method: str, duration: f
     error = float(np.max(np.abs(trajectory.omega_body - exact))) / float(np.hypot(1.0, 1e-4))
     estimate = res.motion.diagnostics.relative_error_estimate
     assert estimate is not None and error <= estimate
+
+
+def test_a_state_the_moments_rounding_puts_across_the_separatrix_has_no_digits() -> None:
+    # masses 0.175, 0.125, 0.025 kg in pairs at +-1 m on the axes, Omega (2, 0.5, 1): with the masses' own binary
+    # values M^2 - 2 E I2 is -4.7e-17 of M^2 (exact rationals below), far inside the computed moments' rounding,
+    # which put it on the other side: the motion circulates about another axis, an error of 1.7 |Omega| by t = 50 s
+    masses = {0: 0.17500000000000002, 1: 0.125, 2: 0.025}
+    points = [{"mass": m, "position": [s * float(k == a) for a in range(3)]} for k, m in masses.items() for s in (1.0, -1.0)]
+    w = [Fraction(2), Fraction(1, 2), Fraction(1)]
+    # each pair off an axis adds 2 m to the moment about it
+    i = [2 * sum((Fraction(m) for k, m in masses.items() if k != axis), Fraction(0)) for axis in range(3)]
+    m2 = sum(((ii * wi) ** 2 for ii, wi in zip(i, w)), Fraction(0))
+    d2 = m2 - sum((ii * wi * wi for ii, wi in zip(i, w)), Fraction(0)) * i[1]
+    assert 0 < abs(d2) / m2 < 1e-16
+    result = analyze_points(points, AnalysisOptions(omega=(2.0, 0.5, 1.0), duration=100.0, samples=201))
+    assert result.motion is not None and result.motion.diagnostics is not None
+    estimate = result.motion.diagnostics.relative_error_estimate
+    assert estimate is not None and estimate >= 1.0
+
+
+def test_a_top_symmetric_to_rounding_spun_across_its_axis_has_no_digits_over_a_long_horizon() -> None:
+    # two pairs of equal transverse moments to rounding (a prolate top turned off the axes), Omega across the
+    # axis at 1e6 rad/s: a gap at the rounding level of the moments turns Omega over within ~1e3 s, so over 500 s
+    # the trajectory of the moments as computed (regular precession) is no prediction
+    from scipy.spatial.transform import Rotation
+
+    turn = Rotation.from_euler("zyx", [0.3, 0.7, 1.1]).as_matrix()
+    axes = [(0, 2.0), (1, 0.25), (2, 0.25)]  # I = (1, 4.5, 4.5) about the turned axes
+    points = [{"mass": m, "position": (s * turn[:, k]).tolist()} for k, m in axes for s in (1.0, -1.0)]
+    omega = (turn @ np.array([0.0, 0.6e6, 0.8e6])).tolist()
+    result = analyze_points(points, AnalysisOptions(omega=tuple(omega), duration=500.0, samples=201))
+    assert result.motion is not None and result.motion.diagnostics is not None
+    estimate = result.motion.diagnostics.relative_error_estimate
+    assert estimate is not None and estimate >= 1.0
