@@ -199,7 +199,7 @@ def predict_motion(
     if unstable:  # the rounding's tilt turns Omega over within the duration: it may be anywhere, even -Omega
         error = max(error, 2.0)
     motion = replace(motion, warnings=(*motion.warnings, *notes))
-    trajectory = _trajectory(setup.problem, times, omega_body, attitude)
+    trajectory = _trajectory(setup.problem, times, omega_body, attitude, units.angular_velocity(omega))
     energy_drift, momentum_drift = invariant_drifts(setup.problem, trajectory.omega_body, trajectory.quaternion)
     motion = units.restore(replace(motion, trajectory=trajectory), given_times)
     diagnostics = MotionDiagnostics(time.perf_counter() - started, energy_drift, momentum_drift, error)
@@ -298,14 +298,23 @@ def _parse_times(duration: float | None, samples: int | None) -> Array | None:
 # -- the trajectory in the input frame ------------------------------------------------
 
 
-def _trajectory(problem: RigidProblem, t: Array, omega_body: Array, attitude: Array) -> Trajectory:
+def _trajectory(problem: RigidProblem, t: Array, omega_body: Array, attitude: Array, omega: Array) -> Trajectory:
     """Express the principal-frame attitude in the input frame.
 
     q = q_A q~ q_A* with q_A the principal->input rotation: the same angle about
     the rotated axis, so the scalar part is kept and the vector part is taken
-    through the axes (exactly the identity at t = 0).
+    through the axes.  At t = 0 the state is the one given, exactly (API.md: the
+    quaternion is the identity there): Omega as given (``omega``, computation
+    units), Omega_body as the problem has it, whatever rounding the closed forms
+    leave at their start.
     """
     q = np.concatenate([attitude[:, :1], attitude[:, 1:] @ problem.axes], axis=1)
     q = quat.canonical(q)
-    omega = quat.rotate(q, omega_body @ problem.axes)
-    return Trajectory(t=t, omega_body=omega_body, omega=omega, quaternion=q)
+    omega_t = quat.rotate(q, omega_body @ problem.axes)
+    start = t == 0.0
+    if np.any(start):
+        q[start] = (1.0, 0.0, 0.0, 0.0)
+        omega_body = np.array(omega_body, dtype=np.float64)
+        omega_body[start] = problem.omega_body
+        omega_t[start] = omega
+    return Trajectory(t=t, omega_body=omega_body, omega=omega_t, quaternion=q)

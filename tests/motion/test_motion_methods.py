@@ -159,3 +159,13 @@ def test_numerical_methods_estimate_covers_omega_in_space(method: str, omega: li
     want = np.array([_turned(momentum, rate * t, w0) for t in motion["trajectory"]["t"]])
     error = float(np.max(np.abs(np.array(motion["trajectory"]["omega"]) - want))) / float(np.linalg.norm(w0))
     assert error <= motion["diagnostics"]["relative_error_estimate"]
+
+
+@pytest.mark.parametrize("method", ["exact", "dop853", "rk45", "splitting"])
+def test_the_first_sample_is_the_state_given_exactly(method: str) -> None:
+    # API.md: the quaternion is the identity at t = 0; Omega there is the Omega given, not the closed forms'
+    # value at their start (an elliptic function's rounding left 1e-16 in the quaternion)
+    doc = precession(principal_moments=[1.0, 2.0, 3.0], omega=[0.3, 1.0, 0.2], duration=10.0, samples=3, method=method)
+    trajectory = doc.as_dict()["precession"]["trajectory"]
+    assert trajectory["quaternion"][0] == [1.0, 0.0, 0.0, 0.0]
+    assert trajectory["omega"][0] == [0.3, 1.0, 0.2] and trajectory["omega_body"][0] == [0.3, 1.0, 0.2]
