@@ -142,6 +142,8 @@ def _decide(frame: PrincipalFrame, classification: Classification, omega: Array,
         # frame: it is kept, so that Omega(t) starts as given (the limit of a needle as I1 -> 0)
         if float(np.hypot(omega_body[1], omega_body[2])) <= noise * rate:
             return Setup(_snap(problem, 0, None), Regime.PERMANENT_ROTATION, True, tuple(warnings))
+        if abs(float(omega_body[0])) <= noise * rate:  # a spin of rounding only: no spin, no period of it
+            return Setup(_snap(problem, None, 0), Regime.ROTATOR, True, tuple(warnings))
         return Setup(problem, Regime.ROTATOR, True, tuple(warnings))
     along_axis = _principal_axis_of(omega_body, noise)
     if rotor.is_symmetric:

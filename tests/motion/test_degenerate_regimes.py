@@ -17,7 +17,7 @@ import numpy as np
 import pytest
 
 from benchmarks.cases import box
-from inertia import analyze, precession
+from inertia import analyze, analyze_points, precession
 from inertia.motion import predict_motion
 from inertia.options import AnalysisOptions
 from tests.support.motion import body, elliptic_reference
@@ -209,3 +209,16 @@ def test_principal_moments_given_within_rounding_of_equal_move_as_the_numbers_gi
     moments = (1.0, 1.0 + ulps[0] * EPS, 1.0 + ulps[1] * EPS)
     _, error = _omega_error(moments, (0.6, 0.5, 0.4), duration=1e4)
     assert error <= 64 * EPS, error  # the ideal top's closed form was 1e-12..4e-11 off by t = 1e4
+
+
+def test_a_rotators_spin_of_rounding_is_no_spin() -> None:
+    # three collinear points turned off the axes, Omega across the line: the axial component of Omega_body is the
+    # rounding of the turned axes (~1e-16), not a spin with a period of 4e16 s
+    from scipy.spatial.transform import Rotation
+
+    line = Rotation.from_euler("zyx", [0.3, 0.7, 1.1]).as_matrix()[:, 0]
+    across = np.cross(line, [0.0, 0.0, 1.0])
+    points = [{"mass": m, "position": (t * line).tolist()} for m, t in ((1.0, -1.0), (2.0, 0.5), (1.0, 1.5))]
+    result = analyze_points(points, AnalysisOptions(omega=tuple(across / np.linalg.norm(across))))
+    assert result.motion is not None and result.motion.regime.value == "rotator"
+    assert result.motion.period is None and result.motion.spin_rate is None and result.motion.body_precession_rate is None
