@@ -2,9 +2,22 @@
 
 from __future__ import annotations
 
+import importlib.util
+from functools import cache
+
 from ..errors import UnsupportedFormatError
 
-__all__ = ["SURFACE_FORMATS", "VOLUME_FORMATS", "SCENE_FORMATS", "POINT_FORMATS", "CAD_FORMATS", "sniff_format", "FORMATS"]
+__all__ = [
+    "SURFACE_FORMATS",
+    "VOLUME_FORMATS",
+    "SCENE_FORMATS",
+    "POINT_FORMATS",
+    "CAD_FORMATS",
+    "sniff_format",
+    "FORMATS",
+    "OPTIONAL_READERS",
+    "unavailable_formats",
+]
 
 # surface meshes read through our STL reader or trimesh
 SURFACE_FORMATS = ("stl", "obj", "ply", "off", "glb", "gltf", "3mf")
@@ -29,6 +42,30 @@ POINT_FORMATS = ("json", "csv", "xyz")  # xyz: atoms by element, in angstrom
 CAD_FORMATS = ("step", "iges")
 FORMATS = SURFACE_FORMATS + tuple(VOLUME_FORMATS) + CAD_FORMATS
 
+# format -> (module its reader imports, what to install)
+OPTIONAL_READERS: dict[str, tuple[str, str]] = {
+    "xdmf": ("h5py", "the 'hdf5' extra: pip install 'inertia-service[hdf5]'"),
+    "med": ("h5py", "the 'hdf5' extra: pip install 'inertia-service[hdf5]'"),
+    "vtk": ("vtkmodules", "the 'vtk' extra: pip install 'inertia-service[vtk]'"),
+    "vtu": ("vtkmodules", "the 'vtk' extra: pip install 'inertia-service[vtk]'"),
+    "step": ("OCP", "the 'cad' extra: pip install 'inertia-service[cad]'"),
+    "iges": ("OCP", "the 'cad' extra: pip install 'inertia-service[cad]'"),
+}
+
+
+@cache
+def unavailable_formats() -> dict[str, str]:
+    """Formats whose reader cannot be imported here, with what enables each."""
+    return {fmt: needs for fmt, (module, needs) in OPTIONAL_READERS.items() if importlib.util.find_spec(module) is None}
+
+
+def _readable() -> str:
+    """The formats this installation reads, for a message (those missing a package named apart)."""
+    missing = unavailable_formats()
+    text = ", ".join(f for f in FORMATS + POINT_FORMATS if f not in missing)
+    return text + (f" ({', '.join(missing)} need an optional extra, see /v1/formats)" if missing else "")
+
+
 _ALIASES = {"extxyz": "xyz", "gmsh": "msh", "stla": "stl", "stlb": "stl", "ascii_stl": "stl", "stp": "step", "igs": "iges"}
 
 
@@ -38,7 +75,7 @@ def sniff_format(filename: str | None, declared: str | None, head: bytes = b"") 
         fmt = _ALIASES.get(declared.lower().lstrip("."), declared.lower().lstrip("."))
         if fmt not in FORMATS and fmt not in POINT_FORMATS:
             raise UnsupportedFormatError(
-                f"format {declared!r} is not supported; readable formats are {', '.join(FORMATS + POINT_FORMATS)}",
+                f"format {declared!r} is not supported; readable formats are {_readable()}",
                 format=declared,
             )
         return fmt
@@ -49,7 +86,7 @@ def sniff_format(filename: str | None, declared: str | None, head: bytes = b"") 
             return ext
         part = " (a .model file is the XML part inside a 3MF package: send the .3mf file itself)" if ext == "model" else ""
         raise UnsupportedFormatError(
-            f"cannot read files ending in .{ext}{part}; readable formats are {', '.join(FORMATS + POINT_FORMATS)} "
+            f"cannot read files ending in .{ext}{part}; readable formats are {_readable()} "
             "(or pass format=... if the name is misleading)",
             format=ext,
         )

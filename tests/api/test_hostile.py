@@ -212,6 +212,11 @@ def test_formats_lists_only_readable_formats(client: Any) -> None:
         assert all("hdf5" in u["needs"] for u in doc["unavailable"] if u["format"] in ("xdmf", "med"))
     assert {"stl", "3mf", "msh"} <= listed
     assert ("vtu" in listed) == (importlib.util.find_spec("vtkmodules") is not None)
+    # an unknown extension's message offers what /v1/formats lists, and names the others apart
+    res = client.post("/v1/analyze/mesh", files={"file": ("part.xyzw", b"x")})
+    assert res.status_code == 415
+    offered = res.json()["error"]["message"].split("readable formats are ", 1)[1].split(" (", 1)[0]
+    assert set(offered.split(", ")) == listed | set(doc["points"])
 
 
 # --- a real server: connections, temporary files, memory ------------------------------------------------
