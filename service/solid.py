@@ -144,7 +144,12 @@ def _orient_outward(
     x = vertices - local_origin(vertices)
     det = _signed_volumes(x, faces)
     if np.all(det >= 0):  # every face sees the local origin from outside: outward already
-        return faces, []
+        count, label = face_components(faces, topo)
+        if count == 1:
+            return faces, []
+        noise = np.bincount(label, weights=_volume_magnitudes(x, faces), minlength=count)
+        solid = np.abs(np.bincount(label, weights=det, minlength=count)) > 64 * EPS * noise
+        return faces, _overlap_note(x, faces, label, solid)
     scale = _volume_magnitudes(x, faces)  # each face's rounding scale, for the shells' noise
     del x
     total = float(det.sum())
@@ -165,7 +170,7 @@ def _orient_outward(
         # every shell encloses positive volume as the file winds it: the file says each is a solid (one inside
         # another is a second body there, not a cavity), as when all its faces see the local origin from outside;
         # nesting decides only where the file's windings disagree with each other
-        return faces, []
+        return faces, _overlap_note(vertices - local_origin(vertices), faces, label, ~flat)
     shifted = vertices - local_origin(vertices)  # formed again: not held above
     depth = _nesting_depth(shifted, faces, label, count)
     if isinstance(depth, str):  # nesting undecidable: keep the file's orientation
@@ -197,6 +202,37 @@ def _orient_outward(
     return out, [
         f"winding corrected on {int(flip_shell.sum())} of {count} shells by their nesting "
         "(a shell inside an odd number of others is a cavity)"
+    ]
+
+
+def _overlap_note(
+    x: NDArray[np.float64], faces: NDArray[np.int64], label: NDArray[np.int64], solid: NDArray[np.bool_]
+) -> list[str]:
+    """A warning where shells that all wind outward lie inside or across one another, else nothing.
+
+    Each such shell is weighed as a solid of its own, so the volume two of them share counts twice: the
+    sum of the signed volumes, as trimesh, numpy-stl and MuJoCo read the file; the part may be their
+    union (a CAD export of touching bodies), which the file does not say.  ``solid``: the shells that
+    enclose volume (flat ones add none).  Beyond the nesting test's work limit nothing is said.
+    """
+    kept = np.flatnonzero(solid)
+    if len(kept) < 2:
+        return []
+    renumber = np.full(len(solid), -1, dtype=np.int64)
+    renumber[kept] = np.arange(len(kept))
+    chosen = renumber[label] >= 0
+    faces, label = faces[chosen], renumber[label[chosen]]
+    count = len(kept)
+    # a vertex of one shell clearly inside another (winding number not 0) is volume the two share: with
+    # every depth taken as 0, the crossing test looks for exactly that (vertices on another shell, where
+    # shells merely touch, decide nothing)
+    if _crossing_shell(x, faces, label, count, np.zeros(count, dtype=np.int64), _OVERLAP_SAMPLES) is None:
+        return []
+    return [
+        f"the mesh's {count} shells all wind outward and overlap (some lie inside or across others): each is "
+        "weighed as a solid of its own, so the volume they share counts once for each (as trimesh and MuJoCo "
+        "read the file); if the part is their union, join them into one closed surface (a boolean union) or "
+        "send them as separate parts"
     ]
 
 
@@ -325,10 +361,16 @@ def _shell_boxes(
 
 _NESTING_ATTEMPTS = 4
 _CROSSING_SAMPLES = 24  # vertices of each nested shell tested against the shells around it
+_OVERLAP_SAMPLES = 256  # vertices of each outward shell tested for lying inside another (a warning, not a refusal)
 
 
 def _crossing_shell(
-    x: NDArray[np.float64], faces: NDArray[np.int64], label: NDArray[np.int64], count: int, depth: NDArray[np.int64]
+    x: NDArray[np.float64],
+    faces: NDArray[np.int64],
+    label: NDArray[np.int64],
+    count: int,
+    depth: NDArray[np.int64],
+    samples: int = _CROSSING_SAMPLES,
 ) -> tuple[int, int, int] | None:
     """A shell whose vertices are not all as deep as its test point: (its faces, its depth, a vertex's depth),
     or None.
@@ -348,7 +390,7 @@ def _crossing_shell(
     for t in range(count):
         used = np.unique(faces[order[bounds[t] : bounds[t + 1]]])
         ends = np.concatenate([used[np.argmin(x[used], axis=0)], used[np.argmax(x[used], axis=0)]])
-        spread = used[np.linspace(0, len(used) - 1, min(len(used), _CROSSING_SAMPLES - len(ends))).astype(np.int64)]
+        spread = used[np.linspace(0, len(used) - 1, min(len(used), samples - len(ends))).astype(np.int64)]
         points = x[np.unique(np.concatenate([ends, spread]))]
         # the shells whose boxes hold each point, all at once (points x shells)
         near = np.all((lo[None, :, :] <= points[:, None, :]) & (hi[None, :, :] >= points[:, None, :]), axis=2)

@@ -176,6 +176,20 @@ def test_shells_all_wound_outward_are_each_a_solid_wherever_they_lie(centre: tup
     props = mass_properties(MeshBody(np.vstack([bv, sv]), np.vstack([bf, sf + 8])), density=1.0)
     assert props.mass == pytest.approx(64 + float(exact_solid(sv, sf)[0]), rel=1e-14)
     assert not any("winding corrected" in w for w in props.warnings)
+    # the volume they share counts twice, and the result says so
+    assert any("all wind outward and overlap" in w for w in props.warnings)
+
+
+@pytest.mark.parametrize(("origin", "overlap"), [((0.5, 0.25, 0.25), True), ((1.5, 0.0, 0.0), False), ((1.0, 0.0, 0.0), False)])
+def test_outward_shells_that_overlap_are_weighed_each_and_said_so(origin: tuple[float, float, float], overlap: bool) -> None:
+    # two unit boxes wound outward: overlapping (a corner region of 0.5 x 0.75 x 0.75 shared), apart, or touching
+    # along a face. Each is weighed as a solid, as trimesh and MuJoCo sum the signed volumes (2, whatever the
+    # overlap); where they overlap the shared volume counted twice is named
+    v, f = box(1.0, 1.0, 1.0)
+    cv, cf = box(1.0, 1.0, 1.0, origin=origin)
+    props = mass_properties(MeshBody(np.vstack([v, cv]), np.vstack([f, cf + len(v)])), density=1.0)
+    assert props.mass == pytest.approx(2.0, rel=1e-14)
+    assert any("all wind outward and overlap" in w for w in props.warnings) is overlap
 
 
 def test_zero_stored_volume_is_never_turned_into_a_body() -> None:
