@@ -31,6 +31,8 @@ of a shell is never re-wound on its own.
 
 from __future__ import annotations
 
+from collections.abc import Iterator
+
 import numpy as np
 from numpy.typing import NDArray
 
@@ -208,12 +210,15 @@ def _orient_outward(
 def _overlap_note(
     x: NDArray[np.float64], faces: NDArray[np.int64], label: NDArray[np.int64], solid: NDArray[np.bool_]
 ) -> list[str]:
-    """A warning where shells that all wind outward lie inside or across one another, else nothing.
+    """A warning where shells that all wind outward share volume, else nothing.
 
     Each such shell is weighed as a solid of its own, so the volume two of them share counts twice: the
     sum of the signed volumes, as trimesh, numpy-stl and MuJoCo read the file; the part may be their
-    union (a CAD export of touching bodies), which the file does not say.  ``solid``: the shells that
-    enclose volume (flat ones add none).  Beyond the nesting test's work limit nothing is said.
+    union (a CAD export of touching bodies), which the file does not say.  Shared volume is seen where
+    two shells have a face in common (a body stored twice) or a vertex of one lies inside another;
+    shells that cross with no vertex inside each other (two bars laid across as a plus sign) are not
+    seen.  ``solid``: the shells that enclose volume (flat ones add none).  Beyond the nesting test's
+    work limit nothing is said.
     """
     kept = np.flatnonzero(solid)
     if len(kept) < 2:
@@ -223,10 +228,12 @@ def _overlap_note(
     chosen = renumber[label] >= 0
     faces, label = faces[chosen], renumber[label[chosen]]
     count = len(kept)
+    corners = np.sort(faces, axis=1)
+    stored_twice = len(np.unique(corners, axis=0)) < len(corners)  # after the weld: the same three vertices
     # a vertex of one shell clearly inside another (winding number not 0) is volume the two share: with
     # every depth taken as 0, the crossing test looks for exactly that (vertices on another shell, where
     # shells merely touch, decide nothing)
-    if _crossing_shell(x, faces, label, count, np.zeros(count, dtype=np.int64), _OVERLAP_SAMPLES) is None:
+    if not stored_twice and _crossing_shell(x, faces, label, count, np.zeros(count, dtype=np.int64), _OVERLAP_SAMPLES) is None:
         return []
     return [
         f"the mesh's {count} shells all wind outward and overlap (some lie inside or across others): each is "
@@ -359,6 +366,26 @@ def _shell_boxes(
     return lo, hi
 
 
+def _box_partners(lo: NDArray[np.float64], hi: NDArray[np.float64], rows: int = 256) -> Iterator[tuple[int, NDArray[np.int64]]]:
+    """Each shell with the other shells whose bounding boxes meet its own.
+
+    The shells are swept in order of their boxes' lower x, a block of ``rows`` at a time against the
+    shells whose x ranges reach the block's: disjoint shells (a part library's thousand screws) cost a
+    sort, not every pair.
+    """
+    order = np.argsort(lo[:, 0], kind="stable")
+    lo_s, hi_s = lo[order], hi[order]
+    for start in range(0, len(lo), rows):
+        block = slice(start, start + rows)
+        stop = int(np.searchsorted(lo_s[:, 0], hi_s[block, 0].max(), side="right"))
+        reach = np.flatnonzero(hi_s[:stop, 0] >= lo_s[block, 0].min())
+        meets = np.all((lo_s[block, None, :] <= hi_s[None, reach, :]) & (hi_s[block, None, :] >= lo_s[None, reach, :]), axis=2)
+        for r, row in enumerate(meets):
+            t = int(order[start + r])
+            found = order[reach[row]]
+            yield t, found[found != t]
+
+
 _NESTING_ATTEMPTS = 4
 _CROSSING_SAMPLES = 24  # vertices of each nested shell tested against the shells around it
 _OVERLAP_SAMPLES = 256  # vertices of each outward shell tested for lying inside another (a warning, not a refusal)
@@ -387,14 +414,17 @@ def _crossing_shell(
     lo, hi = _shell_boxes(x, faces, label, count)
     sizes = np.diff(bounds)
     spent = 0
-    for t in range(count):
+    for t, partners in _box_partners(lo, hi):
+        if len(partners) == 0:
+            continue  # no other shell's box meets this one's: nothing to cross
         used = np.unique(faces[order[bounds[t] : bounds[t + 1]]])
         ends = np.concatenate([used[np.argmin(x[used], axis=0)], used[np.argmax(x[used], axis=0)]])
         spread = used[np.linspace(0, len(used) - 1, min(len(used), samples - len(ends))).astype(np.int64)]
         points = x[np.unique(np.concatenate([ends, spread]))]
-        # the shells whose boxes hold each point, all at once (points x shells)
-        near = np.all((lo[None, :, :] <= points[:, None, :]) & (hi[None, :, :] >= points[:, None, :]), axis=2)
-        near[:, t] = False
+        # the partners whose boxes hold each point, all at once (points x partners)
+        held = (lo[partners][None, :, :] <= points[:, None, :]) & (hi[partners][None, :, :] >= points[:, None, :])
+        near = np.zeros((len(points), count), dtype=bool)
+        near[:, partners] = np.all(held, axis=2)
         per_shell = near.sum(axis=0)
         others = np.flatnonzero(per_shell)
         if len(others) == 0:

@@ -237,3 +237,23 @@ def test_winding_numbers_agree_point_by_point() -> None:
     alone = [winding_numbers(v, f, p[None, :])[0] for p in pts]
     np.testing.assert_allclose(together, alone, atol=1e-12)
     np.testing.assert_allclose(np.abs(together), [1, 1, 0, 0], atol=1e-12)
+
+
+def test_a_body_stored_twice_is_weighed_twice_and_said_so() -> None:
+    # the same closed box twice, both copies outward (an exporter that wrote a body twice): every vertex of one
+    # copy lies on the other, so no vertex is inside; their common faces show the shared volume
+    v, f = box(1.0, 2.0, 3.0)
+    props = mass_properties(MeshBody(np.vstack([v, v]), np.vstack([f, f + len(v)])), density=1.0)
+    assert props.mass == pytest.approx(12.0, rel=1e-14)
+    assert any("all wind outward and overlap" in w for w in props.warnings)
+
+
+def test_many_disjoint_shells_get_no_overlap_warning() -> None:
+    # 3,000 separate unit boxes in a row (the overlap check sweeps their boxes rather than testing every pair)
+    v, f = box(1.0, 1.0, 1.0)
+    shift = np.repeat(np.arange(3000) * 2.0, len(v))[:, None] * np.array([1.0, 0.0, 0.0])
+    vertices = np.tile(v, (3000, 1)) + shift
+    faces = np.vstack([f + k * len(v) for k in range(3000)])
+    props = mass_properties(MeshBody(vertices, faces), density=1.0)
+    assert props.mass == pytest.approx(3000.0, rel=props.relative_error_estimate)
+    assert not any("overlap" in w for w in props.warnings)
