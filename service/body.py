@@ -16,7 +16,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from .errors import EmptyGeometryError, InvalidParameterError
 
-__all__ = ["MeshBody", "VolumeBody", "CellBlock", "PointBody", "BrepBody", "Part", "Body", "stored_eps"]
+__all__ = ["MeshBody", "VolumeBody", "CellBlock", "PointBody", "BrepBody", "Part", "Body", "few_points_valid", "stored_eps"]
 
 
 def _frozen(arr: ArrayLike, dtype: type[np.generic]) -> NDArray[Any]:
@@ -183,7 +183,7 @@ class PointBody:
             raise InvalidParameterError("each point needs a mass and a 3-component position")
         if len(m) == 0:
             raise EmptyGeometryError("no points were given; send at least one point mass")
-        if not (len(m) <= _FEW_POINTS and _few_points_valid(m, x, self.length_scale)):
+        if not (len(m) <= _FEW_POINTS and few_points_valid(m.tolist(), x.tolist(), self.length_scale, float(m.sum()))):
             _check_finite("masses", m)
             _check_finite("positions", x)
             if np.any(m <= 0):
@@ -203,17 +203,15 @@ _MIN_MOMENT_SCALE = float(np.finfo(np.float64).tiny) / float(np.finfo(np.float64
 _FEW_POINTS = 64  # up to this many points the checks run on Python floats (numpy's per-call cost dominates)
 
 
-def _few_points_valid(masses: NDArray[np.float64], positions: NDArray[np.float64], length_scale: float) -> bool:
+def few_points_valid(masses: list[float], positions: list[list[float]], length_scale: float, mass_sum: float) -> bool:
     """True when the checks below would all pass; False sends the body through them (to raise their errors).
 
-    The same comparisons on the same floats: max, min and their difference are exact in both, and the
-    mass sum is numpy's, as in ``_check_span``."""
-    ms = masses.tolist()
-    xs = positions.tolist()
-    if not all(math.isfinite(v) and v > 0 for v in ms) or not all(math.isfinite(c) for p in xs for c in p):
+    The same comparisons on the same floats: max, min and their difference are exact in both, and
+    ``mass_sum`` is numpy's sum of the masses, as in ``_check_span``."""
+    if not all(math.isfinite(v) and v > 0 for v in masses) or not all(math.isfinite(c) for p in positions for c in p):
         return False
-    span = max(max(column) - min(column) for column in zip(*xs)) * length_scale
-    return not (span > 0.0 and float(masses.sum()) * span * span < _MIN_MOMENT_SCALE)
+    span = max(max(column) - min(column) for column in zip(*positions)) * length_scale
+    return not (span > 0.0 and mass_sum * span * span < _MIN_MOMENT_SCALE)
 
 
 def _check_span(masses: NDArray[np.float64], positions: NDArray[np.float64], length_scale: float) -> None:

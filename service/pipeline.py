@@ -45,6 +45,7 @@ __all__ = [
     "analyze_loaded",
     "PrecessionResult",
     "precession",
+    "uncertain_class",
     "METHODS",
 ]
 
@@ -154,7 +155,7 @@ def analyze_loaded(loaded: Loaded, options: AnalysisOptions, start: float | None
         parts = part_results
     warnings = list(loaded.warnings) + list(props.warnings)
     if np.any(props.principal_moments):  # all zero (one point, or all at one place): no margin decided the class
-        warnings += _uncertain_class(cls, props.relative_error_estimate)
+        warnings += uncertain_class(cls, props.relative_error_estimate)
     if loaded.units_from == "file":
         warnings.append(f"length unit {loaded.units!r} taken from the file")
     warnings.extend(_unit_warning(loaded))
@@ -308,7 +309,7 @@ def _extent(body: Any) -> NDArray[np.float64] | None:
     return extent
 
 
-def _uncertain_class(cls: Classification, estimate: float) -> list[str]:
+def uncertain_class(cls: Classification, estimate: float) -> list[str]:
     """A warning where a margin that decided the class is nearer its tolerance than the moments' error
     allows (each gap is off by at most twice the relative error estimate): the class may differ."""
     margins = cls.margins

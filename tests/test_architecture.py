@@ -50,7 +50,7 @@ LAYERS: list[tuple[str, list[str]]] = [
     ("motion", ["motion"]),
     ("derived", ["export", "frames", "rotational"]),
     ("results", ["options", "results", "report"]),
-    ("pipeline", ["pipeline"]),
+    ("pipeline", ["pipeline", "few_points"]),
     ("surfaces", ["api", "app", "batch", "cli", "web", "__main__", ""]),
 ]
 

@@ -129,12 +129,12 @@ def test_kappa_does_not_depend_on_scale(scale: float) -> None:
 def test_a_class_decided_within_the_error_estimate_is_flagged() -> None:
     """I2 - I1 = 1.5e-6 I3 against the tolerance 1e-6: asymmetric, but with moments known only to 1e-3
     (a CAD file whose faces leave gaps) that gap says nothing, and the result must say so."""
-    from inertia.pipeline import _uncertain_class
+    from inertia.pipeline import uncertain_class
 
     cls = classify(PrincipalFrame.from_eigen(np.array([1.0, 1.0 + 3e-6, 2.0]), np.eye(3), 1e-6))
     assert cls.rotor is RotorClass.ASYMMETRIC
-    [warning] = _uncertain_class(cls, 1e-3)
+    [warning] = uncertain_class(cls, 1e-3)
     assert "(I2 - I1) / I3 = 1.5e-06" in warning and "1e-06" in warning and "0.001" in warning
-    assert _uncertain_class(cls, 1e-12) == []
+    assert uncertain_class(cls, 1e-12) == []
     exact = classify(PrincipalFrame.from_eigen(np.array([1.0, 1.0, 2.0]), np.eye(3), 1e-6))
-    assert _uncertain_class(exact, 1e-12) == []
+    assert uncertain_class(exact, 1e-12) == []

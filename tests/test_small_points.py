@@ -18,7 +18,7 @@ import inertia.mass.points as small
 from inertia.ddouble import rotated
 from inertia.errors import ServiceError
 from inertia.integrals import Sums, point_sums
-from inertia.mass.points import SMALL_POINTS, _pairwise, small_point_sums
+from inertia.mass.points import SMALL_POINTS, pairwise_sum, small_point_sums
 from inertia.options import AnalysisOptions
 from inertia.pipeline import analyze_points
 
@@ -76,7 +76,7 @@ def test_sums_equal_the_numpy_kernels_bit_for_bit(points: tuple[np.ndarray, np.n
 @settings(max_examples=300, deadline=None)
 @given(st.lists(st.floats(min_value=-1e300, max_value=1e300, allow_nan=False), min_size=1, max_size=128))
 def test_pairwise_sum_is_numpys(values: list[float]) -> None:
-    assert np.float64(_pairwise(values)).tobytes() == np.array(values).sum().tobytes()
+    assert np.float64(pairwise_sum(values)).tobytes() == np.array(values).sum().tobytes()
 
 
 def _analysis(m: np.ndarray, x: np.ndarray, options: dict[str, Any]) -> str:

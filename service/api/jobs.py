@@ -29,6 +29,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from ..errors import InvalidParameterError, ServiceError
+from ..few_points import few_points_document
 from ..pipeline import AnalysisOptions, analyze_loaded, analyze_points, precession
 from .transport import PayloadTooLargeError
 
@@ -92,7 +93,9 @@ class PointsJob:
     memory_limit_bytes: int | None = None
 
     def __call__(self) -> dict[str, Any]:
-        return analyze_points(self.records, self.options).as_dict()
+        # a few plain point masses: the same document without the general pipeline's objects
+        doc = few_points_document(self.records, self.options)
+        return analyze_points(self.records, self.options).as_dict() if doc is None else doc
 
 
 @dataclass(frozen=True, slots=True)

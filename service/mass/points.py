@@ -8,7 +8,7 @@ nearest, on every platform Python supports):
 - ``ddouble.rotated``: the exact difference (TwoSum) and the compensated dot products (Dekker's
   TwoProduct) are elementwise, so their order is the expression's;
 - ``integrals.point_sums``: numpy reduces an (n, 3) array along its rows one row after another,
-  starting from 0.0; a contiguous vector is summed pairwise (``_pairwise``: numpy's
+  starting from 0.0; a contiguous vector is summed pairwise (``pairwise_sum``: numpy's
   ``pairwise_sum``, eight accumulators for up to 128 terms), also after 0.0.
 
 Overflow: the numpy kernels run under ``errstate(over="raise", invalid="raise")``.  Here an overflow
@@ -27,13 +27,13 @@ from numpy.typing import NDArray
 from ..ddouble import SPLIT
 from ..integrals import IJ, Sums
 
-__all__ = ["SMALL_POINTS", "Moments", "as_sums", "point_moments", "small_point_sums"]
+__all__ = ["SMALL_POINTS", "Moments", "as_sums", "pairwise_sum", "point_moments", "small_point_sums"]
 
 SMALL_POINTS = 16
 """Point sets up to this size are summed here (numpy wins above a few dozen points)."""
 
 
-def _pairwise(a: list[float]) -> float:
+def pairwise_sum(a: list[float]) -> float:
     """numpy's sum of a contiguous float64 vector of at most 128 terms, in its order."""
     n = len(a)
     if n < 8:
@@ -153,7 +153,7 @@ def as_sums(found: Moments, n: int) -> Sums:
 
 
 def _short_sums(masses: list[float], x: list[list[float]]) -> Moments:
-    """The sums of fewer than eight points, each accumulated in point order from 0.0 (``_pairwise``)."""
+    """The sums of fewer than eight points, each accumulated in point order from 0.0 (``pairwise_sum``)."""
     a0 = a1 = a2 = s00 = s11 = s22 = s01 = s02 = s12 = d0 = d1 = d2 = total = 0.0
     for m, (x0, x1, x2) in zip(masses, x):
         mx0, mx1, mx2 = m * x0, m * x1, m * x2
@@ -181,6 +181,6 @@ def _long_sums(masses: list[float], x: list[list[float]]) -> Moments:
         m1[2] += m * xi[2]
     m2 = [[0.0] * 3 for _ in range(3)]
     for i, j in IJ:
-        m2[i][j] = m2[j][i] = _pairwise([m * xi[i] * xi[j] for m, xi in zip(masses, x)])
-    diag = [_pairwise([m * (xi[i] * xi[i]) for m, xi in zip(masses, x)]) for i in range(3)]
-    return m1, m2, diag, _pairwise(masses)
+        m2[i][j] = m2[j][i] = pairwise_sum([m * xi[i] * xi[j] for m, xi in zip(masses, x)])
+    diag = [pairwise_sum([m * (xi[i] * xi[i]) for m, xi in zip(masses, x)]) for i in range(3)]
+    return m1, m2, diag, pairwise_sum(masses)

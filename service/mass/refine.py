@@ -38,7 +38,16 @@ from ..tolerances import EPS, Tolerances
 from . import points as small_points
 from .geometry import Geometry
 
-__all__ = ["FRAME_SETTLED", "MAX_PASSES", "Refined", "refine"]
+__all__ = [
+    "FRAME_SETTLED",
+    "MAX_PASSES",
+    "FewPoints",
+    "Refined",
+    "moment_errors",
+    "refine",
+    "refine_few_points",
+    "zero_point_moments",
+]
 
 MAX_PASSES = 4  # one coarse pass plus refinements; the frame settles in 2-3
 FRAME_SETTLED = 1e-7  # off-diagonal / sqrt(diag product) below this: the next pass moves moments < 1e-14
@@ -145,7 +154,31 @@ def _list_tensor(found: small_points.Moments) -> tuple[list[float], list[list[fl
 
 
 def _refine_few_points(geometry: Geometry, tolerances: Tolerances) -> Refined | None:
-    """``refine`` for a few point masses, bit for bit, on Python floats.
+    """``refine`` for a few point masses, bit for bit, on Python floats (``refine_few_points``)."""
+    masses, points = geometry.small_lists()
+    found = refine_few_points(masses, points, tolerances)
+    if found is None:
+        return None
+    return _finished(
+        geometry, small_points.as_sums(found.moments, len(masses)), found.com, found.rotation, np.array(found.values), found.step
+    )
+
+
+@dataclass(frozen=True, slots=True)
+class FewPoints:
+    """The last pass of ``refine_few_points``: its sums about ``com`` in the frame ``rotation`` (whose
+    columns are the axes in the input frame), the moments it found, and the last step where the frame
+    did not settle (None where it did)."""
+
+    moments: small_points.Moments
+    com: NDArray[np.float64]
+    rotation: NDArray[np.float64]
+    values: list[float]
+    step: float | None
+
+
+def refine_few_points(masses: list[float], points: list[list[float]], tolerances: Tolerances) -> FewPoints | None:
+    """``refine``'s passes for a few point masses, bit for bit, on Python floats.
 
     A handful of points is a few dozen flops per pass; numpy's fixed cost per call (and the ``Sums``
     of every pass) was most of the time.  The operations and their order are ``refine``'s: the
@@ -153,7 +186,6 @@ def _refine_few_points(geometry: Geometry, tolerances: Tolerances) -> Refined | 
     numpy's (its BLAS may fuse their multiply-adds).  None where a number is not finite: ``refine``
     then decides, with its own errors.
     """
-    masses, points = geometry.small_lists()
     origin = [lo + 0.5 * (hi - lo) for lo, hi in ((min(column), max(column)) for column in zip(*points))]
     found = small_points.point_moments(masses, points, origin, None)
     if found is None:
@@ -183,7 +215,7 @@ def _refine_few_points(geometry: Geometry, tolerances: Tolerances) -> Refined | 
         if settled:
             step = None
             break
-    return _finished(geometry, small_points.as_sums(found, len(masses)), com, rotation, np.array(values), step)
+    return FewPoints(found, com, rotation, values, step)
 
 
 def _physical_moments(
@@ -197,11 +229,8 @@ def _physical_moments(
     whose integration gives a moment within its rounding of zero, or below,
     is not a body (its faces cross or its shells are degenerate) and is refused.
     """
-    low = values <= errors
     if geometry.kind == "points":
-        # the second pass's rotation leaves a line's points off it by ~eps of their spread: a smallest
-        # moment below 64 eps of the largest (the motion's rounding level) is that, not a size
-        low |= values <= 64 * EPS * float(np.max(values))
+        low = np.array(zero_point_moments(values.tolist(), errors.tolist()))
         if not np.any(low):
             return values, ()
         if bool(np.all(low)):  # a single point, or all the mass at one place: every moment is zero
@@ -211,6 +240,7 @@ def _physical_moments(
         return np.where(low, 0.0, values), (
             "the smallest principal moment is zero within rounding (the points lie on a line) and is reported as 0",
         )
+    low = values <= errors
     order = np.sort(values)
     slack = float(errors.sum())
     if np.any(low) or order[0] + order[1] < order[2] - slack:
@@ -221,6 +251,14 @@ def _physical_moments(
             moments=[float(x) for x in order],
         )
     return values, ()
+
+
+def zero_point_moments(values: list[float], errors: list[float]) -> list[bool]:
+    """Which moments of a point set are zero within rounding: within their error bound, or (the second
+    pass's rotation leaves a line's points off it by ~eps of their spread) below 64 eps of the largest
+    moment, the motion's rounding level."""
+    line = 64 * EPS * max(values)
+    return [v <= e or v <= line for v, e in zip(values, errors)]
 
 
 _RESOLUTION_REFUSE = 1.0
@@ -368,14 +406,22 @@ def _error_estimate(s: Sums, moments: NDArray[np.float64]) -> tuple[float, NDArr
     blocks, bounded by gamma * sum |terms| with gamma growing as the depth of
     the two trees (Higham, Accuracy and Stability of Numerical Algorithms, §4.2).
     """
-    per_block = max(2, math.ceil(s.terms / max(s.blocks, 1)))
-    gamma = (math.log2(per_block) + math.log2(max(s.blocks, 1)) + 4) * EPS
-    # Python floats, the same operations as on the arrays (a 3-vector costs numpy more per call than the work)
-    d = [gamma * a + 8 * EPS * e for a, e in zip(s.abs_m2.diagonal().tolist(), s.element_err.tolist())]
+    estimate, errors = moment_errors(s.abs_m2.diagonal().tolist(), s.element_err.tolist(), s.terms, s.blocks, moments.tolist())
+    return estimate, np.array(errors)
+
+
+def moment_errors(
+    abs_diagonal: list[float], element_err: list[float], terms: int, blocks: int, moments: list[float]
+) -> tuple[float, list[float]]:
+    """``_error_estimate`` on Python floats: the sums' ``abs_m2`` diagonal and ``element_err``, the
+    count of terms and blocks, and the moments (a 3-vector costs numpy more per call than the work)."""
+    per_block = max(2, math.ceil(terms / max(blocks, 1)))
+    gamma = (math.log2(per_block) + math.log2(max(blocks, 1)) + 4) * EPS
+    d = [gamma * a + 8 * EPS * e for a, e in zip(abs_diagonal, element_err)]
     errors = [d[1] + d[2], d[0] + d[2], d[0] + d[1]]
-    live = [err / m for err, m in zip(errors, moments.tolist()) if m > err]
+    live = [err / m for err, m in zip(errors, moments) if m > err]
     worst = max(live) if live else 1.0
-    return max(worst, 4 * EPS), np.array(errors)
+    return max(worst, 4 * EPS), errors
 
 
 def _check_volume(s: Sums, kind: str) -> None:
