@@ -13,6 +13,7 @@ constants A = 1/I1 >= B = 1/I2 >= C = 1/I3 (Ray, Z. Physik 78, 1932).
 from __future__ import annotations
 
 import enum
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -20,7 +21,7 @@ from numpy.typing import NDArray
 
 from .principal import PrincipalFrame, equal_moment_pairs
 
-__all__ = ["RotorClass", "Margins", "Classification", "classify", "ray_asymmetry"]
+__all__ = ["RotorClass", "Margins", "Classification", "classify", "classify_moments", "ray_asymmetry"]
 
 
 class RotorClass(enum.Enum):
@@ -87,7 +88,7 @@ class Classification:
         return self.rotor.shape
 
 
-def ray_asymmetry(moments: NDArray[np.float64]) -> float:
+def ray_asymmetry(moments: Sequence[float] | NDArray[np.float64]) -> float:
     """Ray's kappa from ascending moments, as [I3(I1-I2) + I1(I3-I2)] / [I2(I3-I1)].
 
     That form (kappa multiplied through by I1 I2 I3) uses only moment gaps,
@@ -100,19 +101,22 @@ def ray_asymmetry(moments: NDArray[np.float64]) -> float:
 
 def classify(frame: PrincipalFrame, tolerance: float | None = None) -> Classification:
     """Classify the body whose principal frame is ``frame``."""
-    tol = frame.tolerance if tolerance is None else tolerance
-    i1, i2, i3 = (float(x) for x in frame.moments)
+    return classify_moments(frame.moments.tolist(), frame.axes, frame.tolerance if tolerance is None else tolerance)
+
+
+def classify_moments(moments: list[float], axes: NDArray[np.float64], tol: float) -> Classification:
+    """``classify`` on the ascending moments and the principal axes (rows) of a frame."""
+    i1, i2, i3 = moments
     if i3 == 0.0:  # all mass at one point: no axis is distinguished, every moment is zero
         return Classification(RotorClass.SPHERICAL, None, None, True, tol, Margins())
     margins = Margins(gap12=(i2 - i1) / i3, gap23=(i3 - i2) / i3, smallest=i1 / i3, planarity=abs(i1 + i2 - i3) / i3)
-    pairs = equal_moment_pairs(frame.moments, tol)
+    pairs = equal_moment_pairs(moments, tol)
     planar = margins.planarity <= tol
-    axes = frame.axes
     if len(pairs) == 3:
         return Classification(RotorClass.SPHERICAL, None, None, planar, tol, margins)
     if pairs == ((1, 2),) and margins.smallest <= tol:
         return Classification(RotorClass.LINEAR, axes[0].copy(), None, planar, tol, margins)
-    kappa = ray_asymmetry(frame.moments)
+    kappa = ray_asymmetry(moments)
     if pairs == ((1, 2),):
         return Classification(RotorClass.SYMMETRIC_PROLATE, axes[0].copy(), kappa, planar, tol, margins)
     if pairs == ((0, 1),):

@@ -60,7 +60,8 @@ def orient_axes(axes: NDArray[np.float64]) -> NDArray[np.float64]:
     rows = np.asarray(axes, dtype=np.float64).tolist()
     for i in (0, 1):
         row = rows[i]
-        if not all(math.isfinite(x) for x in row):  # numpy's argmax takes the first NaN: keep its rule
+        # numpy's argmax takes the first NaN: keep its rule (a finite sum needs no look at each entry)
+        if not math.isfinite(row[0] + row[1] + row[2]) and not all(math.isfinite(x) for x in row):
             k = int(np.argmax(np.abs(row)))
         else:
             magnitudes = [abs(x) for x in row]
@@ -69,8 +70,14 @@ def orient_axes(axes: NDArray[np.float64]) -> NDArray[np.float64]:
             rows[i] = [-x for x in row]
     (a0, a1, a2), (b0, b1, b2) = rows[0], rows[1]
     out = np.array([rows[0], rows[1], [a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0]])  # a x b
-    out[2] /= np.linalg.norm(out[2])
+    out[2] /= _norm(out[2])
     return out + 0.0  # -0.0 becomes 0.0: the same axis prints the same way
+
+
+def _norm(v: NDArray[np.float64]) -> float:
+    """``np.linalg.norm`` of a contiguous float64 vector without its dispatch: the root of the same
+    ``v.dot(v)`` (BLAS, which may fuse its multiply-adds), correctly rounded in both."""
+    return math.sqrt(float(v.dot(v)))
 
 
 def _sqrt(x: float) -> float:
@@ -102,7 +109,7 @@ def quaternion_from_matrix(matrix: NDArray[np.float64]) -> NDArray[np.float64]:
         s = 2.0 * _sqrt(1.0 - m00 - m11 + m22)
         q = [(m10 - m01) / s, (m02 + m20) / s, (m12 + m21) / s, 0.25 * s]
     quat = np.array(q, dtype=np.float64)
-    quat /= np.linalg.norm(quat)
+    quat /= _norm(quat)
     if quat[0] < 0:
         quat = -quat
     return quat

@@ -43,7 +43,13 @@ def jacobi_lists(m: list[list[float]], tolerances: Tolerances = DEFAULT_TOLERANC
     # Python floats: the same IEEE binary64 operations as numpy's, without its overhead per call on a 3x3.
     # Symmetrised without overflow: an entry equal to its mirror stays itself (even above 9e307, where x + x
     # is inf); otherwise 0.5 x + 0.5 y is the rounded mean, as 0.5 (x + y) is wherever that does not overflow
-    a = [[_mean(m[i][j], m[j][i]) for j in range(3)] for i in range(3)]
+    (m00, m01, m02), (m10, m11, m12), (m20, m21, m22) = m
+    # a diagonal entry is its own mean; each off-diagonal one keeps its own side's sign of zero
+    a = [
+        [m00, _mean(m01, m10), _mean(m02, m20)],
+        [_mean(m10, m01), m11, _mean(m12, m21)],
+        [_mean(m20, m02), _mean(m21, m12), m22],
+    ]
     exponent = _safe_exponent(a)
     if exponent:
         a = [[math.ldexp(x, -exponent) for x in row] for row in a]

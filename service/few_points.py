@@ -6,7 +6,7 @@ model and its serialiser) cost several times the arithmetic in objects and
 numpy calls on 3-vectors.  ``few_points_document`` computes the same document
 on Python floats from the same kernels: ``refine.refine_few_points`` for the
 passes, ``refine.moment_errors`` for the bound, ``conventions`` for the axes and
-the quaternion, ``classification.classify`` for the class, and the pipeline's
+the quaternion, ``classification.classify_moments`` for the class, and the pipeline's
 own warning rules.  Its answer is the general path's, byte for byte
 (``tests/test_few_points.py`` compares them on generated point sets).
 
@@ -27,13 +27,13 @@ from typing import Any
 import numpy as np
 
 from .body import few_points_valid
-from .classification import classify
+from .classification import classify_moments
 from .conventions import LENGTH_UNITS, orient_axes, quaternion_from_matrix
 from .mass.points import SMALL_POINTS, pairwise_sum
 from .mass.refine import moment_errors, refine_few_points, zero_point_moments
 from .options import AnalysisOptions
 from .pipeline import uncertain_class
-from .principal import PrincipalFrame, equal_moment_pairs
+from .principal import equal_moment_pairs
 from .results import radii_of_gyration
 from .tolerances import DEFAULT_TOLERANCES, EPS
 
@@ -109,14 +109,13 @@ def few_points_document(records: list[dict[str, Any]], options: AnalysisOptions)
     if not (math.isfinite(mass) and all(map(math.isfinite, com)) and all(math.isfinite(x) for row in matrix for x in row)):
         return None
     estimate = max(float(estimate + 8 * EPS), 0.0)
-    # the principal frame: ascending moments (a stable order), oriented axes, the quaternion
+    # the principal frame (``PrincipalFrame.from_eigen``): ascending moments in a stable order, oriented
+    # axes, the quaternion; then the class
     order = sorted(range(3), key=moments.__getitem__)
-    ascending = np.array([moments[k] for k in order])
+    ascending = [moments[k] for k in order]
     axes = orient_axes(rotation.T[order])
-    frame = PrincipalFrame(
-        ascending, axes, quaternion_from_matrix(axes.T), not equal_moment_pairs(ascending, options.tolerance), options.tolerance
-    )
-    cls = classify(frame)
+    tolerance = options.tolerance
+    cls = classify_moments(ascending, axes, tolerance)
     warnings = uncertain_class(cls, estimate)
     classification: dict[str, Any] = {"kind": cls.kind}
     if cls.shape is not None:
@@ -139,11 +138,11 @@ def few_points_document(records: list[dict[str, Any]], options: AnalysisOptions)
         "center_of_mass": com,
         "inertia_tensor": matrix,
         "principal": {
-            "moments": frame.moments.tolist(),
-            "axes": frame.axes.tolist(),
-            "quaternion": frame.quaternion.tolist(),
-            "unique_axes": bool(frame.unique_axes),
-            **({"radii_of_gyration": radii_of_gyration(frame.moments, mass)} if mass > 0 else {}),
+            "moments": ascending,
+            "axes": axes.tolist(),
+            "quaternion": quaternion_from_matrix(axes.T).tolist(),
+            "unique_axes": not equal_moment_pairs(ascending, tolerance),
+            **({"radii_of_gyration": radii_of_gyration(ascending, mass)} if mass > 0 else {}),
         },
         "classification": classification,
         "warnings": warnings,

@@ -6,6 +6,7 @@ high relative accuracy for every moment, the smallest of a needle included.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
@@ -166,7 +167,7 @@ def tensor_frame(tensor: NDArray[np.float64], tolerance: float = DEFAULT_TOLERAN
     return TensorFrame(frame, errors, relative, axes_error, tuple(warnings))
 
 
-def equal_moment_pairs(moments: NDArray[np.float64], tolerance: float) -> tuple[tuple[int, int], ...]:
+def equal_moment_pairs(moments: Sequence[float] | NDArray[np.float64], tolerance: float) -> tuple[tuple[int, int], ...]:
     """Pairs of sorted moments equal within ``tolerance`` x largest moment.
 
     The decision looks at all gaps at once, so it cannot depend on the order of

@@ -66,55 +66,60 @@ def _shifted(points: list[list[float]], origin: list[float]) -> list[list[float]
 def _rotated(points: list[list[float]], origin: list[float], rotation: list[list[float]]) -> list[list[float]]:
     """``ddouble.rotated``: (points - origin) @ rotation, each coordinate rounded once from double-double.
 
-    ``ddouble.two_prod`` is written out in place (Dekker's TwoProduct, the same operations): a call per
-    product would cost more than the product.
+    ``ddouble.two_prod`` and ``two_sum`` are written out in place (Dekker's TwoProduct and Knuth's
+    TwoSum, the same operations in the same order), and the three terms of each coordinate unrolled:
+    a call per product would cost more than the product.
     """
     split = SPLIT
-    neg = [-origin[0], -origin[1], -origin[2]]
-    # the rotation's entries split once (Dekker): r, its high and low halves
-    parts: list[list[tuple[float, float, float]]] = []
-    for i in range(3):
-        halves = []
-        for j in range(3):
+    n0, n1, n2 = -origin[0], -origin[1], -origin[2]
+    # each column of the rotation: its entries r, their high and low halves (Dekker's split), once
+    columns = []
+    for j in range(3):
+        column: list[float] = []
+        for i in range(3):
             r = rotation[i][j]
             cr = split * r
             rh = cr - (cr - r)
-            halves.append((r, rh, r - rh))
-        parts.append(halves)
+            column += (r, rh, r - rh)
+        columns.append(column)
     out = []
-    for p in points:
-        d_hi = [0.0, 0.0, 0.0]
-        d_lo = [0.0, 0.0, 0.0]
-        d_split = [(0.0, 0.0)] * 3
-        for i in range(3):
-            a, b = p[i], neg[i]
-            s = a + b
-            bb = s - a
-            d_hi[i] = s
-            d_lo[i] = (a - (s - bb)) + (b - bb)
-            cs = split * s
-            sh = cs - (cs - s)
-            d_split[i] = (sh, s - sh)
+    for x0, x1, x2 in points:
+        # d = x - origin as double-double (TwoSum), and the split of its high part
+        s0 = x0 + n0
+        b = s0 - x0
+        l0 = (x0 - (s0 - b)) + (n0 - b)
+        c = split * s0
+        h0 = c - (c - s0)
+        t0 = s0 - h0
+        s1 = x1 + n1
+        b = s1 - x1
+        l1 = (x1 - (s1 - b)) + (n1 - b)
+        c = split * s1
+        h1 = c - (c - s1)
+        t1 = s1 - h1
+        s2 = x2 + n2
+        b = s2 - x2
+        l2 = (x2 - (s2 - b)) + (n2 - b)
+        c = split * s2
+        h2 = c - (c - s2)
+        t2 = s2 - h2
         row = []
-        for j in range(3):
-            r, rh, rl = parts[0][j]
-            d = d_hi[0]
-            dh, dl = d_split[0]
-            hi = r * d
-            lo = ((rh * dh - hi) + rh * dl + rl * dh) + rl * dl
-            lo = lo + r * d_lo[0]
-            for i in (1, 2):
-                r, rh, rl = parts[i][j]
-                d = d_hi[i]
-                dh, dl = d_split[i]
-                q = r * d
-                e = ((rh * dh - q) + rh * dl + rl * dh) + rl * dl
-                s = hi + q
-                bb = s - hi
-                e2 = (hi - (s - bb)) + (q - bb)
-                hi = s
-                lo = lo + (e + e2 + r * d_lo[i])
-            row.append(hi + lo)
+        for r0, rh0, rl0, r1, rh1, rl1, r2, rh2, rl2 in columns:
+            hi = r0 * s0
+            lo = ((rh0 * h0 - hi) + rh0 * t0 + rl0 * h0) + rl0 * t0
+            lo = lo + r0 * l0
+            q = r1 * s1
+            e = ((rh1 * h1 - q) + rh1 * t1 + rl1 * h1) + rl1 * t1
+            s = hi + q
+            b = s - hi
+            lo = lo + (e + ((hi - (s - b)) + (q - b)) + r1 * l1)
+            hi = s
+            q = r2 * s2
+            e = ((rh2 * h2 - q) + rh2 * t2 + rl2 * h2) + rl2 * t2
+            s = hi + q
+            b = s - hi
+            lo = lo + (e + ((hi - (s - b)) + (q - b)) + r2 * l2)
+            row.append(s + lo)
         out.append(row)
     return out
 
@@ -132,7 +137,11 @@ def point_moments(
     # under eight points numpy's pairwise sum is a plain one from 0.0: every sum in one loop
     found = _short_sums(masses, x) if len(masses) < 8 else _long_sums(masses, x)
     m1, m2, diag, total = found
-    if not all(math.isfinite(v) for v in (*m1, *m2[0], *m2[1], *m2[2], *diag, total)):
+    # a finite sum has finite terms; only where it is not (or overflows) is each one looked at
+    (a0, a1, a2), ((s00, s01, s02), (_, s11, s12), (_, _, s22)) = m1, m2
+    if not math.isfinite(a0 + a1 + a2 + s00 + s01 + s02 + s11 + s12 + s22 + diag[0] + diag[1] + diag[2] + total) and not all(
+        math.isfinite(v) for v in (*m1, *m2[0], *m2[1], *m2[2], *diag, total)
+    ):
         return None
     return found
 

@@ -142,15 +142,17 @@ def _finished(
 
 
 def _list_tensor(found: small_points.Moments) -> tuple[list[float], list[list[float]]]:
-    """``_covariance`` then ``_inertia_from_covariance`` on Python floats, the same operations."""
-    m1, m2, _, total = found
-    c = [m1[0] / total, m1[1] / total, m1[2] / total]
-    cov = [[m2[i][j] - total * (c[i] * c[j]) for j in range(3)] for i in range(3)]
-    tensor = [[-x for x in row] for row in cov]
-    for i in range(3):
-        j, k = (i + 1) % 3, (i + 2) % 3
-        tensor[i][i] = cov[j][j] + cov[k][k]
-    return c, tensor
+    """``_covariance`` then ``_inertia_from_covariance`` on Python floats, the same operations (m2 is
+    symmetric, and so is every product c_i c_j: each entry is computed once for both sides)."""
+    m1, (m2_0, m2_1, m2_2), _, total = found
+    c0, c1, c2 = m1[0] / total, m1[1] / total, m1[2] / total
+    v00 = m2_0[0] - total * (c0 * c0)
+    v11 = m2_1[1] - total * (c1 * c1)
+    v22 = m2_2[2] - total * (c2 * c2)
+    t01 = -(m2_0[1] - total * (c0 * c1))
+    t02 = -(m2_0[2] - total * (c0 * c2))
+    t12 = -(m2_1[2] - total * (c1 * c2))
+    return [c0, c1, c2], [[v11 + v22, t01, t02], [t01, v22 + v00, t12], [t02, t12, v00 + v11]]
 
 
 def _refine_few_points(geometry: Geometry, tolerances: Tolerances) -> Refined | None:
