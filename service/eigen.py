@@ -21,6 +21,7 @@ from .tolerances import DEFAULT_TOLERANCES, Tolerances
 __all__ = ["jacobi_eigh", "jacobi_lists"]
 
 _PAIRS = ((0, 1), (0, 2), (1, 2))
+_TRIPLES = ((0, 1, 2), (0, 2, 1), (1, 2, 0))  # each pair (p, q) of the sweep, and the third index r
 
 
 def jacobi_eigh(
@@ -57,9 +58,9 @@ def jacobi_lists(m: list[list[float]], tolerances: Tolerances = DEFAULT_TOLERANC
     for _ in range(tolerances.jacobi_max_sweeps):
         if _off_diagonal_negligible(a, tolerances.jacobi_rel):
             break
-        for p, q in _PAIRS:
-            _rotate(a, v, p, q)
-    return [math.ldexp(a[i][i], exponent) for i in range(3)], v
+        for p, q, r in _TRIPLES:
+            _rotate(a[p], a[q], a[r], v, p, q, r)
+    return [math.ldexp(a[0][0], exponent), math.ldexp(a[1][1], exponent), math.ldexp(a[2][2], exponent)], v
 
 
 # The negligibility test multiplies two diagonal entries: entries beyond 2**±480 would overflow to inf (every
@@ -91,26 +92,26 @@ def _off_diagonal_negligible(a: list[list[float]], rel: float) -> bool:
     return True
 
 
-def _rotate(a: list[list[float]], v: list[list[float]], p: int, q: int) -> None:
+def _rotate(ap: list[float], aq: list[float], ar: list[float], v: list[list[float]], p: int, q: int, r: int) -> None:
     """One rotation in the (p, q) plane: a <- R^T a R and v <- v R, R = [[c, s], [-s, c]] in rows and
-    columns p, q, chosen so that the new a[p][q] is zero."""
-    apq = a[p][q]
+    columns p, q, chosen so that the new a[p][q] is zero.  ``ap``, ``aq``, ``ar`` are the rows p, q and
+    r of a, r the third index."""
+    apq = ap[q]
     if apq == 0.0:
         return
     # where a[p][q] is negligible theta * theta overflows to inf (Python floats raise no warning for it)
     # and t goes to 0 as it should
-    theta = (a[q][q] - a[p][p]) / (2.0 * apq)
+    theta = (aq[q] - ap[p]) / (2.0 * apq)
     t = math.copysign(1.0, theta) / (abs(theta) + math.sqrt(theta * theta + 1.0))
     c = 1.0 / math.sqrt(t * t + 1.0)
     s = t * c
     tau = s / (1.0 + c)  # c = 1 - s tau: the off-plane updates below add a small correction to each entry
-    a[p][p] -= t * apq
-    a[q][q] += t * apq
-    a[p][q] = a[q][p] = 0.0
-    r = 3 - p - q  # the third index
-    arp, arq = a[r][p], a[r][q]
-    a[r][p] = a[p][r] = arp - s * (arq + tau * arp)
-    a[r][q] = a[q][r] = arq + s * (arp - tau * arq)
+    ap[p] -= t * apq
+    aq[q] += t * apq
+    ap[q] = aq[p] = 0.0
+    arp, arq = ar[p], ar[q]
+    ar[p] = ap[r] = arp - s * (arq + tau * arp)
+    ar[q] = aq[r] = arq + s * (arp - tau * arq)
     for row in v:
         vp, vq = row[p], row[q]
         row[p] = vp - s * (vq + tau * vp)

@@ -24,13 +24,11 @@ import time
 from dataclasses import fields
 from typing import Any
 
-import numpy as np
-
 from .body import few_points_valid
 from .classification import classify_moments
 from .conventions import LENGTH_UNITS, orient_axes, quaternion_from_matrix
 from .mass.points import SMALL_POINTS, pairwise_sum
-from .mass.refine import moment_errors, refine_few_points, zero_point_moments
+from .mass.refine import frame_tensor, moment_errors, refine_few_points, zero_point_moments
 from .options import AnalysisOptions
 from .pipeline import uncertain_class
 from .principal import equal_moment_pairs
@@ -98,8 +96,7 @@ def few_points_document(records: list[dict[str, Any]], options: AnalysisOptions)
     if any(zero_point_moments(values, errors)):
         return None  # a line or a single place: the general path reports those moments as 0, with a warning
     rotation = refined.rotation
-    tensor = rotation @ np.diag(values) @ rotation.T
-    tensor = 0.5 * (tensor + tensor.T)
+    tensor = frame_tensor(rotation, values)
     # the material of point masses: their own masses; lengths scale by L, moments by L^2
     inertia_scale = 1.0 * L**2
     mass = total * (1.0 * L**0)

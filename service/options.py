@@ -15,6 +15,8 @@ from .errors import InvalidParameterError
 from .tolerances import DEFAULT_TOLERANCES
 from .vocabulary import METHODS, MODELS, ExportFormat, Geometry, Isotopes, MassUnit, Model, MotionMethod, values
 
+_EXPORT_FORMATS, _ISOTOPES, _MASS_UNITS, _GEOMETRIES = (values(e) for e in (ExportFormat, Isotopes, MassUnit, Geometry))
+
 __all__ = ["AnalysisOptions", "METHODS", "DEFAULT_OPTIONS"]
 
 
@@ -101,7 +103,7 @@ class AnalysisOptions:
 
 def _check_v11(options: AnalysisOptions) -> None:
     """The options of API 1.1: export, frame, isotopes, mass_unit."""
-    formats = values(ExportFormat)
+    formats = _EXPORT_FORMATS
     if options.export is not None and options.export not in formats:
         raise InvalidParameterError(f"export must be one of {', '.join(formats)}, got {options.export!r}", parameter="export")
     if options.frame is not None:
@@ -109,15 +111,15 @@ def _check_v11(options: AnalysisOptions) -> None:
 
         frame_rotation(options.frame)  # refused here if it is no unit quaternion; normalised in the section
         object.__setattr__(options, "frame", tuple(float(v) for v in options.frame))
-    if options.isotopes not in values(Isotopes):
+    if options.isotopes not in _ISOTOPES:
         raise InvalidParameterError(f"isotopes must be 'standard' or 'abundant', got {options.isotopes!r}", parameter="isotopes")
-    if options.mass_unit not in values(MassUnit):
+    if options.mass_unit not in _MASS_UNITS:
         raise InvalidParameterError(f"mass_unit must be 'kg' or 'u', got {options.mass_unit!r}", parameter="mass_unit")
 
 
 def _check_geometry(geometry: str, deflection: float | None) -> None:
     """CAD files: ``geometry`` brep or mesh; ``deflection`` (mesh only) relative to the bounding-box diagonal."""
-    if geometry not in values(Geometry):
+    if geometry not in _GEOMETRIES:
         raise InvalidParameterError("geometry must be 'brep' or 'mesh'", parameter="geometry")
     if deflection is None:
         return

@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 from numpy.typing import NDArray
@@ -136,9 +137,15 @@ def _finished(
     values, warnings = _physical_moments(geometry, values, errors)
     if geometry.kind == "apex":
         warnings += _check_resolution(geometry, s, com, rotation, values)
-    tensor = rotation @ np.diag(values) @ rotation.T
-    tensor = 0.5 * (tensor + tensor.T)
-    return Refined(s, com, tensor, values, rotation.T.copy(), estimate, warnings)
+    return Refined(s, com, frame_tensor(rotation, values.tolist()), values, rotation.T.copy(), estimate, warnings)
+
+
+def frame_tensor(rotation: NDArray[np.float64], values: list[float]) -> NDArray[np.float64]:
+    """The tensor in the input frame, ``rotation diag(values) rotation^T`` (the columns of ``rotation``
+    are the axes), symmetrised."""
+    v0, v1, v2 = values
+    tensor: NDArray[np.float64] = rotation @ np.array([[v0, 0.0, 0.0], [0.0, v1, 0.0], [0.0, 0.0, v2]]) @ rotation.T
+    return 0.5 * (tensor + tensor.T)
 
 
 def _list_tensor(found: small_points.Moments) -> tuple[list[float], list[list[float]]]:
@@ -166,8 +173,7 @@ def _refine_few_points(geometry: Geometry, tolerances: Tolerances) -> Refined | 
     )
 
 
-@dataclass(frozen=True, slots=True)
-class FewPoints:
+class FewPoints(NamedTuple):
     """The last pass of ``refine_few_points``: its sums about ``com`` in the frame ``rotation`` (whose
     columns are the axes in the input frame), the moments it found, and the last step where the frame
     did not settle (None where it did)."""
@@ -188,7 +194,9 @@ def refine_few_points(masses: list[float], points: list[list[float]], tolerances
     numpy's (its BLAS may fuse their multiply-adds).  None where a number is not finite: ``refine``
     then decides, with its own errors.
     """
-    origin = [lo + 0.5 * (hi - lo) for lo, hi in ((min(column), max(column)) for column in zip(*points))]
+    xs, ys, zs = zip(*points)
+    x0, y0, z0, x1, y1, z1 = min(xs), min(ys), min(zs), max(xs), max(ys), max(zs)
+    origin = [x0 + 0.5 * (x1 - x0), y0 + 0.5 * (y1 - y0), z0 + 0.5 * (z1 - z0)]
     found = small_points.point_moments(masses, points, origin, None)
     if found is None:
         return None
