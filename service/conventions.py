@@ -56,22 +56,23 @@ def length_scale(unit: str) -> float:
 def orient_axes(axes: NDArray[np.float64]) -> NDArray[np.float64]:
     """Apply the sign rule to unit axes given as rows; returns a new array."""
     # Python floats for the 3x3 steps (numpy's per-call cost is most of the time on arrays this small); a
-    # negation and the cross product's products and differences round as numpy's do, the norm stays numpy's
+    # negation, the cross product's products and differences and the division by its norm round as
+    # numpy's do, the norm stays numpy's (the same v.dot(v)); x + 0.0 turns -0.0 into 0.0 as numpy's does
     rows = np.asarray(axes, dtype=np.float64).tolist()
     for i in (0, 1):
         row = rows[i]
-        # numpy's argmax takes the first NaN: keep its rule (a finite sum needs no look at each entry)
-        if not math.isfinite(row[0] + row[1] + row[2]) and not all(math.isfinite(x) for x in row):
-            k = int(np.argmax(np.abs(row)))
+        x0, x1, x2 = row
+        if not math.isfinite(x0 + x1 + x2) and not all(math.isfinite(x) for x in row):
+            k = int(np.argmax(np.abs(row)))  # numpy's argmax takes the first NaN: keep its rule
         else:
-            magnitudes = [abs(x) for x in row]
-            k = magnitudes.index(max(magnitudes))  # the first maximum, as argmax
+            m0, m1, m2 = abs(x0), abs(x1), abs(x2)
+            k = 0 if m0 >= m1 and m0 >= m2 else (1 if m1 >= m2 else 2)  # the first maximum, as argmax
         if row[k] < 0:
-            rows[i] = [-x for x in row]
+            rows[i] = [-x0, -x1, -x2]
     (a0, a1, a2), (b0, b1, b2) = rows[0], rows[1]
-    out = np.array([rows[0], rows[1], [a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0]])  # a x b
-    out[2] /= _norm(out[2])
-    return out + 0.0  # -0.0 becomes 0.0: the same axis prints the same way
+    c0, c1, c2 = a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0  # a x b
+    n = _norm(np.array([c0, c1, c2]))
+    return np.array([[a0 + 0.0, a1 + 0.0, a2 + 0.0], [b0 + 0.0, b1 + 0.0, b2 + 0.0], [c0 / n + 0.0, c1 / n + 0.0, c2 / n + 0.0]])
 
 
 def _norm(v: NDArray[np.float64]) -> float:
