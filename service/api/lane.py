@@ -5,9 +5,11 @@ analysis; FastAPI's routing, dependency resolution and request object cost
 about as much again. This ASGI layer sits inside the access log, the API-key
 and size guard and the last-resort handler, in front of FastAPI's router. For
 that one path it reads the JSON body, validates it with the route's own model
-(``PointsRequest``, the way FastAPI does: ``json.loads``, then the model) and,
-when the job is small (``is_small``), answers with ``run_job_json``'s bytes:
-the route's own response, byte for byte.
+(``PointsRequest``, from the JSON text with pydantic's parser: the same model
+FastAPI builds from ``json.loads``' values, in one pass) and, when the job is
+small (``is_small``), answers with ``run_job_json``'s bytes: the route's own
+response, byte for byte. What that parser refuses and ``json.loads`` reads
+(``NaN``, UTF-16 text) goes on to FastAPI, which decides as it always has.
 
 Everything else goes on to FastAPI unchanged, with the body replayed: another
 path or method, a body that is not ``application/json``, a body that does not
@@ -19,8 +21,6 @@ cases; ``tests/api/test_lane.py`` checks that the answers agree.
 """
 
 from __future__ import annotations
-
-import json
 
 from pydantic_core import to_json
 from starlette.types import ASGIApp, Message, Receive, Scope, Send
@@ -87,7 +87,7 @@ class SmallPointsLane:
 def _small_job(body: bytes) -> PointsJob | None:
     """The route's job for this body, if it validates and is small; else None (FastAPI decides)."""
     try:
-        request = PointsRequest.model_validate(json.loads(body))
+        request = PointsRequest.model_validate_json(body)
         job = PointsJob(request.records(), request.as_options())
     except Exception:  # malformed JSON, a validation error, an option the route refuses: FastAPI's answer
         return None

@@ -16,10 +16,15 @@ from typing import Any
 import pytest
 from fastapi import FastAPI
 from fastapi.testclient import TestClient
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from pydantic import ValidationError
 from starlette.responses import Response
 
 from inertia.api import Settings, create_app
 from inertia.api.lane import MAX_LANE_BYTES, POINTS_PATH, SmallPointsLane
+from inertia.api.schemas import PointsRequest
+from inertia.errors import ServiceError
 
 from .test_points_inline import BODIES, TRIANGLE, _untimed
 
@@ -44,11 +49,30 @@ ANSWERED: list[tuple[bytes, str]] = [
     # an error of the input itself: the error handler's envelope
     (json.dumps({"points": [{"element": "Xx", "position": [0, 0, 0]}]}).encode(), "application/json"),
     (json.dumps({"points": [{"mass": 1e-320, "position": [0, 0, 0]}]}).encode(), "application/json"),
+    # what a JSON parser may read differently: repeated keys (the last one counts), long and odd numbers, escapes
+    (
+        b'{"points": [{"mass": 1, "mass": 2, "position": [0, 0, 0]}, {"mass": 1, "position": [1, 0, 0]}], '
+        b'"units": "mm", "units": "cm"}',
+        "application/json",
+    ),
+    (
+        b'{"points": [{"mass": 123456789012345678901234567890, "position": [0.1000000000000000055511151231257827, 1e-300, 2]}, '
+        b'{"mass": 1E0, "position": [-0.0, 1, 9.999999999999999e99]}]}',
+        "application/json",
+    ),
+    (
+        b'{"points": [{"mass": "1.5", "position": ["1", 0, 0]}, {"mass": 1, "position": [0, 2, 0]}], "tolerance": "0.001"}',
+        "application/json",
+    ),
+    (rb'{"points": [{"position": [0, 0, 0], "element": "\u004f"}, {"element": "H", "position": [0, 1, 0]}]}', "application/json"),
 ]
 
 # requests the lane leaves to FastAPI
 PASSED_ON: list[tuple[bytes, str]] = [
     (b'{"points": [', "application/json"),  # not JSON
+    (b'{"points": [{"mass": NaN, "position": [0, 0, 0]}]}', "application/json"),  # json.loads reads NaN: FastAPI decides
+    ('{"points": [{"mass": 1, "position": [0, 0, 0]}]}'.encode("utf-16"), "application/json"),  # so does UTF-16
+    (b'\xef\xbb\xbf{"points": [{"mass": 1, "position": [0, 0, 0]}]}', "application/json"),  # and a byte-order mark
     (b"[" * 5000 + b"]" * 5000, "application/json"),  # too deep for json.loads
     (json.dumps({"points": []}).encode(), "application/json"),  # fails validation
     (json.dumps({"points": TRIANGLE, "tolerance": 2}).encode(), "application/json"),
@@ -127,3 +151,52 @@ def test_what_start_up_built_is_out_of_the_collectors_sight_while_serving() -> N
     with TestClient(create_app(Settings(compute_processes=1))):
         assert gc.get_freeze_count() > 10_000
     assert gc.get_freeze_count() == 0
+
+
+_number = st.one_of(
+    st.floats(min_value=-1e6, max_value=1e6),
+    st.integers(min_value=-1000, max_value=1000),
+    st.floats(min_value=-1e6, max_value=1e6).map(repr),  # numbers as text, which the model's lax mode reads
+    st.booleans(),
+)
+_points = st.lists(
+    st.fixed_dictionaries(
+        {"position": st.lists(_number, min_size=3, max_size=3)},
+        optional={
+            "mass": st.one_of(st.floats(min_value=1e-3, max_value=1e3), st.integers(min_value=1, max_value=100), st.booleans()),
+            "element": st.sampled_from(["O", "H", "13C", "Xx", None]),
+        },
+    ),
+    min_size=1,
+    max_size=4,
+)
+_options = st.fixed_dictionaries(
+    {},
+    optional={
+        "units": st.sampled_from(["m", "mm", None, "furlong"]),
+        "tolerance": st.one_of(st.floats(min_value=1e-9, max_value=0.5), st.sampled_from(["0.01", 2])),
+        "omega": st.lists(_number, min_size=3, max_size=3),
+        "mass_unit": st.sampled_from(["kg", "u"]),
+        "extra": st.integers(),
+    },
+)
+
+
+@settings(max_examples=400, deadline=None)
+@given(_points, _options, st.booleans())
+def test_the_lanes_parser_builds_what_fastapis_builds(points: list[dict[str, Any]], options: dict[str, Any], spaced: bool) -> None:
+    """Where pydantic's JSON parser accepts a body, ``json.loads`` and the model give the same request."""
+    body = json.dumps({"points": points, **options}, indent=1 if spaced else None).encode()
+    try:
+        fast = PointsRequest.model_validate_json(body)
+    except ValidationError:
+        return  # FastAPI decides, as without the lane
+    slow = PointsRequest.model_validate(json.loads(body))
+    assert _job_of(fast) == _job_of(slow)
+
+
+def _job_of(request: PointsRequest) -> Any:
+    try:
+        return request.records(), request.as_options()
+    except ServiceError as exc:  # an option the route refuses: the same refusal either way
+        return exc.as_dict()
