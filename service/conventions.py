@@ -53,12 +53,12 @@ def length_scale(unit: str) -> float:
         raise InvalidParameterError(f"unknown length unit {unit!r}; use one of {known}", parameter="units") from None
 
 
-def orient_axes(axes: NDArray[np.float64]) -> NDArray[np.float64]:
-    """Apply the sign rule to unit axes given as rows; returns a new array."""
+def orient_axes(axes: NDArray[np.float64] | list[list[float]]) -> NDArray[np.float64]:
+    """Apply the sign rule to unit axes given as rows (an array, or lists of floats); returns a new array."""
     # Python floats for the 3x3 steps (numpy's per-call cost is most of the time on arrays this small); a
     # negation, the cross product's products and differences and the division by its norm round as
     # numpy's do, the norm stays numpy's (the same v.dot(v)); x + 0.0 turns -0.0 into 0.0 as numpy's does
-    rows = np.asarray(axes, dtype=np.float64).tolist()
+    rows = list(axes) if isinstance(axes, list) else np.asarray(axes, dtype=np.float64).tolist()
     for i in (0, 1):
         row = rows[i]
         x0, x1, x2 = row
@@ -109,11 +109,9 @@ def quaternion_from_matrix(matrix: NDArray[np.float64]) -> NDArray[np.float64]:
     else:
         s = 2.0 * _sqrt(1.0 - m00 - m11 + m22)
         q = [(m10 - m01) / s, (m02 + m20) / s, (m12 + m21) / s, 0.25 * s]
-    quat = np.array(q, dtype=np.float64)
-    quat /= _norm(quat)
-    if quat[0] < 0:
-        quat = -quat
-    return quat
+    n = _norm(np.array(q, dtype=np.float64))
+    w, x, y, z = q[0] / n, q[1] / n, q[2] / n, q[3] / n
+    return np.array([-w, -x, -y, -z] if w < 0 else [w, x, y, z])
 
 
 def matrix_from_quaternion(quaternion: NDArray[np.float64]) -> NDArray[np.float64]:

@@ -22,6 +22,7 @@ from __future__ import annotations
 import math
 import time
 from dataclasses import fields
+from operator import attrgetter
 from typing import Any
 
 from .body import few_points_valid
@@ -40,10 +41,12 @@ __all__ = ["few_points_document"]
 _FREE = ("units", "tolerance")
 """The options this path applies; every other must have its default (a new option is then never ignored)."""
 _DEFAULTS = tuple((f.name, f.default) for f in fields(AnalysisOptions) if f.name not in _FREE)
+_FIXED = attrgetter(*(name for name, _ in _DEFAULTS))
+_FIXED_DEFAULTS = tuple(default for _, default in _DEFAULTS)
 
 
 def _plain(options: AnalysisOptions) -> bool:
-    return all(getattr(options, name) == default for name, default in _DEFAULTS)
+    return bool(_FIXED(options) == _FIXED_DEFAULTS)
 
 
 def _number(value: Any) -> float | None:
@@ -110,7 +113,8 @@ def few_points_document(records: list[dict[str, Any]], options: AnalysisOptions)
     # axes, the quaternion; then the class
     order = sorted(range(3), key=moments.__getitem__)
     ascending = [moments[k] for k in order]
-    axes = orient_axes(rotation.T[order])
+    columns = rotation.T.tolist()  # the axes, in the order of ``values``
+    axes = orient_axes([columns[k] for k in order])
     tolerance = options.tolerance
     cls = classify_moments(ascending, axes, tolerance)
     warnings = uncertain_class(cls, estimate)

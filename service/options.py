@@ -79,11 +79,14 @@ class AnalysisOptions:
             raise InvalidParameterError("give either density or mass, not both", parameter="density")
         if self.model not in MODELS:
             raise InvalidParameterError(f"model must be 'solid' or 'shell', got {self.model!r}", parameter="model")
-        object.__setattr__(self, "model", Model(self.model))
+        if type(self.model) is not Model:
+            object.__setattr__(self, "model", Model(self.model))
         if not (isinstance(self.tolerance, (int, float)) and math.isfinite(self.tolerance) and 0 < self.tolerance < 1):
             raise InvalidParameterError("tolerance must be a number between 0 and 1 (relative)", parameter="tolerance")
-        object.__setattr__(self, "reference", _vector("reference", self.reference))
-        object.__setattr__(self, "omega", _vector("omega", self.omega))
+        if self.reference is not None:
+            object.__setattr__(self, "reference", _vector("reference", self.reference))
+        if self.omega is not None:
+            object.__setattr__(self, "omega", _vector("omega", self.omega))
         if self.samples is not None and (not isinstance(self.samples, int) or self.samples < 1):
             raise InvalidParameterError("samples must be a positive whole number", parameter="samples")
         if (self.duration is None) != (self.samples is None):
@@ -93,7 +96,8 @@ class AnalysisOptions:
         method = self.method.value if isinstance(self.method, MotionMethod) else self.method
         if method not in METHODS:
             raise InvalidParameterError(f"method must be one of {', '.join(METHODS)}", parameter="method")
-        object.__setattr__(self, "method", MotionMethod(method))
+        if type(self.method) is not MotionMethod:
+            object.__setattr__(self, "method", MotionMethod(method))
         if self.densities is not None:
             for name, rho in self.densities.items():
                 _positive(f"densities[{name!r}]", rho)
