@@ -10,6 +10,7 @@ import re
 import struct
 import zipfile
 from collections.abc import Callable
+from fractions import Fraction
 from pathlib import Path
 from typing import Any, cast
 
@@ -750,6 +751,32 @@ def test_ply_triangle_strips_are_read(encoding: str) -> None:
     assert doc["center_of_mass"] == pytest.approx([0.5, 1.0, 1.5], rel=1e-15)
     assert doc["principal"]["moments"] == pytest.approx(sorted(6000 * (p + q) / 12 for p, q in ((4, 9), (1, 9), (1, 4))), rel=1e-14)
     assert not doc["warnings"]
+
+
+@pytest.mark.parametrize(
+    ("encoding", "kind"), [("ascii", "float"), ("ascii", "float32"), ("ascii", "double"), ("binary_little_endian", "float")]
+)
+def test_a_ply_files_coordinates_are_its_numbers_as_written(encoding: str, kind: str) -> None:
+    # trimesh's PLY reader casts an ASCII file's text to the declared type: `property float` read "0.1" as
+    # 0.100000001 and a trimesh models/ sphere came back 4e-9 off its float64 coordinates (API.md: float64
+    # coordinates as written). A binary file's float32 numbers are exactly what it holds.
+    a = 0.1
+    corners = [(0.0, 0.0, 0.0), (a, 0.0, 0.0), (0.0, a, 0.0), (0.0, 0.0, a)]
+    faces = [(0, 2, 1), (0, 1, 3), (0, 3, 2), (1, 2, 3)]
+    head = ["ply", f"format {encoding} 1.0", "element vertex 4", *(f"property {kind} {c}" for c in "xyz")]
+    head += ["element face 4", "property list uchar int vertex_indices", "end_header"]
+    text = ("\r\n".join(head) + "\r\n").encode()
+    if encoding == "ascii":
+        text += "".join(f"{x!r} {y!r} {z!r}\n" for x, y, z in corners).encode()
+        text += "".join(f"3 {i} {j} {k}\n" for i, j, k in faces).encode()
+        side = Fraction(a)
+    else:
+        text += np.asarray(corners, dtype="<f4").tobytes()
+        text += b"".join(struct.pack("<B3i", 3, *f) for f in faces)
+        side = Fraction(float(np.float32(a)))
+    doc = analyze(text, filename="tetra.ply").as_dict()
+    assert doc["mass"] == float(1000 * side**3 / 6)
+    assert doc["center_of_mass"] == pytest.approx([float(side / 4)] * 3, rel=1e-15)
 
 
 def test_a_flat_pillow_shell_far_from_the_origin_does_not_turn_a_body_into_a_cavity() -> None:
