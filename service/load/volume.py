@@ -736,7 +736,6 @@ _MESHIO_MISSING_DIMENSIONS = {"wedge15": 3, "pyramid13": 3, "hexahedron24": 3}
 
 
 def _read_meshio(data: bytes, fmt: str, label: str, filename: str | None, companions: Mapping[str, bytes] | None) -> _Mesh:
-    import meshio
     from meshio import _mesh
 
     table = getattr(_mesh, "topological_dimension", None)
@@ -750,15 +749,21 @@ def _read_meshio(data: bytes, fmt: str, label: str, filename: str | None, compan
         data = abaqus_one_node_block(data, label)
         companions = None
 
-    with _upload_dir(data, fmt, filename, companions) as path, _quiet() as printed:
-        try:
-            mesh = meshio.read(path, file_format=VOLUME_FORMATS[fmt])
-        except KeyboardInterrupt:
+    try:
+        mesh = _meshio_read(data, fmt, label, filename, companions)
+    except UnreadableFileError as exc:
+        fields = _gmsh_data_fields(data) if fmt == "msh" and isinstance(exc.__cause__, ValueError) else None
+        if not fields:
             raise
-        except BaseException as exc:  # meshio calls sys.exit(1) and raises KeyError, ValueError, ...
-            if isinstance(exc, ImportError) and (exc.name or "").partition(".")[0] == "h5py":
-                raise _hdf5_missing(label, fmt, exc) from exc
-            raise UnreadableFileError(_meshio_failure(exc, printed.getvalue(), path, fmt, label, companions), format=fmt) from exc
+        if "density" in fields:
+            raise UnreadableFileError(
+                f"{label} has a 'density' field that its reader (meshio) cannot split between the file's cell "
+                f"blocks ({exc.__cause__}); write the density for the 3-D elements alone, or convert the mesh to VTK (.vtu)",
+                format=fmt,
+            ) from exc
+        # meshio cannot split an element-data field over several cell blocks ("Incompatible cell data"); the
+        # fields of a Gmsh file (results, tags) weigh nothing, so the mesh is read without them
+        mesh = _meshio_read(_GMSH_DATA.sub(b"", data), fmt, label, filename, companions)
     if fmt == "msh":
         _gmsh_node_order(mesh)
     out = _mesh_from_meshio(mesh, label)
@@ -1102,6 +1107,36 @@ def _refuse_unapplied(keyword: bytes, line: bytes, data: list[bytes], label: str
                 "does not apply; export the assembly flattened (without *PART and *INSTANCE)",
                 keyword="INSTANCE",
             )
+
+
+def _meshio_read(data: bytes, fmt: str, label: str, filename: str | None, companions: Mapping[str, bytes] | None) -> Any:
+    """``meshio.read`` of the upload in its private folder; every failure an ``UnreadableFileError``."""
+    import meshio
+
+    with _upload_dir(data, fmt, filename, companions) as path, _quiet() as printed:
+        try:
+            return meshio.read(path, file_format=VOLUME_FORMATS[fmt])
+        except KeyboardInterrupt:
+            raise
+        except BaseException as exc:  # meshio calls sys.exit(1) and raises KeyError, ValueError, ...
+            if isinstance(exc, ImportError) and (exc.name or "").partition(".")[0] == "h5py":
+                raise _hdf5_missing(label, fmt, exc) from exc
+            raise UnreadableFileError(_meshio_failure(exc, printed.getvalue(), path, fmt, label, companions), format=fmt) from exc
+
+
+# a Gmsh file's data sections (gmsh.info, "MSH file format": $NodeData, $ElementData, $ElementNodeData), from the
+# section's name to its end marker; their first string tag is the field's name
+_GMSH_DATA = re.compile(rb"\$(NodeData|ElementData|ElementNodeData)\r?\n.*?\$End\1[^\S\n]*\r?(\n|\Z)", re.DOTALL)
+_GMSH_FIELD_NAME = re.compile(rb"\A\$\w+\r?\n\s*\d+\s*\r?\n\s*\"([^\"\n]*)\"")
+
+
+def _gmsh_data_fields(data: bytes) -> set[str]:
+    """The names of a Gmsh file's data fields (``"?"`` for one whose name cannot be read)."""
+    names = set()
+    for match in _GMSH_DATA.finditer(data):
+        name = _GMSH_FIELD_NAME.match(match.group(0))
+        names.add(name.group(1).decode("utf-8", "replace") if name else "?")
+    return names
 
 
 def _meshio_failure(

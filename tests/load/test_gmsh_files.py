@@ -11,6 +11,7 @@ from collections.abc import Sequence
 
 import pytest
 
+from inertia.errors import UnreadableFileError
 from inertia.pipeline import analyze
 
 # the 18-node prism in Gmsh's order: corners, then edge midpoints 0-1, 0-2, 0-3, 1-2, 1-4, 2-5, 3-4, 3-5, 4-5,
@@ -73,3 +74,37 @@ def test_a_surface_apart_from_the_volume_is_named_and_boundary_faces_are_not() -
     assert boundary["mass"] == apart["mass"] == pytest.approx(1000 / 6, rel=1e-14)
     assert not any("no 3-D cell uses" in w for w in boundary["warnings"])
     assert any("3 points that no 3-D cell uses" in w for w in apart["warnings"])
+
+
+def _element_data(name: str, count: int) -> bytes:
+    """An ASCII $ElementData section: one scalar per element, 1..count."""
+    lines = ["$ElementData", "1", f'"{name}"', "1", "0.0", "3", "0", "1", str(count)]
+    lines += [f"{k} {0.5 * k!r}" for k in range(1, count + 1)]
+    return ("\n".join([*lines, "$EndElementData"]) + "\n").encode()
+
+
+_TETRA = [(0.0, 0.0, 0.0), (1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0)]
+# the tetrahedron and its four faces as triangles, as Gmsh writes a volume with its boundary
+_WITH_FACES: list[tuple[int, list[int], list[int]]] = [
+    (2, [1, 1], [1, 3, 2]),
+    (2, [1, 1], [1, 2, 4]),
+    (2, [1, 1], [1, 4, 3]),
+    (2, [1, 1], [2, 3, 4]),
+    (4, [2, 1], [1, 2, 3, 4]),
+]
+
+
+def test_a_data_field_over_several_cell_blocks_does_not_stop_the_reading() -> None:
+    # libigl's tutorial hand.msh: one $ElementData field "E" over its triangles and tetrahedra, which meshio
+    # cannot split between its cell blocks ("Incompatible cell data"); the file was refused as unreadable
+    data = _msh22(_TETRA, _WITH_FACES) + _element_data("E", 5)
+    doc = analyze(data, filename="hand.msh").as_dict()
+    assert doc["mass"] / doc["density"] == pytest.approx(1 / 6, rel=1e-15)
+    assert doc["center_of_mass"] == pytest.approx([0.25, 0.25, 0.25], rel=1e-15)
+
+
+def test_a_density_field_meshio_cannot_split_is_refused_not_dropped() -> None:
+    # a field named density gives each cell its own (API.md): left out, the file would weigh as uniform
+    data = _msh22(_TETRA, _WITH_FACES) + _element_data("density", 5)
+    with pytest.raises(UnreadableFileError, match="field that its reader"):
+        analyze(data, filename="weighted.msh")
