@@ -13,9 +13,7 @@ References, independent of the service's own readers and integrator:
 
 - ``exact``: the file read by trimesh (its own readers, ``process=False``; a
   glTF scene flattened with its node transforms; a 3MF without the objects
-  the 3MF specification does not weigh; an ASCII PLY file's text read in
-  float64 by ``_ascii_ply_mesh``, since trimesh casts it to the header's
-  type), vertices within 1e-11 of the part's
+  the 3MF specification does not weigh), vertices within 1e-11 of the part's
   diagonal merged by trimesh's own ``merge_vertices`` (the seams), then
   integrated exactly in rational arithmetic (``benchmarks/exact.py``): volume,
   centre and inertia tensor of the polyhedron for unit density.
@@ -199,13 +197,8 @@ def reference(path: Path, rel: str, companions: tuple[str, ...]) -> tuple[float,
         geom = scene.geometry[name]
         if not isinstance(geom, trimesh.Trimesh) or any(str(name).endswith(s) or str(node) == s for s in skip):
             continue
-        v = np.asarray(geom.vertices, dtype=np.float64)
+        v = np.asarray(geom.vertices, dtype=np.float64) @ np.asarray(transform)[:3, :3].T + np.asarray(transform)[:3, 3]
         f = np.asarray(geom.faces, dtype=np.int64)
-        if ext == "ply":  # trimesh casts an ASCII file's text to the header's type; the file's numbers are the text
-            written = _ascii_ply_mesh(path.read_bytes())
-            if written is not None:
-                v, f = written
-        v = v @ np.asarray(transform)[:3, :3].T + np.asarray(transform)[:3, 3]
         if np.linalg.det(np.asarray(transform)[:3, :3]) < 0:
             f = f[:, [0, 2, 1]]
         verts.append(v)
@@ -219,40 +212,6 @@ def reference(path: Path, rel: str, companions: tuple[str, ...]) -> tuple[float,
     volume, _, tensor = exact_solid(mesh.vertices, mesh.faces)
     sign = 1.0 if volume > 0 else -1.0
     return sign * float(volume), sign * np.array([[float(x) for x in row] for row in tensor])
-
-
-def _ascii_ply_mesh(data: bytes) -> tuple[np.ndarray, np.ndarray] | None:
-    """An ASCII PLY file's vertices (float64 from its text) and faces (polygons as fans from their first corner),
-    read here independently of trimesh, which casts the text to the header's type; None where the file is
-    binary or holds no plain ``vertex`` and ``face`` elements."""
-    head, _, body = data.partition(b"end_header")
-    lines = head.decode("ascii", "replace").splitlines()
-    if not any(line.split()[:2] == ["format", "ascii"] for line in lines):
-        return None
-    elements: list[tuple[str, int, list[tuple[str, bool]]]] = []
-    for line in lines:
-        words = line.split()
-        if words[:1] == ["element"]:
-            elements.append((words[1], int(words[2]), []))
-        elif words[:1] == ["property"] and elements:
-            elements[-1][2].append((words[-1], words[1] == "list"))
-    rows = iter(body.decode("ascii", "replace").splitlines()[1:])
-    vertices: list[list[float]] = []
-    faces: list[list[int]] = []
-    for name, count, props in elements:
-        for _ in range(count):
-            values = iter(next(rows).split())
-            found: dict[str, Any] = {}
-            for prop, is_list in props:
-                found[prop] = [next(values) for _ in range(int(next(values)))] if is_list else next(values)
-            if name == "vertex":
-                vertices.append([float(found[c]) for c in "xyz"])
-            elif name == "face":
-                corners = [int(i) for i in found.get("vertex_indices", found.get("vertex_index", []))]
-                faces += [[corners[0], corners[k], corners[k + 1]] for k in range(1, len(corners) - 1)]
-    if not vertices or not faces:
-        return None
-    return np.array(vertices), np.array(faces, dtype=np.int64)
 
 
 def run_one(rel: str) -> Row:
@@ -295,8 +254,7 @@ def run_one(rel: str) -> Row:
     warnings = "; ".join(w for w in doc["warnings"] if "length unit" not in w and "declares no length unit" not in w)
     detail = f"volume {volume:.10g}, rel. error {mass_err:.1e}, tensor {t_err:.1e}" + (f"; {warnings[:160]}" if warnings else "")
     outcome = "read right" if mass_err <= TOL and t_err <= TOL else "wrong"
-    own = fmt == "ply" and _ascii_ply_mesh(path.read_bytes()) is not None
-    return Row(rel, fmt, outcome, detail, "exact rational integration of " + ("its text" if own else "trimesh's reading"))
+    return Row(rel, fmt, outcome, detail, "exact rational integration of trimesh's reading")
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -324,8 +282,7 @@ def render(rows: list[Row], elapsed: float) -> Report:
         "file's source repository, path, commit and licence). Targets: 0 wrong, 0 crashed.",
         "",
         "References: **exact** = the file read by trimesh's own readers (glTF nodes flattened with their transforms, "
-        "3MF objects the specification does not weigh left out; an ASCII PLY file's text read in float64 by the "
-        "benchmark's own parser, since trimesh casts it to the header's type), vertices within 1e-11 of the diagonal merged by "
+        "3MF objects the specification does not weigh left out), vertices within 1e-11 of the diagonal merged by "
         "trimesh, then integrated exactly in rational arithmetic (`benchmarks/exact.py`); a number is *read right* when "
         f"mass (unit density, file units) and inertia tensor agree to {TOL:g}. *Refused* means the file is broken "
         "or a 3MF Consortium MUSTFAIL sample and the service answered an error code with a sentence. Volume meshes "

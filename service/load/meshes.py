@@ -135,8 +135,6 @@ def read_trimesh_parts(
         if cameras and not placed:  # expand_instances wrote the document only where it placed instances
             data = with_document(data, fmt, doc)
         notes += placed
-    if fmt == "ply":
-        data = _ascii_ply_as_double(data)
     # the upload's own files, and nothing else: a name outside them (a texture that did not come along, a path)
     # is not found, never looked for on disk; images are not needed for the geometry (skip_materials)
     kwargs: dict[str, Any] = {"resolver": trimesh.resolvers.ZipResolver(dict(companions or {}))}
@@ -217,32 +215,6 @@ def _without_cameras(doc: Any) -> bool:
             del node["camera"]
             found = True
     return found
-
-
-_PLY_SINGLE = (b"float", b"float32")
-
-
-def _ascii_ply_as_double(data: bytes) -> bytes:
-    """An ASCII PLY file whose header declares ``float`` properties, declaring ``double`` instead.
-
-    The numbers of an ASCII file are its text: read as float32 (the type's width in a binary file), a
-    coordinate written ``0.1`` would become 0.100000001, and the body 1e-8 off the one written (API.md:
-    float64 coordinates as written).  Only the header's type names change; a binary file is left alone.
-    """
-    end = data.find(b"end_header")
-    if end < 0 or not data.startswith(b"ply"):
-        return data
-    lines = data[:end].split(b"\n")
-    if not any(line.split()[:2] == [b"format", b"ascii"] for line in lines):
-        return data
-    out = []
-    for line in lines:
-        words = line.split()
-        if words[:1] == [b"property"] and any(w in _PLY_SINGLE for w in words[1:-1]):
-            ending = b"\r" if line.endswith(b"\r") else b""
-            line = b" ".join(b"double" if w in _PLY_SINGLE and k < len(words) - 1 else w for k, w in enumerate(words)) + ending
-        out.append(line)
-    return b"\n".join(out) + data[end:]
 
 
 def _ply_split_notes(scene: Any) -> list[str]:
