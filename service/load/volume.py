@@ -219,6 +219,12 @@ def read_volume_parts(
             "(.msh), e.g. with MFEM's own mesh tools",
             format=fmt,
         )
+    if fmt == "msh" and data[:64].lstrip().startswith(b"$NOD"):  # MSH 1: $NOD, $ELM, no $MeshFormat
+        raise UnsupportedFormatError(
+            f"{_label(filename, fmt)} is in Gmsh's version-1 format ($NOD and $ELM sections), which its reader "
+            "(meshio) does not read; save it again as MSH 2.2 or 4.1 (for example gmsh OLD.msh -save -format msh22 -o NEW.msh)",
+            format=fmt,
+        )
     if fmt == "inp" and is_avs_ucd(data):  # the other format named .inp: VTK reads it, meshio would take it for Abaqus
         label = _label(filename, "ucd")
         mesh = _read_vtk(data, "ucd", label)
@@ -303,8 +309,10 @@ def _reason(exc: BaseException, printed: str, tmp_paths: tuple[str, ...]) -> str
         text = f"it refers to {key!r} (a node, element, tag or entity number) without defining it"
     elif isinstance(exc, IndexError):
         text = f"it refers to an entry it does not hold, or announces more than it holds ({text or 'index out of range'})"
-    if not text:
-        text = next((ln.strip() for ln in printed.splitlines() if ln.strip()), "") or type(exc).__name__
+    if not text:  # what the library printed: its first line that is not a warning (a skipped keyword says nothing)
+        lines = [ln.strip() for ln in printed.splitlines() if ln.strip()]
+        text = next((ln for ln in lines if not ln.lower().startswith("warning")), lines[0] if lines else "")
+        text = text or type(exc).__name__
     text = text.splitlines()[0]
     for p in tmp_paths:
         text = text.replace(p, "the file")

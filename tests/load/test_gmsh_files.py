@@ -11,7 +11,7 @@ from collections.abc import Sequence
 
 import pytest
 
-from inertia.errors import UnreadableFileError
+from inertia.errors import UnreadableFileError, UnsupportedFormatError
 from inertia.pipeline import analyze
 
 # the 18-node prism in Gmsh's order: corners, then edge midpoints 0-1, 0-2, 0-3, 1-2, 1-4, 2-5, 3-4, 3-5, 4-5,
@@ -108,3 +108,20 @@ def test_a_density_field_meshio_cannot_split_is_refused_not_dropped() -> None:
     data = _msh22(_TETRA, _WITH_FACES) + _element_data("density", 5)
     with pytest.raises(UnreadableFileError, match="field that its reader"):
         analyze(data, filename="weighted.msh")
+
+
+def test_a_version_1_gmsh_file_is_refused_by_its_version() -> None:
+    # gmsh's own benchmarks/extrude/surf.msh: meshio says only "Couldn't read file ... as gmsh"
+    data = b"$NOD\n4\n1 0 0 0\n2 1 0 0\n3 0 1 0\n4 0 0 1\n$ENDNOD\n$ELM\n1\n1 4 1 1 4 1 2 3 4\n$ENDELM\n"
+    with pytest.raises(UnsupportedFormatError, match="version-1 format"):
+        analyze(data, filename="surf.msh")
+
+
+def test_a_readers_warning_is_not_given_as_the_reason_it_failed() -> None:
+    # MmgTools' init.mesh: meshio prints "Warning: ... doesn't know keyword RequiredVertices. Skipping.", then
+    # fails on RequiredEdges; the refusal named the harmless warning
+    lines = ["MeshVersionFormatted 2", "Dimension 3", "Vertices", "1", "0 0 0 1", "RequiredVertices", "1", "1"]
+    lines += ["RequiredEdges", "1", "1", "End"]
+    with pytest.raises(UnreadableFileError) as caught:
+        analyze(("\n".join(lines) + "\n").encode(), filename="init.mesh")
+    assert "RequiredEdges" in caught.value.message and "Skipping" not in caught.value.message
