@@ -760,18 +760,10 @@ def _read_meshio(data: bytes, fmt: str, label: str, filename: str | None, compan
     try:
         mesh = _meshio_read(data, fmt, label, filename, companions)
     except UnreadableFileError as exc:
-        fields = _gmsh_data_fields(data) if fmt == "msh" and isinstance(exc.__cause__, ValueError) else None
-        if not fields:
+        again = _gmsh_retry(data, exc, label) if fmt == "msh" else None
+        if again is None:
             raise
-        if "density" in fields:
-            raise UnreadableFileError(
-                f"{label} has a 'density' field that its reader (meshio) cannot split between the file's cell "
-                f"blocks ({exc.__cause__}); write the density for the 3-D elements alone, or convert the mesh to VTK (.vtu)",
-                format=fmt,
-            ) from exc
-        # meshio cannot split an element-data field over several cell blocks ("Incompatible cell data"); the
-        # fields of a Gmsh file (results, tags) weigh nothing, so the mesh is read without them
-        mesh = _meshio_read(_GMSH_DATA.sub(b"", data), fmt, label, filename, companions)
+        mesh = _meshio_read(again, fmt, label, filename, companions)
     if fmt == "msh":
         _gmsh_node_order(mesh)
     out = _mesh_from_meshio(mesh, label)
@@ -1132,6 +1124,34 @@ def _meshio_read(data: bytes, fmt: str, label: str, filename: str | None, compan
             raise UnreadableFileError(_meshio_failure(exc, printed.getvalue(), path, fmt, label, companions), format=fmt) from exc
 
 
+def _gmsh_retry(data: bytes, exc: UnreadableFileError, label: str) -> bytes | None:
+    """The Gmsh file without what meshio could not split between its cell blocks ("Incompatible cell data"),
+    where that weighs nothing; None where there is no such part to leave out.
+
+    - An MSH 4 file whose elements lie in entities of which only some carry physical tags (Gmsh's
+      ``Mesh.SaveAll``: a physical volume beside untagged surfaces): the tags only name the parts, so the
+      file is read without its ``$Entities`` (the parts are then named by cell type).
+    - A data field over several cell blocks (libigl's tutorial hand.msh): results and tags weigh nothing,
+      so the file is read without its data sections; a ``density`` field is refused by name instead.
+    """
+    cause = exc.__cause__
+    if not isinstance(cause, ValueError) or "Incompatible cell data" not in str(cause):
+        return None
+    if "'gmsh:" in str(cause):
+        return _GMSH_ENTITIES.sub(b"", data, count=1)
+    fields = _gmsh_data_fields(data)
+    if not fields:
+        return None
+    if "density" in fields:
+        raise UnreadableFileError(
+            f"{label} has a 'density' field that its reader (meshio) cannot split between the file's cell "
+            f"blocks ({cause}); write the density for the 3-D elements alone, or convert the mesh to VTK (.vtu)",
+            format="msh",
+        ) from exc
+    return _GMSH_DATA.sub(b"", data)
+
+
+_GMSH_ENTITIES = re.compile(rb"\$Entities\r?\n.*?\$EndEntities[^\S\n]*\r?(\n|\Z)", re.DOTALL)
 # a Gmsh file's data sections (gmsh.info, "MSH file format": $NodeData, $ElementData, $ElementNodeData), from the
 # section's name to its end marker; their first string tag is the field's name
 _GMSH_DATA = re.compile(rb"\$(NodeData|ElementData|ElementNodeData)\r?\n.*?\$End\1[^\S\n]*\r?(\n|\Z)", re.DOTALL)

@@ -125,3 +125,48 @@ def test_a_readers_warning_is_not_given_as_the_reason_it_failed() -> None:
     with pytest.raises(UnreadableFileError) as caught:
         analyze(("\n".join(lines) + "\n").encode(), filename="init.mesh")
     assert "RequiredEdges" in caught.value.message and "Skipping" not in caught.value.message
+
+
+_MSH41_SAVE_ALL = """$MeshFormat
+4.1 0 8
+$EndMeshFormat
+$PhysicalNames
+1
+3 7 "solid"
+$EndPhysicalNames
+$Entities
+0 0 1 1
+1 0 0 0 1 1 1 0 0
+1 0 0 0 1 1 1 1 7 1 1
+$EndEntities
+$Nodes
+1 4 1 4
+3 1 0 4
+1
+2
+3
+4
+0 0 0
+1 0 0
+0 1 0
+0 0 1
+$EndNodes
+$Elements
+2 5 1 5
+2 1 2 4
+1 1 3 2
+2 1 2 4
+3 1 4 3
+4 2 3 4
+3 1 4 1
+5 1 2 3 4
+$EndElements
+"""
+
+
+def test_an_msh4_file_with_untagged_surfaces_beside_a_physical_volume_is_read() -> None:
+    # Gmsh's Mesh.SaveAll writes every entity, physical or not (gmsh's own benchmarks/3d/discrete.msh): meshio
+    # 5.3 could not split the physical tags of some entities between all cell blocks and the file was refused
+    doc = analyze(_MSH41_SAVE_ALL.encode(), filename="discrete.msh").as_dict()
+    assert doc["mass"] / doc["density"] == pytest.approx(1 / 6, rel=1e-15)
+    assert doc["center_of_mass"] == pytest.approx([0.25, 0.25, 0.25], rel=1e-15)
