@@ -182,9 +182,21 @@ def _orient_outward(
             f"the {count} shells are kept as the file winds them ({depth}, so nesting was not tested); "
             f"{int(np.count_nonzero(vol < 0))} of them enclose negative volume (cavities)"
         ]
-    crossing = _crossing_shell(shifted, faces, label, count, depth)
+    found = _crossing_shell(shifted, faces, label, count, depth, every=True)
     del shifted
-    if crossing is not None:
+    want_positive = depth % 2 == 0
+    if found is not None:
+        crossing, crosses = found
+        disagree = ((vol > 0) != want_positive) & ~flat & ~crosses
+        if not np.any(disagree) and np.all(vol[crosses & ~flat] > 0):
+            # the file winds every other shell as its nesting says (bodies outward, cavities inward) and the
+            # crossing ones outward: its signed volumes are a reading, bodies overlapping where they cross
+            return faces, [
+                f"the mesh has {int(np.count_nonzero(crosses))} shell(s) wound outward that lie partly inside another "
+                f"of its {count} shells: every shell is weighed as the file winds it (cavities subtracted, bodies added), so the "
+                "volume the crossing ones share counts once for each (as trimesh and MuJoCo read the file); if the "
+                "part is their union, join them into one closed surface (a boolean union) or send them as separate parts"
+            ]
         raise InvalidMeshError(
             f"the mesh's shells cross each other: a shell of {crossing[0]} faces lies partly inside and partly "
             f"outside another (its largest face inside {crossing[1]} other shell(s), one of its vertices inside "
@@ -192,7 +204,6 @@ def _orient_outward(
             "join the shells into one closed surface (a boolean union) or send them as separate parts",
             faces=crossing[0],
         )
-    want_positive = depth % 2 == 0
     flip_shell = ((vol > 0) != want_positive) & ~flat
     if not np.any(flip_shell):
         return faces, []
@@ -400,9 +411,10 @@ def _crossing_shell(
     count: int,
     depth: NDArray[np.int64],
     samples: int = _CROSSING_SAMPLES,
-) -> tuple[int, int, int] | None:
+    every: bool = False,
+) -> tuple[tuple[int, int, int], NDArray[np.bool_]] | None:
     """A shell whose vertices are not all as deep as its test point: (its faces, its depth, a vertex's depth),
-    or None.
+    and which shells were found crossing (all of them with ``every``, else the first); None where none is.
 
     The depth of a shell comes from one point of it; a shell lies wholly inside the shells around it (or
     wholly outside them) only if it crosses none of them, which a few of its vertices (its extremes along
@@ -416,6 +428,8 @@ def _crossing_shell(
     lo, hi = _shell_boxes(x, faces, label, count)
     sizes = np.diff(bounds)
     spent = 0
+    first: tuple[int, int, int] | None = None
+    crossing = np.zeros(count, dtype=bool)
     for t, partners in _box_partners(lo, hi):
         if len(partners) == 0:
             continue  # no other shell's box meets this one's: nothing to cross
@@ -433,7 +447,7 @@ def _crossing_shell(
             continue
         spent += int(per_shell[others] @ sizes[others])
         if spent > NESTING_WORK_LIMIT:
-            return None
+            return None  # beyond the work limit nothing is said, not even what was found
         found = np.zeros(len(points), dtype=np.int64)
         decided = np.ones(len(points), dtype=bool)
         for other in others.tolist():
@@ -444,5 +458,9 @@ def _crossing_shell(
             found[inside[clear]] += np.round(w[clear]) != 0
         wrong = decided & (found != depth[t])
         if np.any(wrong):
-            return int(sizes[t]), int(depth[t]), int(found[np.flatnonzero(wrong)[0]])
-    return None
+            crossing[t] = True
+            if first is None:
+                first = int(sizes[t]), int(depth[t]), int(found[np.flatnonzero(wrong)[0]])
+            if not every:
+                break
+    return None if first is None else (first, crossing)

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from fractions import Fraction
+
 import numpy as np
 import pytest
 
@@ -147,6 +149,30 @@ def test_an_inward_shell_that_crosses_its_outer_shell_is_refused(shift: tuple[fl
         return
     with pytest.raises(InvalidMeshError, match="shells cross each other"):
         mass_properties(both, density=1.0)
+
+
+def test_an_outward_shell_that_crosses_a_body_with_cavities_is_summed_with_a_warning() -> None:
+    # Universal Robots' UR5 collision wrist3.stl: a body with three sealed cavities wound inward, and an outward
+    # pin that runs from inside the body to outside it. The cavities sent the file into nesting, where the pin
+    # was refused as crossing; without them the same pin was summed with a warning. The file winds every shell
+    # as its nesting says but the pin, which is outward: its signed volumes (as trimesh and MuJoCo read it) are
+    # body - cavity + pin, with the pin's part inside the body counted twice, and a warning says so
+    bv, bf = box(2.0, 2.0, 2.0)
+    cv, cf = box(0.5, 0.5, 0.5, origin=(0.25, 0.25, 0.25))
+    pv, pf = box(0.25, 0.25, 1.5, origin=(1.5, 1.5, 1.5))
+    v = np.vstack([bv, cv, pv])
+    f = np.vstack([bf, cf[:, [0, 2, 1]] + 8, pf + 16])
+    props = mass_properties(MeshBody(v, f), density=1.0)
+    parts = [(Fraction(8), (1, 1, 1)), (Fraction(-1, 8), (0.5, 0.5, 0.5)), (Fraction(3, 32), (1.625, 1.625, 2.25))]
+    volume = sum(m for m, _ in parts)
+    com = [sum(m * Fraction(c[k]) for m, c in parts) / volume for k in range(3)]
+    assert props.mass == float(volume)
+    assert props.center_of_mass == pytest.approx([float(c) for c in com], rel=1e-15)
+    assert any("lie partly inside another" in w and "counts once for each" in w for w in props.warnings)
+    # wound inward, the same pin is no reading at all: refused as before
+    f_in = np.vstack([bf, cf[:, [0, 2, 1]] + 8, pf[:, [0, 2, 1]] + 16])
+    with pytest.raises(InvalidMeshError, match="shells cross each other"):
+        mass_properties(MeshBody(v, f_in), density=1.0)
 
 
 def test_an_inward_shell_that_crosses_from_outside_is_refused_too() -> None:
