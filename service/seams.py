@@ -5,7 +5,9 @@ vertices on the edge two patches share are computed twice: ``0.0`` in one
 triangle, ``-2.7e-16`` in the next.  Bit-exact welding (``topology.weld``)
 leaves such a seam open.  Here the vertices that lie on open edges and are
 closer than ``Tolerances.seam_rel`` times the part's bounding-box diagonal
-are merged onto one of them (the lowest-numbered), unless the merge would
+(in a file of float32 coordinates, ``SEAM_STEPS`` of their steps, which
+their rounding alone can put between two writings of one point) are merged
+onto one of them (the lowest-numbered), unless the merge would
 collapse a triangle (two corners of one face in one cluster), in which case
 that cluster is not merged at all.  The merged polyhedron is a polyhedron in
 its own right, with the coordinates of the kept vertices, and every integral
@@ -28,7 +30,7 @@ from .body import MeshBody, Part
 from .tolerances import DEFAULT_TOLERANCES, Tolerances
 from .topology import face_components, surface_topology, weld
 
-__all__ = ["SeamMerge", "merge_seams", "close_pairs", "open_edge_vertices", "join_open_parts"]
+__all__ = ["SEAM_STEPS", "SeamMerge", "merge_seams", "close_pairs", "open_edge_vertices", "join_open_parts"]
 
 
 @dataclass(frozen=True, slots=True)
@@ -48,11 +50,12 @@ class SeamMerge:
     largest_gap: float
     tolerance: float
     refused: int
+    basis: str = "1e-12 of the part's size"
 
     def warning(self) -> str:
         text = (
             f"{self.merged} seam vertices merged onto a neighbour closer than {self.tolerance:.3g} "
-            f"(1e-12 of the part's size; largest gap {self.largest_gap:.3g} file units); "
+            f"({self.basis}; largest gap {self.largest_gap:.3g} file units); "
             "the results are exact for the merged surface"
         )
         if self.refused:
@@ -99,17 +102,35 @@ def close_pairs(points: NDArray[np.float64], tol: float) -> NDArray[np.int64]:
     return np.sort(pairs, axis=1)
 
 
-def merge_seams(vertices: NDArray[np.float64], faces: NDArray[np.int64], tolerances: Tolerances = DEFAULT_TOLERANCES) -> SeamMerge:
+SEAM_STEPS = 8
+"""In a file of float32 coordinates a point written twice is apart by a few of their steps (one step is
+2**-24 of the largest coordinate): seams within this many steps are merged too."""
+
+
+def merge_seams(
+    vertices: NDArray[np.float64],
+    faces: NDArray[np.int64],
+    tolerances: Tolerances = DEFAULT_TOLERANCES,
+    coordinate_eps: float = 2.0**-53,
+) -> SeamMerge:
     """Merge the vertices of open edges that are closer than the seam tolerance.
 
     ``vertices`` must already be bit-exactly welded (distinct rows) and
-    ``faces`` free of degenerate triangles.
+    ``faces`` free of degenerate triangles.  ``coordinate_eps``: the unit
+    roundoff of the file's coordinates (``MeshBody.coordinate_eps``); for
+    float32 ones the tolerance is at least ``SEAM_STEPS`` of their steps at
+    the largest coordinate, the gap their rounding leaves between two writings
+    of one point (1e-12 of the size is below a single step there).
     """
     used = vertices[np.unique(faces)]
     diagonal = float(np.linalg.norm(used.max(axis=0) - used.min(axis=0)))
-    tol = tolerances.seam_rel * diagonal
+    tol, basis = tolerances.seam_rel * diagonal, "1e-12 of the part's size"
+    if coordinate_eps >= 2.0**-24:
+        steps = SEAM_STEPS * coordinate_eps * float(np.abs(used).max())
+        if steps > tol:
+            tol, basis = steps, f"{SEAM_STEPS} steps of the file's float32 coordinates at their largest"
     candidates = open_edge_vertices(faces)
-    none = SeamMerge(faces, 0, 0.0, tol, 0)
+    none = SeamMerge(faces, 0, 0.0, tol, 0, basis)
     if len(candidates) < 2 or tol <= 0:
         return none
     pts = vertices[candidates]
@@ -140,9 +161,9 @@ def merge_seams(vertices: NDArray[np.float64], faces: NDArray[np.int64], toleran
         mapped = target[faces]  # undoing merges can only remove collapses, never create one
     moved = np.flatnonzero(target != np.arange(len(vertices)))
     if len(moved) == 0:
-        return SeamMerge(faces, 0, 0.0, tol, len(refused_clusters))
+        return SeamMerge(faces, 0, 0.0, tol, len(refused_clusters), basis)
     gap = float(np.max(np.linalg.norm(vertices[moved] - vertices[target[moved]], axis=1)))
-    return SeamMerge(mapped, len(moved), gap, tol, len(refused_clusters))
+    return SeamMerge(mapped, len(moved), gap, tol, len(refused_clusters), basis)
 
 
 def _welded_faces(vertices: NDArray[np.float64], faces: NDArray[np.int64]) -> tuple[NDArray[np.float64], NDArray[np.int64]]:

@@ -65,7 +65,7 @@ def closed_surface(body: MeshBody) -> tuple[NDArray[np.float64], NDArray[np.int6
     topo = surface_topology(faces, len(vertices))
     warnings: list[str] = []
     if topo.open_edges:
-        seams = merge_seams(vertices, faces)
+        seams = merge_seams(vertices, faces, coordinate_eps=body.coordinate_eps)
         if seams.merged:
             faces = seams.faces
             topo = surface_topology(faces, len(vertices))

@@ -7,13 +7,13 @@ from fractions import Fraction
 import numpy as np
 import pytest
 
-from benchmarks.cases import box, icosahedron
+from benchmarks.cases import box, icosahedron, triangles_stl_bytes
 from benchmarks.exact import exact_solid
 from inertia.body import MeshBody, Part
 from inertia.errors import InvalidMeshError, NotWatertightError, ZeroVolumeError
 from inertia.mass import mass_properties
 from inertia.pipeline import analyze
-from inertia.seams import join_open_parts, merge_seams
+from inertia.seams import SEAM_STEPS, join_open_parts, merge_seams
 from inertia.solid import closed_surface, winding_numbers
 from inertia.tolerances import DEFAULT_TOLERANCES
 
@@ -50,6 +50,23 @@ def test_a_gap_above_the_tolerance_stays_open_and_names_the_part() -> None:
     with pytest.raises(NotWatertightError) as err:
         mass_properties(MeshBody(v, f, name="bracket"))
     assert "'bracket'" in err.value.message and err.value.details["part"] == "bracket"
+
+
+@pytest.mark.parametrize("steps", [1, 4, 100])
+def test_a_float32_files_seams_are_merged_within_a_few_of_its_steps(steps: int) -> None:
+    # unitree_ros' waist_roll_link.STL and five more robot links: binary STL seams 3.7e-9 to 3e-8 apart, one or
+    # two float32 steps of their coordinates and 1e4 times the float64 seam tolerance, were refused as open
+    # (trimesh and MuJoCo read them closed). A float32 file's seams are merged within SEAM_STEPS of its steps
+    step = 3.0 * 2.0**-24  # one float32 step at the largest coordinate (3)
+    v, f, _, _ = unshared_box(steps * step)
+    data = triangles_stl_bytes(v[f])
+    if steps > SEAM_STEPS:
+        with pytest.raises(NotWatertightError):
+            analyze(data, filename="link.stl")
+        return
+    doc = analyze(data, filename="link.stl").as_dict()
+    assert doc["mass"] == pytest.approx(6000.0, rel=steps * step)  # the box, one side moved by at most the gap
+    assert any("steps of the file's float32 coordinates" in w for w in doc["warnings"])
 
 
 def test_a_merge_that_would_collapse_a_triangle_is_not_made() -> None:
