@@ -474,3 +474,11 @@ def test_bent_polygons_near_the_top_of_float64_are_an_overflow_not_an_unreadable
     with pytest.raises(InvalidParameterError, match="overflow"), warnings.catch_warnings():
         warnings.simplefilter("ignore", RuntimeWarning)  # numpy says so on the way; the answer is the error
         analyze(("\n".join(lines) + "\n").encode(), filename="big.obj")
+
+
+def test_a_malformed_ascii_stl_vertex_is_named_as_the_file_writes_it() -> None:
+    # OpenSCAD's tests/data/stl/invalidvertex.stl: the message showed numpy's repr, np.bytes_(b'blah')
+    text = b"solid t\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 blah 0\nvertex 0 1 0\nendloop\nendfacet\nendsolid t\n"
+    with pytest.raises(UnreadableFileError) as caught:
+        analyze(text, filename="invalidvertex.stl")
+    assert "'blah' where a coordinate should be" in caught.value.message and "np." not in caught.value.message

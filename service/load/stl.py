@@ -104,6 +104,14 @@ def _welded(corners: NDArray[np.float32]) -> tuple[NDArray[np.float64], NDArray[
     return vertices, ids.reshape(-1, 3)
 
 
+def _is_number(token: bytes) -> bool:
+    try:
+        float(token)
+    except ValueError:
+        return False
+    return True
+
+
 def _ascii(data: bytes) -> tuple[NDArray[np.float64], NDArray[np.int64]]:
     tokens = np.array(data.split())
     idx = np.flatnonzero(tokens == b"vertex")
@@ -115,8 +123,11 @@ def _ascii(data: bytes) -> tuple[NDArray[np.float64], NDArray[np.int64]]:
         raise EmptyGeometryError("the STL file holds no triangles")
     if len(idx) % 3 or idx[-1] + 3 >= len(tokens):
         raise UnreadableFileError("the ASCII STL file has a facet without exactly three vertices")
+    fields = tokens[idx[:, None] + np.arange(1, 4)]
     try:
-        coords = tokens[idx[:, None] + np.arange(1, 4)].astype(np.float64)
+        coords = fields.astype(np.float64)
     except ValueError as exc:
-        raise UnreadableFileError(f"the ASCII STL file has a malformed vertex line ({exc})") from exc
+        bad = next((t for t in fields.ravel().tolist() if not _is_number(t)), None)
+        shown = "a token that is no number" if bad is None else repr(bad.decode("utf-8", "replace")[:40])
+        raise UnreadableFileError(f"the ASCII STL file has a malformed vertex line: {shown} where a coordinate should be") from exc
     return weld(coords, np.arange(len(idx), dtype=np.int64).reshape(-1, 3))
