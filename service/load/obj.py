@@ -28,6 +28,7 @@ from numpy.typing import NDArray
 
 from ..errors import EmptyGeometryError, UnreadableFileError, UnsupportedFormatError
 from .polygons import fan_split_note, fan_triangles
+from .safe import is_number
 
 __all__ = ["read_obj"]
 
@@ -142,21 +143,13 @@ def _refuse_mni(lines: list[str]) -> None:
     lines); Wavefront OBJ has no such statement.
     """
     first = next((line.split() for line in lines if line.strip()), [])
-    if first[:1] in (["P"], ["L"]) and len(first) >= 3 and all(_is_number(t) for t in first[1:]):
+    if first[:1] in (["P"], ["L"]) and len(first) >= 3 and all(is_number(t) for t in first[1:]):
         raise UnsupportedFormatError(
             "the .obj file is an MNI object file (brain-imaging surfaces; its first line is "
             f"{' '.join(first[:7])!r}), not a Wavefront OBJ; convert it to STL, PLY or Wavefront OBJ first "
             "(VTK's vtkMNIObjectReader reads it)",
             format="obj",
         )
-
-
-def _is_number(text: str) -> bool:
-    try:
-        float(text)
-    except ValueError:
-        return False
-    return True
 
 
 def _vertices(rows: list[list[str]], line_nos: list[int], lines: list[str]) -> NDArray[np.float64]:

@@ -24,7 +24,7 @@ from typing import TypeVar
 
 from ..errors import InputTooLargeError, ServiceError, UnreadableFileError
 
-__all__ = ["guarded_read", "explain"]
+__all__ = ["guarded_read", "explain", "is_number"]
 
 T = TypeVar("T")
 
@@ -87,3 +87,12 @@ def guarded_read(fn: Callable[[], T], fmt: str) -> T:
 def _short(exc: BaseException) -> str:
     text = str(exc).strip()
     return (text.splitlines()[0] if text else "")[:200]
+
+
+def is_number(token: str | bytes) -> bool:
+    """Whether a token of a text file reads as a number (Python's ``float``, as the readers parse it)."""
+    try:
+        float(token)
+    except ValueError:
+        return False
+    return True

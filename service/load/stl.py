@@ -23,6 +23,7 @@ from numpy.typing import NDArray
 from ..blocks import for_each_block
 from ..errors import EmptyGeometryError, UnreadableFileError
 from ..topology import row_ids, weld
+from .safe import is_number
 
 __all__ = ["read_stl", "read_stl_file"]
 
@@ -104,14 +105,6 @@ def _welded(corners: NDArray[np.float32]) -> tuple[NDArray[np.float64], NDArray[
     return vertices, ids.reshape(-1, 3)
 
 
-def _is_number(token: bytes) -> bool:
-    try:
-        float(token)
-    except ValueError:
-        return False
-    return True
-
-
 def _ascii(data: bytes) -> tuple[NDArray[np.float64], NDArray[np.int64]]:
     tokens = np.array(data.split())
     idx = np.flatnonzero(tokens == b"vertex")
@@ -127,7 +120,7 @@ def _ascii(data: bytes) -> tuple[NDArray[np.float64], NDArray[np.int64]]:
     try:
         coords = fields.astype(np.float64)
     except ValueError as exc:
-        bad = next((t for t in fields.ravel().tolist() if not _is_number(t)), None)
+        bad = next((t for t in fields.ravel().tolist() if not is_number(t)), None)
         shown = "a token that is no number" if bad is None else repr(bad.decode("utf-8", "replace")[:40])
         raise UnreadableFileError(f"the ASCII STL file has a malformed vertex line: {shown} where a coordinate should be") from exc
     return weld(coords, np.arange(len(idx), dtype=np.int64).reshape(-1, 3))
