@@ -886,3 +886,25 @@ def test_3mf_overlapping_components_are_named(offset: tuple[float, float, float]
     assert any("overlap" in w for w in doc["warnings"]) is overlaps
     # the overlap is not measured: the estimate does not claim the sum's rounding for the united solid
     assert (doc["diagnostics"]["relative_error_estimate"] == 1.0) is overlaps
+
+
+@pytest.mark.parametrize(("order", "newline"), [("<", "\r"), (">", "\n"), ("<", "\r\n")])
+def test_a_binary_ply_with_quads_and_triangles_is_read(order: str, newline: str) -> None:
+    # draco's testdata/Box.ply (a Rhino export): binary faces of 4 and 3 corners, header lines ending in a bare
+    # \r, and a material element after the faces; trimesh reads a binary list as if every row had the first
+    # row's length ("PLY is unexpected length!") and the file was refused as unreadable
+    encoding = "binary_little_endian" if order == "<" else "binary_big_endian"
+    quads = [q for q in _BOX_QUADS if q != _BOX_QUADS[5]]
+    last = _BOX_QUADS[5]
+    faces: list[tuple[int, ...]] = [*quads, (last[0], last[1], last[2]), (last[0], last[2], last[3])]
+    head = ["ply", f"format {encoding} 1.0", "comment Rhino-like", "element vertex 8", "property float x", "property float y"]
+    head += ["property float z", f"element face {len(faces)}", "property list uchar int vertex_indices", "element material 1"]
+    head += ["property uchar red", "property float shine", "end_header"]
+    text = (newline.join(head) + newline).encode()
+    text += np.asarray(_BOX_CORNERS, dtype=order + "f4").tobytes()
+    text += b"".join(struct.pack(f"{order}B{len(f)}i", len(f), *f) for f in faces)
+    text += struct.pack(f"{order}Bf", 200, 0.5)
+    doc = analyze(text, filename="Box.ply").as_dict()
+    assert doc["mass"] / doc["density"] == 6.0  # the 1 x 2 x 3 box, exact
+    assert doc["center_of_mass"] == pytest.approx([0.5, 1.0, 1.5], rel=1e-15)
+    assert doc["principal"]["moments"] == pytest.approx(sorted(6000 * (p + q) / 12 for p, q in ((4, 9), (1, 9), (1, 4))), rel=1e-14)

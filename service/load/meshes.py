@@ -138,14 +138,20 @@ def read_trimesh_parts(
     # the upload's own files, and nothing else: a name outside them (a texture that did not come along, a path)
     # is not found, never looked for on disk; images are not needed for the geometry (skip_materials)
     kwargs: dict[str, Any] = {"resolver": trimesh.resolvers.ZipResolver(dict(companions or {}))}
-    scene = guarded_read(
-        lambda: _same_names_every_read(
-            lambda: trimesh.load_scene(
-                io.BytesIO(data), file_type=fmt, process=False, skip_materials=True, merge_primitives=False, **kwargs
-            )
-        ),
-        fmt,
-    )
+    try:
+        scene = guarded_read(
+            lambda: _same_names_every_read(
+                lambda: trimesh.load_scene(
+                    io.BytesIO(data), file_type=fmt, process=False, skip_materials=True, merge_primitives=False, **kwargs
+                )
+            ),
+            fmt,
+        )
+    except UnreadableFileError:
+        own = _own_binary_ply(data, length_scale) if fmt == "ply" else None  # faces of several lengths, a \r header
+        if own is None:
+            raise
+        return own, None
     if fmt == "ply":
         _with_triangle_strips(scene)
     parts: list[Part] = []
@@ -177,6 +183,25 @@ def read_trimesh_parts(
         assert isinstance(first.body, MeshBody)
         parts[0] = Part(first.name, replace(first.body, warnings=(*first.body.warnings, *notes)))
     return parts, _declared_unit(scene, fmt)
+
+
+def _own_binary_ply(data: bytes, length_scale: float) -> list[Part] | None:
+    """A binary PLY file trimesh could not read, by ``ply.read_binary_ply``; None where that cannot read it
+    either (trimesh's error then stands)."""
+    from .ply import read_binary_ply
+    from .polygons import fan_split_note, fan_triangles
+
+    found = read_binary_ply(data)
+    if found is None:
+        return None
+    vertices, corners, counts = found
+    faces, _ = fan_triangles(corners, counts)
+    part = mesh_part("mesh", vertices, faces, length_scale, "ply")
+    note = fan_split_note(vertices, corners, counts, "ply")
+    if note is not None:
+        assert isinstance(part.body, MeshBody)
+        part = Part(part.name, replace(part.body, warnings=(*part.body.warnings, note)))
+    return [part]
 
 
 def _placement(graph: Any, node: Any) -> tuple[NDArray[np.float64], Any]:

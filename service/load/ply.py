@@ -1,0 +1,112 @@
+"""Binary PLY files that trimesh's reader refuses: face lists of more than one length.
+
+trimesh reads a binary element's list property as if every row had the length of
+the first (``trimesh.exchange.ply``), so a file mixing triangles and quads (Rhino's
+export, draco's testdata/Box.ply) was "unexpected length".  The PLY format
+(Turk, "The PLY Polygon File Format") gives each list its own count, so this
+reader walks the rows: scalar properties by their declared types, each list by
+its count.  Only the vertices' x, y, z and the faces' ``vertex_indices`` (or
+``vertex_index``) are kept; other elements are stepped over.  Header lines may
+end in ``\\r\\n``, ``\\n`` or a bare ``\\r``.
+"""
+
+from __future__ import annotations
+
+import struct
+
+import numpy as np
+from numpy.typing import NDArray
+
+__all__ = ["read_binary_ply"]
+
+_TYPES = {
+    "char": "b",
+    "int8": "b",
+    "uchar": "B",
+    "uint8": "B",
+    "short": "h",
+    "int16": "h",
+    "ushort": "H",
+    "uint16": "H",
+    "int": "i",
+    "int32": "i",
+    "uint": "I",
+    "uint32": "I",
+    "float": "f",
+    "float32": "f",
+    "double": "d",
+    "float64": "d",
+}
+
+Property = tuple[str, str, str | None]  # name, value type, count type (lists only)
+
+
+def _header(data: bytes) -> tuple[str, list[tuple[str, int, list[Property]]], int] | None:
+    """Byte order, elements (name, count, properties) and the offset of the data; None for no binary PLY."""
+    end = data.find(b"end_header")
+    if not data.startswith(b"ply") or end < 0:
+        return None
+    start = end + len(b"end_header")
+    start += 2 if data[start : start + 2] == b"\r\n" else 1 if data[start : start + 1] in (b"\n", b"\r") else 0
+    lines = data[:end].decode("ascii", "replace").replace("\r\n", "\n").replace("\r", "\n").split("\n")
+    order = None
+    elements: list[tuple[str, int, list[Property]]] = []
+    for line in lines:
+        words = line.split()
+        if words[:1] == ["format"] and len(words) >= 2:
+            order = {"binary_little_endian": "<", "binary_big_endian": ">"}.get(words[1])
+        elif words[:1] == ["element"] and len(words) == 3 and words[2].isdigit():
+            elements.append((words[1], int(words[2]), []))
+        elif words[:1] == ["property"] and elements:
+            if words[1] == "list" and len(words) == 5 and words[2] in _TYPES and words[3] in _TYPES:
+                elements[-1][2].append((words[4], _TYPES[words[3]], _TYPES[words[2]]))
+            elif len(words) == 3 and words[1] in _TYPES:
+                elements[-1][2].append((words[2], _TYPES[words[1]], None))
+            else:
+                return None
+    return None if order is None else (order, elements, start)
+
+
+def read_binary_ply(data: bytes) -> tuple[NDArray[np.float64], NDArray[np.int64], NDArray[np.int64]] | None:
+    """The vertices (x, y, z in their declared types), every face's corners one after another, and the
+    corners per face, of a binary PLY file; None where it is no binary PLY with vertices and faces this
+    reader can walk (the caller's own error then stands)."""
+    found = _header(data)
+    if found is None:
+        return None
+    order, elements, offset = found
+    vertices: NDArray[np.float64] | None = None
+    corners: list[int] = []
+    counts: list[int] = []
+    for name, count, props in elements:
+        if all(kind is None for _, _, kind in props):  # fixed rows: one read
+            dtype = np.dtype([(p or f"_{k}", order + t) for k, (p, t, _) in enumerate(props)])
+            if offset + dtype.itemsize * count > len(data):
+                return None
+            rows = np.frombuffer(data, dtype, count, offset)
+            offset += dtype.itemsize * count
+            if name == "vertex":
+                if not {"x", "y", "z"} <= set(dtype.names or ()):
+                    return None
+                vertices = np.stack([rows[c].astype(np.float64) for c in "xyz"], axis=1)
+            continue
+        steps = [(p, struct.Struct(order + t), None if c is None else struct.Struct(order + c)) for p, t, c in props]
+        keep = "vertex_indices" if any(p == "vertex_indices" for p, _, _ in props) else "vertex_index"
+        for _ in range(count):
+            for prop, value, counter in steps:
+                if counter is None:
+                    offset += value.size
+                    continue
+                if offset + counter.size > len(data):
+                    return None
+                (n,) = counter.unpack_from(data, offset)
+                offset += counter.size
+                if n < 0 or offset + n * value.size > len(data):
+                    return None
+                if name == "face" and prop == keep:
+                    corners.extend(struct.unpack_from(f"{order}{n}{value.format[-1]}", data, offset))
+                    counts.append(n)
+                offset += n * value.size
+    if vertices is None or not counts or offset > len(data):
+        return None
+    return vertices, np.asarray(corners, dtype=np.int64), np.asarray(counts, dtype=np.int64)
