@@ -908,3 +908,29 @@ def test_a_binary_ply_with_quads_and_triangles_is_read(order: str, newline: str)
     assert doc["mass"] / doc["density"] == 6.0  # the 1 x 2 x 3 box, exact
     assert doc["center_of_mass"] == pytest.approx([0.5, 1.0, 1.5], rel=1e-15)
     assert doc["principal"]["moments"] == pytest.approx(sorted(6000 * (p + q) / 12 for p, q in ((4, 9), (1, 9), (1, 4))), rel=1e-14)
+
+
+@pytest.mark.parametrize(
+    "head",
+    [
+        ["element vertex 1", "property float x", "property float x", "property float z"],  # a name twice
+        ["element vertex 3"],  # no properties
+        [
+            "element vertex 1",
+            "property float x",
+            "property float y",
+            "property float z",
+            "element face 1",
+            "property list uchar int vertex_indices",
+        ],
+    ],
+    ids=["repeated-name", "no-properties", "truncated"],
+)
+def test_a_binary_ply_no_reader_can_walk_is_refused_in_a_sentence(head: list[str]) -> None:
+    # the fallback reader gives up (None) and trimesh's own classified error stands, not a numpy ValueError
+    from inertia.load.ply import read_binary_ply
+
+    text = ("\n".join(["ply", "format binary_little_endian 1.0", *head, "end_header"]) + "\n").encode() + b"\x00" * 5
+    assert read_binary_ply(text) is None
+    with pytest.raises(ServiceError):
+        analyze(text, filename="broken.ply")

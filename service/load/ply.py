@@ -74,21 +74,30 @@ def read_binary_ply(data: bytes) -> tuple[NDArray[np.float64], NDArray[np.int64]
     found = _header(data)
     if found is None:
         return None
-    order, elements, offset = found
+    try:
+        return _walk(data, *found)
+    except (ValueError, struct.error):  # a header numpy or struct cannot lay out (no properties, a bad count)
+        return None
+
+
+def _walk(
+    data: bytes, order: str, elements: list[tuple[str, int, list[Property]]], offset: int
+) -> tuple[NDArray[np.float64], NDArray[np.int64], NDArray[np.int64]] | None:
     vertices: NDArray[np.float64] | None = None
     corners: list[int] = []
     counts: list[int] = []
     for name, count, props in elements:
         if all(kind is None for _, _, kind in props):  # fixed rows: one read
-            dtype = np.dtype([(p or f"_{k}", order + t) for k, (p, t, _) in enumerate(props)])
+            dtype = np.dtype([(f"_{k}", order + t) for k, (_, t, _) in enumerate(props)])  # names may repeat
             if offset + dtype.itemsize * count > len(data):
                 return None
             rows = np.frombuffer(data, dtype, count, offset)
             offset += dtype.itemsize * count
             if name == "vertex":
-                if not {"x", "y", "z"} <= set(dtype.names or ()):
+                names = [p for p, _, _ in props]
+                if not {"x", "y", "z"} <= set(names):
                     return None
-                vertices = np.stack([rows[c].astype(np.float64) for c in "xyz"], axis=1)
+                vertices = np.stack([rows[f"_{names.index(c)}"].astype(np.float64) for c in "xyz"], axis=1)
             continue
         steps = [(p, struct.Struct(order + t), None if c is None else struct.Struct(order + c)) for p, t, c in props]
         keep = "vertex_indices" if any(p == "vertex_indices" for p, _, _ in props) else "vertex_index"
