@@ -152,10 +152,12 @@ def _orient_outward(
         noise = np.bincount(label, weights=_volume_magnitudes(x, faces), minlength=count)
         solid = np.abs(np.bincount(label, weights=det, minlength=count)) > 64 * EPS * noise
         return faces, _overlap_note(x, faces, label, solid)
-    scale = _volume_magnitudes(x, faces)  # each face's rounding scale, for the shells' noise
-    del x
     total = float(det.sum())
     count, label = face_components(faces, topo)
+    if count == 1:  # one shell: the file's winding or its reverse; no shell noise to weigh
+        return (faces[:, [0, 2, 1]], [INVERTED]) if total < 0 else (faces, [])
+    scale = _volume_magnitudes(x, faces)  # each face's rounding scale, for the shells' noise
+    del x
     vol = np.bincount(label, weights=det, minlength=count)
     if count > 1 and np.any(vol < 0) and not _each_closed(faces, label):
         # components split at non-manifold edges (two rooms sharing a wall) are not shells by themselves:
@@ -164,10 +166,8 @@ def _orient_outward(
         vol = np.bincount(label, weights=det, minlength=count)
     noise = np.bincount(label, weights=scale, minlength=count)
     flat = np.abs(vol) <= 64 * EPS * noise  # a shell of zero volume: no orientation makes it a body
-    if count == 1:
-        if total < 0:
-            return faces[:, [0, 2, 1]], [INVERTED]
-        return faces, []
+    if count == 1:  # one shell once the non-manifold splits are joined
+        return (faces[:, [0, 2, 1]], [INVERTED]) if total < 0 else (faces, [])
     if bool(np.all((vol > 0) | flat)):
         # every shell encloses positive volume as the file winds it: the file says each is a solid (one inside
         # another is a second body there, not a cavity), as when all its faces see the local origin from outside;
