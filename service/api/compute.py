@@ -59,7 +59,7 @@ MIB = 1024 * 1024
 MEMORY_FLOOR_BYTES = 768 * MIB
 MEMORY_FACTOR = 32
 COMPRESSED_MEMORY_FACTOR = 256
-_COMPRESSED = (".3mf", ".vtu", ".vtp", ".vts", ".vtr", ".zip")
+_COMPRESSED = (".3mf", ".vtu", ".vtp", ".vts", ".vtr", ".vti", ".zip")
 
 
 def memory_limit(size: int, filename: str | None, cap: int) -> int:

@@ -13,7 +13,7 @@ from ..conventions import length_scale
 from ..errors import EmptyGeometryError, ExternalReferenceError, ServiceError, UnreadableFileError
 from ..vocabulary import Isotopes, MassUnit, SourceKind, UnitsFrom
 from .guard import check_upload, plain_name
-from .sniff import CAD_FORMATS, FORMATS, POINT_FORMATS, SCENE_FORMATS, SURFACE_FORMATS, VOLUME_FORMATS, sniff_format
+from .sniff import CAD_FORMATS, FORMATS, POINT_FORMATS, SCENE_FORMATS, SURFACE_FORMATS, VOLUME_FORMATS, VTK_FORMATS, sniff_format
 from .upload import pick_model_file, unpack_zip
 
 XYZ_UNIT = "angstrom"  # the XYZ format's length unit (coordinates in angstrom, as chemistry programs write them)
@@ -282,7 +282,7 @@ def _load_bytes(
         body, molecule, declared = read_points_document(data, fmt, scale, isotopes=isotopes)
         parts = [Part(_stem(filename), body, {"molecule": True} if molecule else {})]
         kind = SourceKind.POINTS
-    elif fmt in VOLUME_FORMATS:
+    elif fmt in VOLUME_FORMATS or fmt in VTK_FORMATS:
         from .volume import read_volume_parts
 
         parts = read_volume_parts(data, fmt, scale, filename=filename, companions=companions)

@@ -580,6 +580,7 @@ _CHECKS: dict[str, Callable[[bytes, _Context], None]] = {
     "vtp": _check_vtk_xml,
     "vts": _check_vtk_xml,
     "vtr": _check_vtk_xml,
+    "vti": _check_vtk_xml,
     "pvtu": _check_vtk_xml,
     "3mf": _check_zip,
     "gltf": _check_gltf,

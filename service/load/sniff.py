@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import importlib.util
+import re
 from functools import cache
 
 from ..errors import UnsupportedFormatError
@@ -13,18 +14,22 @@ __all__ = [
     "SCENE_FORMATS",
     "POINT_FORMATS",
     "CAD_FORMATS",
+    "VTK_FORMATS",
     "sniff_format",
     "FORMATS",
     "OPTIONAL_READERS",
     "unavailable_formats",
 ]
 
-# surface meshes read through our STL reader or trimesh
-SURFACE_FORMATS = ("stl", "obj", "ply", "off", "glb", "gltf", "3mf")
-# volume meshes read through meshio (extension -> meshio file_format)
+# surface meshes: read through our STL reader or trimesh, and VTK XML polydata (.vtp) through VTK
+SURFACE_FORMATS = ("stl", "obj", "ply", "off", "glb", "gltf", "3mf", "vtp")
+# volume meshes read through meshio (extension -> meshio file_format), those of ``VTK_FORMATS`` through VTK
 VOLUME_FORMATS = {
     "vtu": "vtu",
     "vtk": "vtk",
+    "vts": "vts",
+    "vtr": "vtr",
+    "vti": "vti",
     "msh": "gmsh",
     "mesh": "medit",
     "inp": "abaqus",
@@ -34,6 +39,16 @@ VOLUME_FORMATS = {
     "dat": "tecplot",
     "ugrid": "ugrid",
     "ele": "tetgen",
+}
+# read by VTK's own readers (the ``vtk`` extra): the legacy format and the serial XML data sets, by the
+# data set type each XML file declares
+VTK_FORMATS = ("vtk", "vtu", "vtp", "vts", "vtr", "vti")
+VTK_XML_TYPES = {
+    "UnstructuredGrid": "vtu",
+    "PolyData": "vtp",
+    "StructuredGrid": "vts",
+    "RectilinearGrid": "vtr",
+    "ImageData": "vti",
 }
 # formats that can hold several named bodies
 SCENE_FORMATS = ("glb", "gltf", "3mf", "obj", "vtu", "vtk", "msh", "mesh", "inp", "xdmf", "med", "step", "iges")
@@ -46,8 +61,7 @@ FORMATS = SURFACE_FORMATS + tuple(VOLUME_FORMATS) + CAD_FORMATS
 OPTIONAL_READERS: dict[str, tuple[str, str]] = {
     "xdmf": ("h5py", "the 'hdf5' extra: pip install 'inertia-service[hdf5]'"),
     "med": ("h5py", "the 'hdf5' extra: pip install 'inertia-service[hdf5]'"),
-    "vtk": ("vtkmodules", "the 'vtk' extra: pip install 'inertia-service[vtk]'"),
-    "vtu": ("vtkmodules", "the 'vtk' extra: pip install 'inertia-service[vtk]'"),
+    **{f: ("vtkmodules", "the 'vtk' extra: pip install 'inertia-service[vtk]'") for f in VTK_FORMATS},
     "step": ("OCP", "the 'cad' extra: pip install 'inertia-service[cad]'"),
     "iges": ("OCP", "the 'cad' extra: pip install 'inertia-service[cad]'"),
 }
@@ -110,9 +124,18 @@ def _from_content(head: bytes) -> str | None:
     if head.lstrip()[:5].lower() == b"solid":
         return "stl"
     if b"<VTKFile" in head[:200]:
-        return "vtu"
+        return vtk_xml_type(head) or "vtu"
     if head.lstrip().startswith(b"ISO-10303-21"):
         return "step"
     if len(head) >= 80 and head[72:73] == b"S" and head[73:80].strip().isdigit():  # IGES start section, column 73
         return "iges"
     return None
+
+
+_VTK_XML_ROOT = re.compile(rb"<VTKFile\b[^>]*?\btype\s*=\s*[\"']([A-Za-z]+)[\"']")
+
+
+def vtk_xml_type(head: bytes) -> str | None:
+    """The format key of the serial data set a VTK XML file declares (``<VTKFile type="PolyData"``), else None."""
+    match = _VTK_XML_ROOT.search(head[:1024])
+    return VTK_XML_TYPES.get(match.group(1).decode("ascii")) if match else None

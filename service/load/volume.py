@@ -76,11 +76,9 @@ from ..cells import CELL_NODES, VOXEL_TO_HEXAHEDRON
 from ..errors import EmptyGeometryError, InputTooLargeError, UnreadableFileError, UnsupportedFormatError
 from .guard import INFLATE_RATIO, inflate_budget, own_name, refuse_reference
 from .polygons import fan_split_note, fan_triangles
-from .sniff import VOLUME_FORMATS
+from .sniff import VOLUME_FORMATS, VTK_FORMATS, VTK_XML_TYPES, vtk_xml_type
 
 __all__ = ["read_volume_parts", "VTK_FORMATS", "VTK_CELL_TYPES"]
-
-VTK_FORMATS = ("vtk", "vtu")
 
 # VTK cell type id -> our (meshio's) name; voxels become hexahedra
 VTK_CELL_TYPES = {
@@ -150,6 +148,10 @@ _MESHIO_OTHER_3D = (
 _FORMAT_NAMES = {
     "vtk": "legacy VTK",
     "vtu": "VTK XML (.vtu)",
+    "vtp": "VTK XML polydata (.vtp)",
+    "vts": "VTK XML structured grid (.vts)",
+    "vtr": "VTK XML rectilinear grid (.vtr)",
+    "vti": "VTK XML image data (.vti)",
     "msh": "Gmsh",
     "mesh": "Medit",
     "inp": "Abaqus",
@@ -182,6 +184,7 @@ class _Mesh:
     other: dict[str, int]  # cells that are not 3-D: type -> count (ignored, reported if nothing else)
     warnings: list[str] = field(default_factory=list)
     surface: _Surface | None = None  # the linear 2-D cells, kept where the file has no 3-D cells
+    polydata: bool = False  # a VTK polydata set: a surface by its kind, so reading it as one assumes nothing
 
 
 @dataclass
@@ -341,15 +344,32 @@ def _read_vtk(data: bytes, fmt: str, label: str) -> _Mesh:
     try:
         from vtkmodules.util.numpy_support import vtk_to_numpy
         from vtkmodules.vtkCommonCore import vtkLogger, vtkOutputWindow, vtkStringOutputWindow
+        from vtkmodules.vtkCommonExecutionModel import vtkAlgorithm
         from vtkmodules.vtkFiltersCore import vtkAppendFilter
         from vtkmodules.vtkIOGeometry import vtkAVSucdReader
         from vtkmodules.vtkIOLegacy import vtkDataSetReader
-        from vtkmodules.vtkIOXML import vtkXMLUnstructuredGridReader
+        from vtkmodules.vtkIOXML import (
+            vtkXMLImageDataReader,
+            vtkXMLPolyDataReader,
+            vtkXMLRectilinearGridReader,
+            vtkXMLStructuredGridReader,
+            vtkXMLUnstructuredGridReader,
+        )
     except ImportError as exc:
         raise _vtk_missing(label, fmt) from exc
 
     kind, fmt = ("AVS UCD", "inp") if fmt == "ucd" else ("VTK", fmt)  # the file's own format, as the client named it
+    readers: dict[str, Any] = {
+        "vtu": vtkXMLUnstructuredGridReader,
+        "vtp": vtkXMLPolyDataReader,
+        "vts": vtkXMLStructuredGridReader,
+        "vtr": vtkXMLRectilinearGridReader,
+        "vti": vtkXMLImageDataReader,
+        "inp": vtkAVSucdReader,
+    }
+    reader_for = _vtk_xml_reader(data, fmt, label) if fmt in VTK_XML_TYPES.values() else fmt
     window = vtkStringOutputWindow()
+    polydata = False
     with _VTK_LOCK, _upload_dir(data, fmt, None, None) as path:  # the output window is process-wide
         previous = vtkOutputWindow.GetInstance()
         try:
@@ -357,15 +377,19 @@ def _read_vtk(data: bytes, fmt: str, label: str) -> _Mesh:
             # VTK's logger writes errors to stderr beside the output window; it stays off for the process
             vtkLogger.SetStderrVerbosity(vtkLogger.VERBOSITY_OFF)
             with _quiet():
-                readers: dict[str, Any] = {"vtu": vtkXMLUnstructuredGridReader, "inp": vtkAVSucdReader}
-                reader: Any = readers.get(fmt, vtkDataSetReader)()
+                reader: Any = readers.get(reader_for, vtkDataSetReader)()
                 reader.SetFileName(path)
-                if fmt == "vtk":
+                if reader_for == "vtk":
                     reader.ReadAllScalarsOn()
                 reader.Update()
                 grid = reader.GetOutput()
+                polydata = grid is not None and grid.GetClassName() == "vtkPolyData"
+                image = _image_note(grid, label)
                 if grid is not None and grid.GetClassName() != "vtkUnstructuredGrid":
                     merge = vtkAppendFilter()  # image data (voxels), structured grids (hexahedra), polydata
+                    # its points in double: an image's and a rectilinear grid's are computed (origin + i spacing),
+                    # which the default precision stores as float32 (6e-9 of the volume off, unannounced)
+                    merge.SetOutputPointsPrecision(vtkAlgorithm.DOUBLE_PRECISION)
                     merge.SetInputData(grid)
                     merge.Update()
                     grid = merge.GetOutput()
@@ -387,7 +411,61 @@ def _read_vtk(data: bytes, fmt: str, label: str) -> _Mesh:
         )
     if log:
         raise UnreadableFileError(f"{label} is damaged: VTK reported '{log}'; re-export it", format=fmt)
-    return _mesh_from_grid(grid, vtk_to_numpy, label)
+    mesh = _mesh_from_grid(grid, vtk_to_numpy, label)
+    mesh.polydata = polydata
+    mesh.warnings.extend(image)
+    return mesh
+
+
+def _image_note(grid: Any, label: str) -> list[str]:
+    """What weighing an image's every voxel assumes, where the image carries values that might mean otherwise.
+
+    An image data set (a CT or simulation volume) is a box of voxels with values at them; the body weighed
+    is the whole box, at the density asked for (or a cell array named ``density``): its other arrays (a
+    scalar field, a label map) neither mask voxels out nor weight them.
+    """
+    if grid is None or not grid.IsA("vtkImageData"):
+        return []
+    names = []
+    for data in (grid.GetPointData(), grid.GetCellData()):
+        for i in range(data.GetNumberOfArrays()):
+            name = data.GetArrayName(i) or "unnamed"
+            if name not in ("density", "vtkGhostType", "vtkValidPointMask"):
+                names.append(name)
+    if not names:
+        return []
+    shown = ", ".join(repr(n) for n in names[:5]) + (f" and {len(names) - 5} more" if len(names) > 5 else "")
+    return [
+        f"every one of the {grid.GetNumberOfCells()} voxels of {label} (image data) was weighed as solid; its "
+        f"arrays ({shown}) neither mask voxels out nor weight them (a cell array named 'density' would weight them); "
+        "to weigh a segmented part, export that part's surface or its voxels alone"
+    ]
+
+
+_VTK_ROOT_TYPE = re.compile(rb"<VTKFile\b[^>]*?\btype\s*=\s*[\"']([^\"']*)[\"']")
+
+
+def _vtk_xml_reader(data: bytes, fmt: str, label: str) -> str:
+    """Which VTK reader reads a file named as one of the XML formats: the one for the data set type its root
+    declares (as the file says, whatever its extension), the legacy reader for a legacy file, else the
+    extension's own (which then says what is wrong)."""
+    head = data[:1024]
+    declared = vtk_xml_type(head)
+    if declared:
+        return declared
+    if head.lstrip().startswith(b"# vtk DataFile"):
+        return "vtk"
+    root = _VTK_ROOT_TYPE.search(head)
+    if root:
+        name = root.group(1).decode("utf-8", "replace")[:60]
+        parallel = " (a parallel file's pieces are separate files: send each piece's own file)" if name.startswith("P") else ""
+        raise UnsupportedFormatError(
+            f"{label} holds a VTK {name!r} data set{parallel}; this service reads the serial data sets "
+            f"{', '.join(VTK_XML_TYPES)} and legacy .vtk files",
+            format=fmt,
+            data_set=name,
+        )
+    return fmt
 
 
 def _text(output: str | bytes) -> str:
@@ -1268,11 +1346,14 @@ def _surface_part(mesh: _Mesh, surface: _Surface, label: str, length_scale: floa
     vertices = mesh.points[used]
     faces = faces.reshape(-1, 3)
     rest = ", ".join(f"{n} {t}" for t, n in sorted(mesh.other.items()) if t not in _SURFACE_CELL_NAMES)
-    notes = [
-        f"{label} has no 3-D cells: its {_count(surface.cells, 'surface cell')} ({_count(len(faces), 'triangle')}) "
-        f"{'was' if surface.cells == 1 else 'were'} read as a triangle surface, as an STL file is"
-        + (f"; its other cells ({rest}) were left out" if rest else "")
-    ]
+    if mesh.polydata:  # a surface by its kind: only what was left out needs saying
+        notes = [f"{label} also holds {rest}, which bound no solid and were left out"] if rest else []
+    else:
+        notes = [
+            f"{label} has no 3-D cells: its {_count(surface.cells, 'surface cell')} ({_count(len(faces), 'triangle')}) "
+            f"{'was' if surface.cells == 1 else 'were'} read as a triangle surface, as an STL file is"
+            + (f"; its other cells ({rest}) were left out" if rest else "")
+        ]
     if mesh.density is not None:
         notes.append(f"{label} has a 'density' cell array: a surface has no cells of its own, so it was not used")
     with np.errstate(all="ignore"):  # coordinates near float64's limits: the solid path refuses them by name

@@ -302,7 +302,9 @@ GARBAGE = [
 ]
 
 
-@pytest.mark.parametrize("ext", ["vtu", "vtk", "msh", "mesh", "inp", "xdmf", "med", "f3grid", "dat", "ugrid", "ele"])
+@pytest.mark.parametrize(
+    "ext", ["vtu", "vtp", "vts", "vtr", "vti", "vtk", "msh", "mesh", "inp", "xdmf", "med", "f3grid", "dat", "ugrid", "ele"]
+)
 @pytest.mark.parametrize("blob", range(len(GARBAGE)))
 def test_broken_files_are_classified_errors_without_chatter(capfd: pytest.CaptureFixture[str], ext: str, blob: int) -> None:
     with pytest.raises(LoadError) as info:
