@@ -1,6 +1,6 @@
 """References for the real volume and CAD files, computed by the files' own tools (not by this project).
 
-    python -m benchmarks.real_references     # rewrites tests/data/real/{vtk,vtu,inp}/vtk_reference.json
+    python -m benchmarks.real_references     # rewrites tests/data/real/{vtk,vtu,inp,vtkxml}/vtk_reference.json
                                              # and tests/data/real/step/gmsh_reference.json
 
 VTK files (legacy ``.vtk``, XML ``.vtu``, AVS UCD ``.inp``): read by VTK's own
@@ -22,6 +22,17 @@ faces, are split by VTK's own ``Triangulate`` and each tetrahedron integrated
 exactly (with its absolute volume; ``vtkCellSizeFilter``'s cell volumes are
 checked to agree).
 
+VTK's other XML data sets (``.vtp``, ``.vts``, ``.vtr``, ``.vti``) are read by
+the XML reader of their type.  Grids are integrated as above (their points
+merged in double precision: an image's are computed from its origin and
+spacing).  A polydata file is a surface: its polygons and triangle strips as
+VTK stores them (strips split as ``vtkTriangleStrip`` does, every other
+triangle turned; polygons as fans from their first corner, the reading the
+service documents for polygons that are not planar), kept where every edge,
+once bit-identical points are merged, is used once in each direction, and
+integrated exactly in rational arithmetic (``benchmarks/exact.py``), turned
+outward where its volume comes out negative.
+
 STEP files: imported by Gmsh's OpenCASCADE kernel (``gmsh.model.occ``) in
 millimetres, each volume's ``getMass``, ``getCenterOfMass`` and
 ``getMatrixOfInertia`` combined (parallel axes) and converted back to the
@@ -38,6 +49,7 @@ two meshes support (``rtol``), without a tensor.
 
 from __future__ import annotations
 
+import itertools
 import json
 from pathlib import Path
 from typing import Any
@@ -61,19 +73,34 @@ STEP_UNITS = {
 }
 
 
-def read_vtk(path: Path) -> Any:
-    from vtkmodules.vtkFiltersCore import vtkAppendFilter
+def read_data_set(path: Path) -> Any:
+    """The data set as VTK's reader for the file's extension reads it."""
+    from vtkmodules import vtkIOXML
     from vtkmodules.vtkIOGeometry import vtkAVSucdReader
     from vtkmodules.vtkIOLegacy import vtkDataSetReader
-    from vtkmodules.vtkIOXML import vtkXMLUnstructuredGridReader
 
-    suffix = path.suffix.lower()
-    reader: Any = {".vtu": vtkXMLUnstructuredGridReader, ".inp": vtkAVSucdReader}.get(suffix, vtkDataSetReader)()
+    readers: dict[str, Any] = {
+        ".vtu": vtkIOXML.vtkXMLUnstructuredGridReader,
+        ".vtp": vtkIOXML.vtkXMLPolyDataReader,
+        ".vts": vtkIOXML.vtkXMLStructuredGridReader,
+        ".vtr": vtkIOXML.vtkXMLRectilinearGridReader,
+        ".vti": vtkIOXML.vtkXMLImageDataReader,
+        ".inp": vtkAVSucdReader,
+    }
+    reader: Any = readers.get(path.suffix.lower(), vtkDataSetReader)()
     reader.SetFileName(str(path))
     reader.Update()
-    grid = reader.GetOutput()
+    return reader.GetOutput()
+
+
+def read_vtk(path: Path) -> Any:
+    from vtkmodules.vtkCommonExecutionModel import vtkAlgorithm
+    from vtkmodules.vtkFiltersCore import vtkAppendFilter
+
+    grid = read_data_set(path)
     if grid.GetClassName() != "vtkUnstructuredGrid":
         merge = vtkAppendFilter()
+        merge.SetOutputPointsPrecision(vtkAlgorithm.DOUBLE_PRECISION)
         merge.SetInputData(grid)
         merge.Update()
         grid = merge.GetOutput()
@@ -161,10 +188,67 @@ def _about_centre(m0: float, m1: np.ndarray, m2: np.ndarray) -> tuple[np.ndarray
     return c, np.trace(s) * np.eye(3) - s
 
 
+def polydata_triangles(data: Any) -> tuple[np.ndarray, np.ndarray]:
+    """Points (float64) and the triangles of a polydata's polygons and strips, as VTK stores them."""
+    from vtkmodules.util.numpy_support import vtk_to_numpy
+
+    to_numpy: Any = vtk_to_numpy  # untyped
+    points = np.asarray(to_numpy(data.GetPoints().GetData()), dtype=np.float64).reshape(-1, 3)
+    tris: list[list[int]] = []
+    for cells, strip in ((data.GetPolys(), False), (data.GetStrips(), True)):
+        offsets = np.asarray(to_numpy(cells.GetOffsetsArray()), dtype=np.int64)
+        conn = np.asarray(to_numpy(cells.GetConnectivityArray()), dtype=np.int64)
+        for start, stop in itertools.pairwise(offsets.tolist()):
+            ids = conn[start:stop].tolist()
+            for k in range(len(ids) - 2):
+                if strip:
+                    a, b = (ids[k + 1], ids[k]) if k % 2 else (ids[k], ids[k + 1])
+                    tris.append([a, b, ids[k + 2]])
+                else:
+                    tris.append([ids[0], ids[k + 1], ids[k + 2]])
+    return points, np.array(tris, dtype=np.int64).reshape(-1, 3)
+
+
+def closed_and_consistent(points: np.ndarray, tris: np.ndarray) -> bool:
+    """Every edge used once in each direction, once bit-identical points are merged."""
+    _, ids = np.unique(points + 0.0, axis=0, return_inverse=True)
+    t = ids.reshape(-1)[tris]
+    t = t[(t[:, 0] != t[:, 1]) & (t[:, 1] != t[:, 2]) & (t[:, 0] != t[:, 2])]
+    directed = np.concatenate([t[:, [0, 1]], t[:, [1, 2]], t[:, [2, 0]]])
+    forward, count_f = np.unique(directed, axis=0, return_counts=True)
+    backward, count_b = np.unique(directed[:, ::-1], axis=0, return_counts=True)
+    return bool(len(t)) and np.array_equal(forward, backward) and np.array_equal(count_f, count_b) and bool(np.all(count_f == 1))
+
+
+def surface_reference(path: Path) -> dict[str, Any] | None:
+    from benchmarks.exact import exact_solid
+
+    data = read_data_set(path)
+    if data.GetPoints() is None:
+        return None  # not polydata VTK can read (a multi-block file named .vtp): the service refuses it
+    points, tris = polydata_triangles(data)
+    if not closed_and_consistent(points, tris):
+        return None  # open or inconsistently wound: the service refuses it or repairs it, no reading to compare
+    volume, centre, tensor = exact_solid(points, tris)
+    if volume < 0:  # wound inward as stored
+        volume, tensor = -volume, [[-v for v in row] for row in tensor]
+    return {
+        "volume": float(volume),
+        "center": [float(c) for c in centre],
+        "inertia_unit_density": [[float(v) for v in row] for row in tensor],
+        "reader": f"VTK {_vtk_version()} XML polydata reader; polygons as first-corner fans, exact rational integration",
+    }
+
+
 def vtk_references(folder: Path) -> dict[str, Any]:
     out: dict[str, Any] = {}
     for path in sorted(folder.iterdir()):
-        if path.suffix.lower() not in (".vtk", ".vtu", ".inp"):
+        if path.suffix.lower() == ".vtp":
+            ref = surface_reference(path)
+            if ref:
+                out[path.name] = ref
+            continue
+        if path.suffix.lower() not in (".vtk", ".vtu", ".inp", ".vts", ".vtr", ".vti"):
             continue
         m0, m1, m2, skipped = vtk_moments(read_vtk(path))
         if m0 <= 0 or any(t in _NOT_INTEGRATED for t in skipped):
@@ -252,7 +336,7 @@ def gmsh_references(folder: Path) -> dict[str, Any]:
 
 
 def main() -> int:
-    for sub in ("vtk", "vtu", "inp"):
+    for sub in ("vtk", "vtu", "inp", "vtkxml"):
         refs = vtk_references(REAL / sub)
         if refs:
             (REAL / sub / "vtk_reference.json").write_text(json.dumps(refs, indent=1) + "\n")
