@@ -835,6 +835,8 @@ def _read_meshio(data: bytes, fmt: str, label: str, filename: str | None, compan
         data = abaqus_one_node_block(data, label)
         companions = None
 
+    if fmt == "mesh":
+        data = medit_layout(data)
     try:
         mesh = _meshio_read(data, fmt, label, filename, companions)
     except UnreadableFileError as exc:
@@ -859,6 +861,28 @@ def _read_meshio(data: bytes, fmt: str, label: str, filename: str | None, compan
             "section properties; they were not weighed: the result is the solid elements alone"
         )
     return out
+
+
+# Medit's keywords whose entry count comes next (libMeshb's GmfKwdFmt), and the version keyword
+_MEDIT_COUNTED = (
+    b"Vertices|Edges|Triangles|Quadrilaterals|Tetrahedra|Prisms|Pyramids|Hexahedra|Hexaedra|Corners|Normals|"
+    b"NormalAtVertices|RequiredVertices|RequiredEdges|RequiredTriangles|Ridges|Tangents|TangentAtVertices|"
+    b"SubDomainFromMesh|VertexOnGeometricVertex|VertexOnGeometricEdge|EdgeOnGeometricEdge"
+)
+_MEDIT_VERSION_APART = re.compile(rb"(?m)^([ \t]*MeshVersionFormatted)[ \t]*\r?\n\s*(\d+)")
+_MEDIT_COUNT_BESIDE = re.compile(rb"(?m)^([ \t]*(?:" + _MEDIT_COUNTED + rb"))[ \t]+(\d+)[ \t]*(?=\r?$)")
+
+
+def medit_layout(data: bytes) -> bytes:
+    """A Medit file laid out as meshio's line reader expects it: a keyword's value on its line for the version,
+    a block's count on the next line.
+
+    libMeshb, Medit's own library, reads keywords and numbers as whitespace-separated tokens, so
+    ``MeshVersionFormatted`` and its number may sit on two lines, and a count beside its keyword; meshio
+    reads line by line and failed on both ("list index out of range", or a count taken from the first entry).
+    """
+    data = _MEDIT_VERSION_APART.sub(rb"\1 \2", data)
+    return _MEDIT_COUNT_BESIDE.sub(rb"\1\n\2", data)
 
 
 # Gmsh numbers an 18-node prism's nodes its own way (edges 0-1, 0-2, 0-3, 1-2, 1-4, 2-5, 3-4, 3-5, 4-5, then the

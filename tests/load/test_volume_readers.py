@@ -484,3 +484,31 @@ def test_a_surface_cell_apart_from_the_volume_is_named(tmp_path: Path) -> None:
     assert docs[0]["mass"] == docs[1]["mass"] == pytest.approx(1000 / 6, rel=1e-14)
     assert any("3 points that no 3-D cell uses" in w for w in docs[0]["warnings"])
     assert not any("no 3-D cell uses" in w for w in docs[1]["warnings"])
+
+
+MEDIT_TET = "Vertices{v}4\n0 0 0 1\n0.1 0 0 1\n0 0.1 0 1\n0 0 0.1 1\nTetrahedra{t}1\n1 2 3 4 0\nEnd\n"
+
+
+@pytest.mark.parametrize(
+    ("head", "v", "t"),
+    [
+        ("MeshVersionFormatted 2\nDimension 3\n", "\n", "\n"),  # as libMeshb writes it
+        ("MeshVersionFormatted\n2\n\nDimension\n3\n", "\n", "\n"),  # keyword and number on two lines
+        ("MeshVersionFormatted 2\r\nDimension 3\r\n", " ", " "),  # counts beside their keywords
+    ],
+)
+def test_medit_keywords_and_numbers_are_tokens_as_libmeshb_reads_them(head: str, v: str, t: str) -> None:
+    """libMeshb reads whitespace-separated tokens; meshio reads lines and failed on the last two layouts."""
+    data = (head + MEDIT_TET.format(v=v, t=t)).encode()
+    doc = analyze(data, filename="tet.mesh", options=AnalysisOptions(density=1.0)).as_dict()
+    assert doc["mass"] == pytest.approx(0.1**3 / 6, rel=1e-15)
+
+
+def test_medit_version_1_reals_are_single_precision_as_mmg_reads_them() -> None:
+    """MeshVersionFormatted 1 means single-precision reals, in text files too: MMG scans them with "%f"
+    into a float (mmg3d inout.c, mesh->ver < 2), and meshio reads them as float32."""
+    data = ("MeshVersionFormatted 1\nDimension 3\n" + MEDIT_TET.format(v="\n", t="\n")).encode()
+    doc = analyze(data, filename="tet.mesh", options=AnalysisOptions(density=1.0)).as_dict()
+    a = float(np.float32(0.1))
+    assert doc["mass"] == pytest.approx(a**3 / 6, rel=1e-15)
+    assert abs(doc["mass"] - 0.1**3 / 6) > 1e-8 * doc["mass"]  # not the decimal's double
