@@ -226,10 +226,10 @@ def _overlap_note(
     Each such shell is weighed as a solid of its own, so the volume two of them share counts twice: the
     sum of the signed volumes, as trimesh, numpy-stl and MuJoCo read the file; the part may be their
     union (a CAD export of touching bodies), which the file does not say.  Shared volume is seen where
-    two shells have a face in common (a body stored twice) or a vertex of one lies inside another;
-    shells that cross with no vertex inside each other (two bars laid across as a plus sign) are not
-    seen.  ``solid``: the shells that enclose volume (flat ones add none).  Beyond the nesting test's
-    work limit nothing is said.
+    two shells have a face in common (a body stored twice), a vertex of one lies inside another, or an
+    edge of one passes through a face of another (two bars laid across as a plus sign, neither with a
+    vertex inside the other: ``_edges_cross``).  ``solid``: the shells that enclose volume (flat ones add
+    none).  Beyond the tests' work limits nothing is said.
     """
     kept = np.flatnonzero(solid)
     if len(kept) < 2:
@@ -246,7 +246,11 @@ def _overlap_note(
     # a vertex of one shell clearly inside another (winding number not 0) is volume the two share: with
     # every depth taken as 0, the crossing test looks for exactly that (vertices on another shell, where
     # shells merely touch, decide nothing)
-    if not stored_twice and _crossing_shell(x, faces, label, count, np.zeros(count, dtype=np.int64), _OVERLAP_SAMPLES) is None:
+    if (
+        not stored_twice
+        and _crossing_shell(x, faces, label, count, np.zeros(count, dtype=np.int64), _OVERLAP_SAMPLES) is None
+        and not _edges_cross(x, faces, label, count)
+    ):
         return []
     return [
         f"the mesh's {count} shells all wind outward and overlap (some lie inside or across others): each is "
@@ -254,6 +258,88 @@ def _overlap_note(
         "read the file); if the part is their union, join them into one closed surface (a boolean union) or "
         "send them as separate parts"
     ]
+
+
+_EDGE_CROSSING_WORK = 20_000_000  # edge-face pairs the overlap warning tests at most (beyond: nothing said)
+_EDGE_CROSSING_BLOCK = 1 << 16  # pairs per block: ~30 MB of temporaries
+_EDGE_CROSSING_MARGIN = 1e-6  # of the two shells' size: how clearly an edge must pass through a face
+
+
+def _edges_cross(x: NDArray[np.float64], faces: NDArray[np.int64], label: NDArray[np.int64], count: int) -> bool:
+    """Whether an edge of one shell passes through a face of another, clearly: its ends on either side of
+    the face's plane and the crossing inside the triangle, each by more than ``_EDGE_CROSSING_MARGIN`` of
+    the two shells' size (shells that touch, face on face or along an edge, do not count).
+
+    Two closed surfaces that cross have such an edge, of one or of the other: where two triangles cross,
+    the ends of their common segment lie on their edges.  Only the edges and faces within both shells'
+    boxes are paired, and at most ``_EDGE_CROSSING_WORK`` pairs in all (beyond, nothing is said).
+    """
+    order = np.argsort(label, kind="stable")
+    bounds = np.searchsorted(label[order], np.arange(count + 1))
+    lo, hi = _shell_boxes(x, faces, label, count)
+    spent = 0
+    for t, partners in _box_partners(lo, hi):
+        if len(partners) == 0:
+            continue
+        lo_e, hi_e, _, _ = _undirected_edges(faces[order[bounds[t] : bounds[t + 1]]])
+        keys = np.unique(lo_e * len(x) + hi_e)  # each edge once (both its faces list it)
+        p, q = x[keys // len(x)], x[keys % len(x)]
+        for other in partners.tolist():
+            box_lo, box_hi = np.maximum(lo[t], lo[other]), np.minimum(hi[t], hi[other])
+            near = np.all((np.minimum(p, q) <= box_hi) & (np.maximum(p, q) >= box_lo), axis=1)
+            tri = faces[order[bounds[other] : bounds[other + 1]]]
+            a, b, c = x[tri[:, 0]], x[tri[:, 1]], x[tri[:, 2]]
+            inside = np.all((np.minimum(np.minimum(a, b), c) <= box_hi) & (np.maximum(np.maximum(a, b), c) >= box_lo), axis=1)
+            n_edges, n_faces = int(near.sum()), int(inside.sum())
+            spent += n_edges * n_faces + len(p) + len(tri)  # the pairs, and the selection itself
+            if spent > _EDGE_CROSSING_WORK:
+                return False
+            if n_edges == 0 or n_faces == 0:
+                continue
+            margin = _EDGE_CROSSING_MARGIN * float(np.max(np.maximum(hi[t], hi[other]) - np.minimum(lo[t], lo[other])))
+            if _segments_pierce(p[near], q[near], a[inside], b[inside], c[inside], margin):
+                return True
+    return False
+
+
+def _segments_pierce(
+    p: NDArray[np.float64],
+    q: NDArray[np.float64],
+    a: NDArray[np.float64],
+    b: NDArray[np.float64],
+    c: NDArray[np.float64],
+    margin: float,
+) -> bool:
+    """Whether any segment pq passes through any triangle abc by more than ``margin`` (every pair, in blocks)."""
+    step = max(1, _EDGE_CROSSING_BLOCK // len(a))
+    normal = np.cross(b - a, c - a)
+    size = np.linalg.norm(normal, axis=1)
+    flat = size == 0.0
+    unit = normal / np.where(flat, 1.0, size)[:, None]
+    sides = [(a, b), (b, c), (c, a)]
+    # each side's inward normal within the triangle's plane, unit length: distances of a point from the sides
+    inward = []
+    for u, v in sides:
+        d = np.cross(unit, v - u)
+        length = np.linalg.norm(d, axis=1)
+        inward.append(d / np.where(length == 0.0, 1.0, length)[:, None])
+    for start in range(0, len(p), step):
+        ps, qs = p[start : start + step, None, :], q[start : start + step, None, :]
+        dp = np.einsum("ijk,jk->ij", ps - a[None], unit)
+        dq = np.einsum("ijk,jk->ij", qs - a[None], unit)
+        across = ((dp > margin) & (dq < -margin)) | ((dp < -margin) & (dq > margin))
+        across &= ~flat[None, :]
+        if not np.any(across):
+            continue
+        i, j = np.nonzero(across)
+        t = dp[i, j] / (dp[i, j] - dq[i, j])
+        hit = p[start + i] + t[:, None] * (q[start + i] - p[start + i])
+        clear = np.ones(len(i), dtype=bool)
+        for (u, _), w in zip(sides, inward, strict=True):
+            clear &= np.einsum("ij,ij->i", hit - u[j], w[j]) > margin
+        if np.any(clear):
+            return True
+    return False
 
 
 def _undirected_edges(

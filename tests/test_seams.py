@@ -235,6 +235,27 @@ def test_outward_shells_that_overlap_are_weighed_each_and_said_so(origin: tuple[
     assert any("all wind outward and overlap" in w for w in props.warnings) is overlap
 
 
+@pytest.mark.parametrize(
+    ("offset", "overlap"),
+    [
+        ((0.0, 0.0, 0.0), True),  # a plus sign: no vertex of either bar inside the other, their middles shared
+        ((0.0, 0.0, 0.999), True),  # barely: 1e-3 of the height shared
+        ((0.0, 0.0, 1.0), False),  # stacked: face on face
+        ((0.0, 3.0, 0.0), False),  # apart
+        ((2.5, 2.5, 0.0), False),  # touching along an edge (x = 2, y = 0.5)
+        ((2.0, 2.0, 0.0), True),  # a corner region shared, no vertex clearly inside the other
+    ],
+)
+def test_bars_laid_across_each_other_are_said_to_overlap(offset: tuple[float, float, float], overlap: bool) -> None:
+    # two closed bars wound outward, 4 x 1 x 1 along x and 1 x 4 x 1 along y, centred together (plus offset):
+    # trimesh and MuJoCo sum the two (8); crossing as a plus, they share a unit cube, which counts twice
+    long_v, long_f = box(4.0, 1.0, 1.0, origin=(-2.0, -0.5, -0.5))
+    wide_v, wide_f = box(1.0, 4.0, 1.0, origin=(-0.5 + offset[0], -2.0 + offset[1], -0.5 + offset[2]))
+    props = mass_properties(MeshBody(np.vstack([long_v, wide_v]), np.vstack([long_f, wide_f + 8])), density=1.0)
+    assert props.mass == pytest.approx(8.0, rel=1e-14)
+    assert any("all wind outward and overlap" in w for w in props.warnings) is overlap
+
+
 def test_zero_stored_volume_is_never_turned_into_a_body() -> None:
     # one box stored twice, the copy inverted and coincident: the stored polyhedron encloses nothing
     v, f = box(1.0, 2.0, 3.0)
