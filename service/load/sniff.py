@@ -132,10 +132,15 @@ def _from_content(head: bytes) -> str | None:
     return None
 
 
-_VTK_XML_ROOT = re.compile(rb"<VTKFile\b[^>]*?\btype\s*=\s*[\"']([A-Za-z]+)[\"']")
+_VTK_XML_ROOT = re.compile(rb"<VTKFile\b[^>]*?\btype\s*=\s*[\"']([^\"']*)[\"']")
+
+
+def vtk_xml_root_type(head: bytes) -> str | None:
+    """The data set type a VTK XML file's root declares (``<VTKFile type="PolyData"``), else None."""
+    match = _VTK_XML_ROOT.search(head[:1024])
+    return match.group(1).decode("utf-8", "replace")[:60] if match else None
 
 
 def vtk_xml_type(head: bytes) -> str | None:
-    """The format key of the serial data set a VTK XML file declares (``<VTKFile type="PolyData"``), else None."""
-    match = _VTK_XML_ROOT.search(head[:1024])
-    return VTK_XML_TYPES.get(match.group(1).decode("ascii")) if match else None
+    """The format key of the serial data set a VTK XML file declares, else None."""
+    return VTK_XML_TYPES.get(vtk_xml_root_type(head) or "")

@@ -76,7 +76,7 @@ from ..cells import CELL_NODES, VOXEL_TO_HEXAHEDRON
 from ..errors import EmptyGeometryError, InputTooLargeError, UnreadableFileError, UnsupportedFormatError
 from .guard import INFLATE_RATIO, inflate_budget, own_name, refuse_reference
 from .polygons import fan_split_note, fan_triangles
-from .sniff import VOLUME_FORMATS, VTK_FORMATS, VTK_XML_TYPES, vtk_xml_type
+from .sniff import VOLUME_FORMATS, VTK_FORMATS, VTK_XML_TYPES, vtk_xml_root_type, vtk_xml_type
 
 __all__ = ["read_volume_parts", "VTK_FORMATS", "VTK_CELL_TYPES"]
 
@@ -442,9 +442,6 @@ def _image_note(grid: Any, label: str) -> list[str]:
     ]
 
 
-_VTK_ROOT_TYPE = re.compile(rb"<VTKFile\b[^>]*?\btype\s*=\s*[\"']([^\"']*)[\"']")
-
-
 def _vtk_xml_reader(data: bytes, fmt: str, label: str) -> str:
     """Which VTK reader reads a file named as one of the XML formats: the one for the data set type its root
     declares (as the file says, whatever its extension), the legacy reader for a legacy file, else the
@@ -455,9 +452,8 @@ def _vtk_xml_reader(data: bytes, fmt: str, label: str) -> str:
         return declared
     if head.lstrip().startswith(b"# vtk DataFile"):
         return "vtk"
-    root = _VTK_ROOT_TYPE.search(head)
-    if root:
-        name = root.group(1).decode("utf-8", "replace")[:60]
+    name = vtk_xml_root_type(head)
+    if name is not None:
         parallel = " (a parallel file's pieces are separate files: send each piece's own file)" if name.startswith("P") else ""
         raise UnsupportedFormatError(
             f"{label} holds a VTK {name!r} data set{parallel}; this service reads the serial data sets "
@@ -1371,7 +1367,8 @@ def _surface_part(mesh: _Mesh, surface: _Surface, label: str, length_scale: floa
     faces = faces.reshape(-1, 3)
     rest = ", ".join(f"{n} {t}" for t, n in sorted(mesh.other.items()) if t not in _SURFACE_CELL_NAMES)
     if mesh.polydata:  # a surface by its kind: only what was left out needs saying
-        notes = [f"{label} also holds {rest}, which bound no solid and were left out"] if rest else []
+        cells = ", ".join(_count(n, f"{t} cell") for t, n in sorted(mesh.other.items()) if t not in _SURFACE_CELL_NAMES)
+        notes = [f"{label} also holds {cells}, which bound no solid and were left out"] if cells else []
     else:
         notes = [
             f"{label} has no 3-D cells: its {_count(surface.cells, 'surface cell')} ({_count(len(faces), 'triangle')}) "
@@ -1408,6 +1405,11 @@ def _unsupported_cells(label: str, counts: Mapping[str, int]) -> str:
 def _parts(mesh: _Mesh, label: str, length_scale: float) -> list[Part]:
     if not mesh.blocks and mesh.surface is not None:
         return [_surface_part(mesh, mesh.surface, label, length_scale)]
+    if not mesh.blocks and mesh.polydata:
+        found = ", ".join(_count(n, f"{t} cell") for t, n in sorted(mesh.other.items())) or "no cells at all"
+        raise EmptyGeometryError(
+            f"{label} holds no polygons or triangle strips (only {found}), so nothing in it bounds a solid; send a closed surface"
+        )
     if not mesh.blocks:
         found = ", ".join(f"{n} {t}" for t, n in sorted(mesh.other.items())) or "no cells at all"
         raise EmptyGeometryError(
