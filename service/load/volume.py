@@ -862,7 +862,8 @@ def _read_meshio(data: bytes, fmt: str, label: str, filename: str | None, compan
 # Medit's keywords whose entry count comes next (libMeshb's GmfKwdFmt), and the version keyword
 _MEDIT_COUNTED = (
     b"Vertices|Edges|Triangles|Quadrilaterals|Tetrahedra|Prisms|Pyramids|Hexahedra|Hexaedra|Corners|Normals|"
-    b"NormalAtVertices|RequiredVertices|RequiredEdges|RequiredTriangles|Ridges|Tangents|TangentAtVertices|"
+    b"NormalAtVertices|RequiredVertices|RequiredEdges|RequiredTriangles|RequiredQuadrilaterals|RequiredTetrahedra|"
+    b"RequiredPrisms|RequiredPyramids|RequiredHexahedra|Ridges|Tangents|TangentAtVertices|"
     b"SubDomainFromMesh|VertexOnGeometricVertex|VertexOnGeometricEdge|EdgeOnGeometricEdge"
 )
 _MEDIT_VERSION_APART = re.compile(rb"(?m)^([ \t]*MeshVersionFormatted)[ \t]*\r?\n\s*(\d+)")
@@ -878,7 +879,24 @@ def medit_layout(data: bytes) -> bytes:
     reads line by line and failed on both ("list index out of range", or a count taken from the first entry).
     """
     data = _MEDIT_VERSION_APART.sub(rb"\1 \2", data)
-    return _MEDIT_COUNT_BESIDE.sub(rb"\1\n\2", data)
+    data = _MEDIT_COUNT_BESIDE.sub(rb"\1\n\2", data)
+    return _without_required_blocks(data)
+
+
+# libMeshb's "required" entities (one id each: elements a remesher must keep, MmgTools' test meshes): meshio
+# knows only RequiredVertices and refuses the file at any other; they weigh nothing
+_MEDIT_REQUIRED = re.compile(
+    rb"(?m)^[ \t]*Required(?:Edges|Triangles|Quadrilaterals|Tetrahedra|Prisms|Pyramids|Hexahedra)[ \t]*\r?\n[ \t]*(\d+)[ \t]*\r?$"
+)
+
+
+def _without_required_blocks(data: bytes) -> bytes:
+    """The Medit file without its Required* blocks other than RequiredVertices (keyword, count and ids)."""
+    while (match := _MEDIT_REQUIRED.search(data)) is not None:
+        ids = int(match.group(1))
+        rest = data[match.end() :].split(None, ids)  # the block's ids, then the rest of the file
+        data = data[: match.start()] + (b"\n" + rest[ids] if len(rest) > ids else b"\n")
+    return data
 
 
 # Gmsh numbers an 18-node prism's nodes its own way (edges 0-1, 0-2, 0-3, 1-2, 1-4, 2-5, 3-4, 3-5, 4-5, then the

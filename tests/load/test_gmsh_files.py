@@ -118,13 +118,23 @@ def test_a_version_1_gmsh_file_is_refused_by_its_version() -> None:
 
 
 def test_a_readers_warning_is_not_given_as_the_reason_it_failed() -> None:
-    # MmgTools' init.mesh: meshio prints "Warning: ... doesn't know keyword RequiredVertices. Skipping.", then
-    # fails on RequiredEdges; the refusal named the harmless warning
+    # as MmgTools' init.mesh once did: meshio prints "Warning: ... doesn't know keyword RequiredVertices.
+    # Skipping.", then fails on a keyword it does not know; the refusal named the harmless warning
     lines = ["MeshVersionFormatted 2", "Dimension 3", "Vertices", "1", "0 0 0 1", "RequiredVertices", "1", "1"]
-    lines += ["RequiredEdges", "1", "1", "End"]
+    lines += ["NoSuchKeyword", "1", "1", "End"]
     with pytest.raises(UnreadableFileError) as caught:
         analyze(("\n".join(lines) + "\n").encode(), filename="init.mesh")
-    assert "RequiredEdges" in caught.value.message and "Skipping" not in caught.value.message
+    assert "NoSuchKeyword" in caught.value.message and "Skipping" not in caught.value.message
+
+
+def test_medit_required_entities_weigh_nothing_and_are_read_past() -> None:
+    # libMeshb's Required* blocks (elements a remesher keeps; MmgTools' test meshes): meshio refused every one
+    # but RequiredVertices ("Unknown keyword 'RequiredEdges'")
+    lines = ["MeshVersionFormatted 2", "Dimension 3", "Vertices", "4", "0 0 0 1", "2 0 0 1", "0 2 0 1", "0 0 2 1"]
+    lines += ["RequiredVertices", "1", "1", "Edges", "1", "1 2 0", "RequiredEdges", "1", "1"]
+    lines += ["Tetrahedra", "1", "1 2 3 4 0", "RequiredTetrahedra 1", "1", "RequiredTriangles", "0", "End"]
+    doc = analyze(("\n".join(lines) + "\n").encode(), filename="init.mesh").as_dict()
+    assert doc["mass"] / doc["density"] == pytest.approx(8 / 6, rel=1e-15)
 
 
 _MSH41_SAVE_ALL = """$MeshFormat
