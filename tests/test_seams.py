@@ -239,7 +239,8 @@ def test_outward_shells_that_overlap_are_weighed_each_and_said_so(origin: tuple[
     ("offset", "overlap"),
     [
         ((0.0, 0.0, 0.0), True),  # a plus sign: no vertex of either bar inside the other, their middles shared
-        ((0.0, 0.0, 0.999), True),  # barely: 1e-3 of the height shared
+        ((0.0, 0.0, 0.99), True),  # 1e-2 of the height shared
+        ((0.0, 0.0, 0.9999), False),  # 1e-4 of it: as far as tessellated parts that touch cut into each other
         ((0.0, 0.0, 1.0), False),  # stacked: face on face
         ((0.0, 3.0, 0.0), False),  # apart
         ((2.5, 2.5, 0.0), False),  # touching along an edge (x = 2, y = 0.5)
