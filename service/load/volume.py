@@ -840,6 +840,8 @@ def _read_meshio(data: bytes, fmt: str, label: str, filename: str | None, compan
         if again is None:
             raise
         mesh = _meshio_read(again, fmt, label, filename, companions)
+        if b"$Entities" not in again:  # read without its entities: their physical tags name the blocks again
+            _restore_physical_tags(mesh, gmsh_entity_physicals(data))
     if fmt == "msh":
         _gmsh_node_order(mesh)
     out = _mesh_from_meshio(mesh, label)
@@ -1246,7 +1248,8 @@ def _gmsh_retry(data: bytes, exc: UnreadableFileError, label: str) -> bytes | No
 
     - An MSH 4 file whose elements lie in entities of which only some carry physical tags (Gmsh's
       ``Mesh.SaveAll``: a physical volume beside untagged surfaces): the tags only name the parts, so the
-      file is read without its ``$Entities`` (the parts are then named by cell type).
+      file is read without its ``$Entities``, and a text file's parts are named from them again
+      (``gmsh_entity_physicals``; a binary file's by cell type).
     - A data field over several cell blocks (libigl's tutorial hand.msh): results and tags weigh nothing,
       so the file is read without its data sections; a ``density`` field is refused by name instead.
     """
@@ -1272,6 +1275,52 @@ _GMSH_ENTITIES = re.compile(rb"\$Entities\r?\n.*?\$EndEntities[^\S\n]*\r?(\n|\Z)
 # section's name to its end marker; their first string tag is the field's name
 _GMSH_DATA = re.compile(rb"\$(NodeData|ElementData|ElementNodeData)\r?\n.*?\$End\1[^\S\n]*\r?(\n|\Z)", re.DOTALL)
 _GMSH_FIELD_NAME = re.compile(rb"\A\$\w+\r?\n\s*\d+\s*\r?\n\s*\"([^\"\n]*)\"")
+
+
+def gmsh_entity_physicals(data: bytes) -> dict[tuple[int, int], list[int]]:
+    """The physical tags of each entity (dimension, tag) of a text MSH 4 file's ``$Entities``; empty where
+    there are none to read (binary files, or a section that does not parse).
+
+    gmsh.info, "MSH file format" (4.1): a line of the four entity counts, then a point per line
+    ``tag x y z numPhysicalTags tags...`` (4.0: a box of six numbers instead of x y z), then curves,
+    surfaces and volumes ``tag minX minY minZ maxX maxY maxZ numPhysicalTags tags... numBounding tags...``.
+    """
+    head = re.match(rb"\s*\$MeshFormat\s+(4\.\d+)\s+0\s", data[:64])
+    section = _GMSH_ENTITIES.search(data)
+    if head is None or section is None:
+        return {}
+    point_box = 6 if head.group(1) == b"4.0" else 3
+    try:
+        tokens = [int(float(t)) for t in section.group(0).split()[1:-1]]
+        counts, pos = tokens[:4], 4
+        out: dict[tuple[int, int], list[int]] = {}
+        for dim, n in enumerate(counts):
+            for _ in range(n):
+                tag = tokens[pos]
+                pos += 1 + (point_box if dim == 0 else 6)
+                n_phys = tokens[pos]
+                out[(dim, tag)] = tokens[pos + 1 : pos + 1 + n_phys]
+                pos += 1 + n_phys
+                if dim > 0:
+                    pos += 1 + abs(tokens[pos])
+    except (ValueError, IndexError):
+        return {}
+    return out
+
+
+def _restore_physical_tags(mesh: Any, physicals: dict[tuple[int, int], list[int]]) -> None:
+    """``gmsh:physical`` of each cell block from its entity's tags (0 where it has none or several), in place."""
+    from meshio import _mesh
+
+    entities = mesh.cell_data.get("gmsh:geometrical")
+    if not physicals or entities is None:
+        return
+    dims = getattr(_mesh, "topological_dimension", {})
+    tags = []
+    for block, entity in zip(mesh.cells, entities, strict=True):
+        found = physicals.get((dims.get(block.type, -1), int(entity[0]) if len(entity) else -1), [])
+        tags.append(np.full(len(block.data), found[0] if len(found) == 1 else 0, dtype=np.int64))
+    mesh.cell_data["gmsh:physical"] = tags
 
 
 def _gmsh_data_fields(data: bytes) -> set[str]:

@@ -12,7 +12,7 @@ from collections.abc import Sequence
 import pytest
 
 from inertia.errors import UnreadableFileError, UnsupportedFormatError
-from inertia.pipeline import analyze
+from inertia.pipeline import AnalysisOptions, analyze
 
 # the 18-node prism in Gmsh's order: corners, then edge midpoints 0-1, 0-2, 0-3, 1-2, 1-4, 2-5, 3-4, 3-5, 4-5,
 # then the centres of the quadrilateral faces 0-1-4-3, 0-2-5-3, 1-2-5-4
@@ -180,3 +180,59 @@ def test_an_msh4_file_with_untagged_surfaces_beside_a_physical_volume_is_read() 
     doc = analyze(_MSH41_SAVE_ALL.encode(), filename="discrete.msh").as_dict()
     assert doc["mass"] / doc["density"] == pytest.approx(1 / 6, rel=1e-15)
     assert doc["center_of_mass"] == pytest.approx([0.25, 0.25, 0.25], rel=1e-15)
+
+
+_MSH41_TWO_MATERIALS = """$MeshFormat
+4.1 0 8
+$EndMeshFormat
+$PhysicalNames
+2
+3 1 "steel"
+3 2 "alu"
+$EndPhysicalNames
+$Entities
+0 0 1 2
+1 0 0 0 1 1 1 0 0
+1 0 0 0 1 1 1 1 1 0
+2 2 0 0 4 2 2 1 2 0
+$EndEntities
+$Nodes
+1 8 1 8
+3 1 0 8
+1
+2
+3
+4
+5
+6
+7
+8
+0 0 0
+1 0 0
+0 1 0
+0 0 1
+2 0 0
+4 0 0
+2 2 0
+2 0 2
+$EndNodes
+$Elements
+3 3 1 3
+2 1 2 1
+1 1 2 3
+3 1 4 1
+2 1 2 3 4
+3 2 4 1
+3 5 6 7 8
+$EndElements
+"""
+
+
+def test_an_msh4_file_read_without_its_entities_keeps_its_physical_names() -> None:
+    # Mesh.SaveAll beside two physical volumes: the file is read without $Entities (meshio cannot split the
+    # tags of the untagged surface), and the volumes keep the names their entities' tags give them, so that
+    # densities by name still apply
+    options = AnalysisOptions(densities={"steel": 7850.0, "alu": 2700.0})
+    doc = analyze(_MSH41_TWO_MATERIALS.encode(), filename="two.msh", options=options).as_dict()
+    assert sorted(p["name"] for p in doc["parts"]) == ["alu", "steel"]
+    assert doc["mass"] == pytest.approx(7850.0 / 6 + 2700.0 * 8 / 6, rel=1e-14)
