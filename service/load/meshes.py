@@ -34,12 +34,12 @@ _GEOMETRY_EXTENSIONS = {
     "KHR_draco_mesh_compression": "Draco mesh compression",
     "EXT_meshopt_compression": "meshopt compression",
     "KHR_meshopt_compression": "meshopt compression",
-    "KHR_mesh_quantization": "quantized geometry",
 }
 # glTF extensions that change nothing in the geometry we read: materials (KHR_techniques_webgl: shaders, carried
 # over from glTF 1.0), textures, lights, metadata
 _HARMLESS_GLTF_EXTENSIONS = (
     "EXT_mesh_gpu_instancing",  # applied before the file is read (``instancing``)
+    "KHR_mesh_quantization",  # normalized positions scaled back before the file is read (``quantized``)
     "KHR_techniques_webgl",
     "KHR_technique_webgl",
     "KHR_materials_",
@@ -127,13 +127,17 @@ def read_trimesh_parts(
     notes = _check_gltf_document(data, fmt) if fmt in ("gltf", "glb") else []
     if fmt in ("gltf", "glb"):  # instances of EXT_mesh_gpu_instancing as nodes, which trimesh draws
         from .instancing import expand_instances, with_document
+        from .quantized import normalized_position_scales, scale_normalized_positions
 
         doc = _gltf_document(data, fmt)
         cameras = _without_cameras(doc)
         original = data
         data, placed = guarded_read(lambda: expand_instances(original, fmt, doc, companions), fmt)
-        if cameras and not placed:  # expand_instances wrote the document only where it placed instances
-            data = with_document(data, fmt, doc)
+        # normalized integer positions (KHR_mesh_quantization), which trimesh reads as the raw integers
+        divisors = guarded_read(lambda: normalized_position_scales(doc, original, fmt, companions), fmt)
+        rescaled = scale_normalized_positions(doc, divisors)
+        if cameras or rescaled:  # changed beside (or after) what expand_instances wrote, which is only its instances
+            data = with_document(original, fmt, doc)
         notes += placed
     # the upload's own files, and nothing else: a name outside them (a texture that did not come along, a path)
     # is not found, never looked for on disk; images are not needed for the geometry (skip_materials)
@@ -349,7 +353,8 @@ def _check_gltf_document(data: bytes, fmt: str) -> list[str]:
     """Refuse what trimesh's glTF reader would read as other geometry than the file's; notes on what is left out.
 
     glTF 2.0 specification: required extensions that change the geometry
-    (Draco or meshopt compression, quantized positions), sparse accessors
+    (Draco or meshopt compression; quantized positions are scaled back by
+    ``quantized``), sparse accessors
     (section 3.6.2.3; trimesh does not apply them), triangle fans (mode 6),
     skinned meshes (posed by their joints, section 3.7.3: the node's own
     transform is ignored) and morph targets with non-zero default weights
