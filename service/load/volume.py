@@ -318,7 +318,7 @@ def _reason(exc: BaseException, printed: str, tmp_paths: tuple[str, ...]) -> str
         text = text or type(exc).__name__
     text = text.splitlines()[0]
     for p in tmp_paths:
-        text = text.replace(p, "the file")
+        text = text.replace(f"file {p}", "the file").replace(p, "the file")  # meshio: "Couldn't read file <path>"
     text = re.sub(r"/\S*/(tmp|Temp)\S*", "the file", text)
     text = re.sub(r"\x1b\[[0-9;]*m|\[/?[a-z ]+\]", "", text)  # terminal colours and rich markup
     return text[:200]
@@ -833,6 +833,7 @@ def _read_meshio(data: bytes, fmt: str, label: str, filename: str | None, compan
 
     if fmt == "mesh":
         data = medit_layout(data)
+        medit_dimension(data, label)
     try:
         mesh = _meshio_read(data, fmt, label, filename, companions)
     except UnreadableFileError as exc:
@@ -882,23 +883,30 @@ def medit_layout(data: bytes) -> bytes:
     """
     data = _MEDIT_VERSION_APART.sub(rb"\1 \2", data)
     data = _MEDIT_COUNT_BESIDE.sub(rb"\1\n\2", data)
-    return _without_required_blocks(data)
+    return _MEDIT_WEIGHTLESS.sub(b"", data)
 
 
-# libMeshb's "required" entities (one id each: elements a remesher must keep, MmgTools' test meshes): meshio
-# knows only RequiredVertices and refuses the file at any other; they weigh nothing
-_MEDIT_REQUIRED = re.compile(
-    rb"(?m)^[ \t]*Required(?:Edges|Triangles|Quadrilaterals|Tetrahedra|Prisms|Pyramids|Hexahedra)[ \t]*\r?\n[ \t]*(\d+)[ \t]*\r?$"
+# Medit blocks that weigh nothing and that meshio refuses or misreads: libMeshb's "required" entities (ids of
+# what a remesher must keep; meshio knows RequiredVertices alone, and counts its lines, so a blank line after
+# the count breaks it, as it does Ridges and Tangents), and ParMmg's parallel communicators (a distributed
+# mesh's pieces). Each goes from its keyword to the next keyword: a block's entries are numbers.
+_MEDIT_WEIGHTLESS = re.compile(
+    rb"(?m)^[ \t]*(?:Required[A-Za-z]*|Parallel[A-Za-z]*|Ridges|Tangents|TangentAtVertices)[ \t]*\r?$"
+    rb"(?:\n(?![ \t]*[A-Za-z]).*$)*\n?"
 )
+_MEDIT_DIMENSION = re.compile(rb"(?m)^[ \t]*Dimension\s+(\d+)")
 
 
-def _without_required_blocks(data: bytes) -> bytes:
-    """The Medit file without its Required* blocks other than RequiredVertices (keyword, count and ids)."""
-    while (match := _MEDIT_REQUIRED.search(data)) is not None:
-        ids = int(match.group(1))
-        rest = data[match.end() :].split(None, ids)  # the block's ids, then the rest of the file
-        data = data[: match.start()] + (b"\n" + rest[ids] if len(rest) > ids else b"\n")
-    return data
+def medit_dimension(data: bytes, label: str) -> None:
+    """Refuse a Medit mesh of dimension 1 or 2 by name (bamg's geometry files, 1-D meshes), before meshio
+    stops at a keyword of theirs it does not know, or finds "no points"."""
+    found = _MEDIT_DIMENSION.search(data[:4096])
+    if found is not None and found.group(1) in (b"1", b"2"):
+        kind = "one" if found.group(1) == b"1" else "two"
+        raise EmptyGeometryError(
+            f"{label} is {kind}-dimensional (Dimension {found.group(1).decode()}); a volume needs a 3-D mesh "
+            "(tetrahedra, hexahedra, ...)"
+        )
 
 
 # Gmsh numbers an 18-node prism's nodes its own way (edges 0-1, 0-2, 0-3, 1-2, 1-4, 2-5, 3-4, 3-5, 4-5, then the

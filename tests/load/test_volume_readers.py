@@ -512,3 +512,21 @@ def test_medit_version_1_reals_are_single_precision_as_mmg_reads_them() -> None:
     a = float(np.float32(0.1))
     assert doc["mass"] == pytest.approx(a**3 / 6, rel=1e-15)
     assert abs(doc["mass"] - 0.1**3 / 6) > 1e-8 * doc["mass"]  # not the decimal's double
+
+
+def test_medit_blocks_that_weigh_nothing_are_read_past_whatever_their_layout() -> None:
+    """MmgTools' Ridges with a blank line after its count (meshio counts lines and stopped there), and ParMmg's
+    parallel communicators of a distributed mesh's piece (meshio: "Unknown keyword")."""
+    head = "MeshVersionFormatted 2\nDimension 3\n" + MEDIT_TET.format(v="\n", t="\n").replace("End\n", "")
+    tail = "Ridges\n2\n\n1\n2\nParallelTriangleCommunicators\n1\n3 7 0\nParallelCommunicatorTriangles\n2\n1 0 0\n2 1 0\nEnd\n"
+    doc = analyze((head + tail).encode(), filename="piece.mesh", options=AnalysisOptions(density=1.0)).as_dict()
+    assert doc["mass"] == pytest.approx(0.1**3 / 6, rel=1e-15)
+
+
+@pytest.mark.parametrize(("dimension", "word"), [(2, "two"), (1, "one")])
+def test_medit_meshes_of_lower_dimension_are_refused_as_such(dimension: int, word: str) -> None:
+    # bamg's geometry files (Dimension 2, with keywords meshio does not know) and 1-D meshes ("no points" before)
+    text = f"MeshVersionFormatted 1\nDimension {dimension}\nMaximalAngleOfCorner 46\nVertices\n2\n" + "0 0 1\n1 0 1\nEnd\n"
+    with pytest.raises(EmptyGeometryError) as info:
+        analyze(text.encode(), filename="geometry.mesh")
+    assert f"{word}-dimensional" in info.value.message
