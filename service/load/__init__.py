@@ -200,7 +200,8 @@ def _missing_beside(exc: ExternalReferenceError, name: str, filename: str) -> Ex
     )
     kind = str(exc.details.get("reference_kind", "")) or "reference"
     return ExternalReferenceError(
-        f"{filename!r}, a {fmt.upper()} file, refers to another file ({kind} {name[:120]!r}), {where} "
+        f"{filename!r}, {'an' if fmt.upper()[:1] in 'AEFHILMNORSX' else 'a'} {fmt.upper()} file, refers to another "
+        f"file ({kind} {name[:120]!r}), {where} "
         "(or send the model and its files together in one .zip)",
         **exc.details,
     )

@@ -73,7 +73,7 @@ from numpy.typing import NDArray
 
 from ..body import CellBlock, MeshBody, Part, VolumeBody, stored_eps
 from ..cells import CELL_NODES, VOXEL_TO_HEXAHEDRON
-from ..errors import EmptyGeometryError, InputTooLargeError, UnreadableFileError, UnsupportedFormatError
+from ..errors import EmptyGeometryError, ExternalReferenceError, InputTooLargeError, UnreadableFileError, UnsupportedFormatError
 from .guard import INFLATE_RATIO, inflate_budget, own_name, refuse_reference
 from .polygons import fan_split_note, fan_triangles
 from .sniff import VOLUME_FORMATS, VTK_FORMATS, VTK_XML_TYPES, vtk_xml_root_type, vtk_xml_type
@@ -1247,6 +1247,15 @@ def _meshio_read(data: bytes, fmt: str, label: str, filename: str | None, compan
         except BaseException as exc:  # meshio calls sys.exit(1) and raises KeyError, ValueError, ...
             if isinstance(exc, ImportError) and (exc.name or "").partition(".")[0] == "h5py":
                 raise _hdf5_missing(label, fmt, exc) from exc
+            if fmt == "ele" and isinstance(exc, OSError) and not companions:
+                # a reference like any other: the command line reads it from beside the .ele
+                node = f"{os.path.splitext(os.path.basename(filename or 'upload.ele'))[0]}.node"
+                raise ExternalReferenceError(
+                    f"{label} needs its companion file {node!r} (the point coordinates): upload both, as a .zip or as two files",
+                    format=fmt,
+                    reference=node,
+                    reference_kind="TetGen node file",
+                ) from exc
             raise UnreadableFileError(_meshio_failure(exc, printed.getvalue(), path, fmt, label, companions), format=fmt) from exc
 
 
@@ -1344,8 +1353,6 @@ def _meshio_failure(
     exc: BaseException, printed: str, path: str, fmt: str, label: str, companions: Mapping[str, bytes] | None
 ) -> str:
     reason = _reason(exc, printed, (path, os.path.dirname(path)))
-    if fmt == "ele" and isinstance(exc, (FileNotFoundError, OSError)) and not companions:
-        return f"{label} needs its companion .node file (the point coordinates): upload both, as a .zip or as two files"
     if isinstance(exc, (FileNotFoundError, OSError)) and ".node" in str(exc):
         return f"{label} refers to a companion file that was not uploaded ({reason}); upload it with the mesh"
     return f"could not read {label}: {reason}; check that the file is complete and of the format its name says"

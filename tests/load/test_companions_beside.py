@@ -133,6 +133,16 @@ def test_an_abaqus_deck_reads_the_include_beside_it(tmp_path: Path) -> None:
         load_body(deck)  # as the server reads an upload
 
 
+def test_a_tetgen_ele_reads_its_node_file_beside_it(tmp_path: Path) -> None:
+    # TetGen's .ele names no file: its points are in the .node of the same stem (sfepy's octahedron.ele)
+    (tmp_path / "tet.node").write_text("4 3 0 0\n1 0 0 0\n2 2 0 0\n3 0 2 0\n4 0 0 2\n", encoding="utf-8")
+    (tmp_path / "tet.ele").write_text("1 4 0\n1 1 2 3 4\n", encoding="utf-8")
+    doc = analyze(tmp_path / "tet.ele").as_dict()
+    assert doc["mass"] == pytest.approx(doc["density"] * 8 / 6, rel=1e-14)
+    with pytest.raises(ExternalReferenceError, match=r"tet\.node"):
+        load_body(tmp_path / "tet.ele")  # as the server reads an upload
+
+
 def test_a_texture_in_a_subfolder_is_skipped_one_climbing_out_refused(tmp_path: Path) -> None:
     doc = analyze(write_gltf(tmp_path, images=["textures/box%20wood.png"])).as_dict()
     assert doc["mass"] == pytest.approx(doc["density"] * VOLUME, rel=1e-14)
