@@ -1269,10 +1269,16 @@ def _gmsh_retry(data: bytes, exc: UnreadableFileError, label: str) -> bytes | No
       (``gmsh_entity_physicals``; a binary file's by cell type).
     - A data field over several cell blocks (libigl's tutorial hand.msh): results and tags weigh nothing,
       so the file is read without its data sections; a ``density`` field is refused by name instead.
+    - A text MSH 2 file whose elements carry different numbers of tags (FreeFem's: lines with one, triangles
+      with two; legal in MSH 2): meshio cannot split them between its blocks, so each element is given the
+      two tags (physical, elementary) it lacks as 0 (``_msh2_two_tags``).
     """
     cause = exc.__cause__
     if not isinstance(cause, ValueError) or "Incompatible cell data" not in str(cause):
         return None
+    padded = _msh2_two_tags(data) if re.match(rb"\s*\$MeshFormat\s+2\.\d+\s+0\s", data[:64]) else None
+    if padded is not None:
+        return padded
     if "'gmsh:" in str(cause):
         return _GMSH_ENTITIES.sub(b"", data, count=1)
     fields = _gmsh_data_fields(data)
@@ -1285,6 +1291,31 @@ def _gmsh_retry(data: bytes, exc: UnreadableFileError, label: str) -> bytes | No
             format="msh",
         ) from exc
     return _GMSH_DATA.sub(b"", data)
+
+
+_MSH2_ELEMENTS = re.compile(rb"(\$Elements[^\S\n]*\r?\n[^\n]*\n)(.*?)(\$EndElements)", re.DOTALL)
+
+
+def _msh2_two_tags(data: bytes) -> bytes | None:
+    """A text MSH 2 file with every element's tags padded with zeros to two, or None where none has fewer.
+
+    An element line is ``number type ntags tag... node...`` (gmsh.info, "MSH file format version 2").
+    """
+    section = _MSH2_ELEMENTS.search(data)
+    if section is None:
+        return None
+    lines = section.group(2).split(b"\n")
+    changed = False
+    for k, line in enumerate(lines):
+        fields = line.split()
+        if len(fields) >= 3 and fields[2].isdigit() and int(fields[2]) < 2:
+            tags = int(fields[2])
+            fields[2 : 3 + tags] = [b"2", *fields[3 : 3 + tags], *([b"0"] * (2 - tags))]
+            lines[k] = b" ".join(fields)
+            changed = True
+    if not changed:
+        return None
+    return data[: section.start(2)] + b"\n".join(lines) + data[section.end(2) :]
 
 
 _GMSH_ENTITIES = re.compile(rb"\$Entities\r?\n.*?\$EndEntities[^\S\n]*\r?(\n|\Z)", re.DOTALL)

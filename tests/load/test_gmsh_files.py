@@ -236,3 +236,38 @@ def test_an_msh4_file_read_without_its_entities_keeps_its_physical_names() -> No
     doc = analyze(_MSH41_TWO_MATERIALS.encode(), filename="two.msh", options=options).as_dict()
     assert sorted(p["name"] for p in doc["parts"]) == ["alu", "steel"]
     assert doc["mass"] == pytest.approx(7850.0 / 6 + 2700.0 * 8 / 6, rel=1e-14)
+
+
+_MSH22_MIXED_TAG_COUNTS = """$MeshFormat
+2.2 0 8
+$EndMeshFormat
+$Nodes
+8
+1 0 0 0
+2 1 0 0
+3 1 1 0
+4 0 1 0
+5 0 0 1
+6 1 0 1
+7 1 1 1
+8 0 1 1
+$EndNodes
+$Elements
+7
+1 2 1 7 1 2 3
+2 4 2 1 1 1 2 3 7
+3 4 2 1 1 1 3 4 7
+4 4 2 1 1 1 5 2 7
+5 4 2 1 1 2 5 6 7
+6 4 2 1 1 1 4 8 7
+7 4 2 1 1 1 8 5 7
+$EndElements
+"""
+
+
+def test_an_msh2_file_whose_elements_carry_different_numbers_of_tags_is_read() -> None:
+    # legal in MSH 2 (FreeFem writes lines with one tag, triangles with two); meshio refused it ("Incompatible
+    # cell data"): the six tetrahedra of the unit cube around its diagonal 1-7
+    doc = analyze(_MSH22_MIXED_TAG_COUNTS.encode(), filename="cube.msh", options=AnalysisOptions(density=1.0)).as_dict()
+    assert doc["mass"] == pytest.approx(1.0, rel=1e-15)
+    assert doc["center_of_mass"] == pytest.approx([0.5, 0.5, 0.5], rel=1e-15)
