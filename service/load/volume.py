@@ -222,6 +222,22 @@ def read_volume_parts(
             "(.msh), e.g. with MFEM's own mesh tools",
             format=fmt,
         )
+    if fmt == "msh" and data.lstrip()[:1] not in (b"$", b""):  # every Gmsh section starts with $
+        named = f"the .msh file {os.path.basename(filename)!r}" if filename else "the .msh file"
+        first = data.lstrip().split(b"\n", 1)[0].split()
+        freefem = len(first) == 3 and all(t.isdigit() for t in first)  # "vertices triangles boundary-edges"
+        if freefem:
+            raise UnsupportedFormatError(
+                f"{named} is not a Gmsh file: it is in FreeFem++'s own .msh format (its first line "
+                "counts vertices, triangles and boundary edges), which this service does not read; save the mesh "
+                'as Medit (savemesh(Th, "mesh.mesh")) or Gmsh',
+                format=fmt,
+            )
+        raise UnreadableFileError(
+            f"{named} is not a Gmsh file: it does not start with a $ section ($MeshFormat); "
+            "check that it is the mesh you meant to send",
+            format=fmt,
+        )
     if fmt == "msh" and data[:64].lstrip().startswith(b"$NOD"):  # MSH 1: $NOD, $ELM, no $MeshFormat
         raise UnsupportedFormatError(
             f"{_label(filename, fmt)} is in Gmsh's version-1 format ($NOD and $ELM sections), which its reader "

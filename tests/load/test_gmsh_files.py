@@ -271,3 +271,11 @@ def test_an_msh2_file_whose_elements_carry_different_numbers_of_tags_is_read() -
     doc = analyze(_MSH22_MIXED_TAG_COUNTS.encode(), filename="cube.msh", options=AnalysisOptions(density=1.0)).as_dict()
     assert doc["mass"] == pytest.approx(1.0, rel=1e-15)
     assert doc["center_of_mass"] == pytest.approx([0.5, 0.5, 0.5], rel=1e-15)
+
+
+def test_freefems_own_msh_format_is_named_as_such() -> None:
+    # FreeFem++ writes .msh files of its own: "vertices triangles boundary-edges", then the lists
+    text = "4 2 4\n0 0 1\n1 0 1\n1 1 1\n0 1 1\n1 2 3 0\n1 3 4 0\n1 2 1\n2 3 1\n3 4 1\n4 1 1\n"
+    with pytest.raises(UnsupportedFormatError) as info:
+        analyze(text.encode(), filename="aile.msh")
+    assert "FreeFem" in info.value.message and "'aile.msh' is not a Gmsh file" in info.value.message
