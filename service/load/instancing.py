@@ -27,7 +27,16 @@ from numpy.typing import NDArray
 
 from ..errors import InputTooLargeError, UnreadableFileError, UnsupportedFormatError
 
-__all__ = ["EXTENSION", "MAX_INSTANCED_TRIANGLES", "MAX_INSTANCES", "expand_instances", "with_document"]
+__all__ = [
+    "EXTENSION",
+    "MAX_INSTANCED_TRIANGLES",
+    "MAX_INSTANCES",
+    "NORMALIZED_DIVISORS",
+    "Buffers",
+    "accessor_values",
+    "expand_instances",
+    "with_document",
+]
 
 EXTENSION = "EXT_mesh_gpu_instancing"
 MAX_INSTANCED_TRIANGLES = 20_000_000
@@ -36,7 +45,7 @@ MAX_INSTANCES = 10_000
 """Instances in one file (each becomes a part of its own, a few milliseconds each)."""
 
 _COMPONENTS = {5120: "<i1", 5121: "<u1", 5122: "<i2", 5123: "<u2", 5125: "<u4", 5126: "<f4"}
-_NORMALIZED = {5120: 127.0, 5121: 255.0, 5122: 32767.0, 5123: 65535.0}
+NORMALIZED_DIVISORS = {5120: 127.0, 5121: 255.0, 5122: 32767.0, 5123: 65535.0}
 _WIDTH = {"SCALAR": 1, "VEC2": 2, "VEC3": 3, "VEC4": 4}
 
 
@@ -56,7 +65,7 @@ def expand_instances(data: bytes, fmt: str, doc: Any, companions: Mapping[str, b
     ]
     if not instanced:
         return data, []
-    buffers = _Buffers(doc, data, fmt, companions or {})
+    buffers = Buffers(doc, data, fmt, companions or {})
     triangles = 0
     count_all = 0
     for k in instanced:
@@ -84,13 +93,13 @@ def expand_instances(data: bytes, fmt: str, doc: Any, companions: Mapping[str, b
     return with_document(data, fmt, doc), [note]
 
 
-def _instance_matrices(doc: Any, ext: Any, buffers: _Buffers, label: str, fmt: str) -> NDArray[np.float64]:
+def _instance_matrices(doc: Any, ext: Any, buffers: Buffers, label: str, fmt: str) -> NDArray[np.float64]:
     """(n, 4, 4) T * R * S of each instance."""
     attributes = ext.get("attributes") if isinstance(ext, dict) else None
     if not isinstance(attributes, dict):
         raise UnreadableFileError(f"the {fmt.upper()} file's {EXTENSION} of {label!r} has no attributes", format=fmt)
     columns = {
-        name: _accessor(doc, attributes[name], buffers, fmt) if name in attributes else None
+        name: accessor_values(doc, attributes[name], buffers, fmt) if name in attributes else None
         for name in ("TRANSLATION", "ROTATION", "SCALE")
     }
     counts = {len(v) for v in columns.values() if v is not None}
@@ -147,7 +156,7 @@ def _mesh_triangles(doc: Any, mesh: int) -> int:
     return total
 
 
-class _Buffers:
+class Buffers:
     """The bytes of each buffer: a GLB's own chunk, a data URI, or a file of the upload (plain names only)."""
 
     def __init__(self, doc: Any, data: bytes, fmt: str, companions: Mapping[str, bytes]) -> None:
@@ -186,7 +195,7 @@ class _Buffers:
         )
 
 
-def _accessor(doc: Any, index: Any, buffers: _Buffers, fmt: str) -> NDArray[np.float64]:
+def accessor_values(doc: Any, index: Any, buffers: Buffers, fmt: str) -> NDArray[np.float64]:
     """An accessor's values as (count, width) float64, normalized integers scaled (glTF 2.0 section 3.6.2)."""
     accessors = doc.get("accessors") or []
     if not isinstance(index, int) or not (0 <= index < len(accessors)) or not isinstance(accessors[index], dict):
@@ -220,8 +229,8 @@ def _accessor(doc: Any, index: Any, buffers: _Buffers, fmt: str) -> NDArray[np.f
     values = np.empty((count, width), dtype=np.float64)
     for k in range(width):  # each component: a strided view of the buffer, copied out
         values[:, k] = np.ndarray((count,), dtype=dtype, buffer=raw, offset=start + k * dtype.itemsize, strides=(stride,))
-    if acc.get("normalized") and component in _NORMALIZED:
-        values = np.maximum(values / _NORMALIZED[component], -1.0)
+    if acc.get("normalized") and component in NORMALIZED_DIVISORS:
+        values = np.maximum(values / NORMALIZED_DIVISORS[component], -1.0)
     return values
 
 

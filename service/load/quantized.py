@@ -2,8 +2,8 @@
 
 The extension (Khronos, "KHR_mesh_quantization") lets POSITION accessors hold
 signed or unsigned 8- or 16-bit integers, normalized or not.  A normalized
-component c stands for c / 127, c / 255, c / 32767 or c / 65535 (signed
-values clamped at -1: glTF 2.0 section 3.11, "Animations", and 3.6.2 on
+component c stands for c / 127, c / 255, c / 32767 or c / 65535, signed
+values clamped at -1 (the extension's text, and glTF 2.0 section 3.6.2 on
 normalized accessors); a plain integer stands for itself, the node's
 transform carrying any scale (as gltfpack writes them).
 
@@ -22,7 +22,7 @@ from collections.abc import Mapping
 from typing import Any
 
 from ..errors import UnsupportedFormatError
-from .instancing import _NORMALIZED, _accessor, _Buffers
+from .instancing import NORMALIZED_DIVISORS, Buffers, accessor_values
 
 __all__ = ["EXTENSION", "normalized_position_scales", "scale_normalized_positions"]
 
@@ -36,7 +36,7 @@ def normalized_position_scales(doc: Any, data: bytes, fmt: str, companions: Mapp
     accessors = doc.get("accessors") if isinstance(doc, dict) else None
     if not isinstance(meshes, list) or not isinstance(accessors, list):
         return {}
-    buffers = _Buffers(doc, data, fmt, companions or {})
+    buffers = Buffers(doc, data, fmt, companions or {})
     out: dict[int, float] = {}
     for index, mesh in enumerate(meshes):
         primitives = mesh.get("primitives") if isinstance(mesh, dict) else None
@@ -48,10 +48,10 @@ def normalized_position_scales(doc: Any, data: bytes, fmt: str, companions: Mapp
                 continue
             acc = accessors[key]
             component = acc.get("componentType")
-            divisors.add(_NORMALIZED[component] if acc.get("normalized") and component in _NORMALIZED else None)
+            divisors.add(NORMALIZED_DIVISORS[component] if acc.get("normalized") and component in NORMALIZED_DIVISORS else None)
             if acc.get("normalized") and component in _SIGNED and "bufferView" in acc:
                 raw = _raw(doc, key, buffers, fmt)
-                if raw.size and float(raw.min()) < -_NORMALIZED[component]:
+                if raw.size and float(raw.min()) < -NORMALIZED_DIVISORS[component]:
                     raise UnsupportedFormatError(
                         f"the {fmt.upper()} file's mesh {index} stores a quantized position of {int(raw.min())}, which "
                         "glTF clamps to -1 (so its corner is not where the integers put it); export it with float positions",
@@ -71,11 +71,11 @@ def normalized_position_scales(doc: Any, data: bytes, fmt: str, companions: Mapp
     return out
 
 
-def _raw(doc: Any, key: int, buffers: _Buffers, fmt: str) -> Any:
+def _raw(doc: Any, key: int, buffers: Buffers, fmt: str) -> Any:
     """An accessor's stored integers (its ``normalized`` flag set aside)."""
     acc = doc["accessors"][key]
     plain = {**doc, "accessors": [*doc["accessors"][:key], {**acc, "normalized": False}, *doc["accessors"][key + 1 :]]}
-    return _accessor(plain, key, buffers, fmt)
+    return accessor_values(plain, key, buffers, fmt)
 
 
 def scale_normalized_positions(doc: Any, divisors: Mapping[int, float]) -> int:
