@@ -317,11 +317,14 @@ _XDMF = b"""<?xml version="1.0"?>
 def test_xdmf_without_h5py_names_the_extra_or_is_read() -> None:
     import importlib.util
 
-    if importlib.util.find_spec("h5py") is not None:  # with the 'hdf5' extra: the unit corner tetrahedron
-        assert analyze(_XDMF, filename="t.xdmf", options=AnalysisOptions(units="m", density=1.0)).props.mass == pytest.approx(1 / 6)
+    # data in the XML itself: read with or without the 'hdf5' extra (the unit corner tetrahedron)
+    assert analyze(_XDMF, filename="t.xdmf", options=AnalysisOptions(units="m", density=1.0)).props.mass == pytest.approx(1 / 6)
+    if importlib.util.find_spec("h5py") is not None:
         return
+    # data in an HDF5 file beside it: without h5py, the refusal names the extra
+    hdf = _XDMF.replace(b'Format="XML">0 0 0 1 0 0 0 1 0 0 0 1', b'Format="HDF">t.h5:/geometry')
     with pytest.raises(UnsupportedFormatError, match=r"inertia-service\[hdf5\]"):
-        analyze(_XDMF, filename="t.xdmf")
+        load_body([("t.xdmf", hdf), ("t.h5", b"\x89HDF\r\n\x1a\n" + bytes(64))])
 
 
 @pytest.mark.parametrize(
