@@ -194,15 +194,16 @@ def _companion_beside(folder: str, name: str) -> bytes | None:
 def _missing_beside(exc: ExternalReferenceError, name: str, filename: str) -> ExternalReferenceError:
     fmt = str(exc.details.get("format", "")) or "model"
     where = (
-        "which is not in the file's folder: keep the files it names beside it"
+        "which is not in the file's folder: keep the files it names beside it (or send the model and its files "
+        "together in one .zip)"
         if plain_name(unquote(name))
-        else "a path or URL: only files named by a plain file name, beside the model, are read"
+        else "a path or URL: only files named by a plain file name, beside the model, are read (in a .zip too): "
+        "name the file by its plain file name beside the model, or export a self-contained file"
     )
     kind = str(exc.details.get("reference_kind", "")) or "reference"
     return ExternalReferenceError(
         f"{filename!r}, {'an' if fmt.upper()[:1] in 'AEFHILMNORSX' else 'a'} {fmt.upper()} file, refers to another "
-        f"file ({kind} {name[:120]!r}), {where} "
-        "(or send the model and its files together in one .zip)",
+        f"file ({kind} {name[:120]!r}), {where}",
         **exc.details,
     )
 

@@ -96,9 +96,15 @@ class _Context:
         name = own_name(target.strip().strip("'\""))
         if plain_name(name) and name in self.companions:
             return
+        fix = (
+            "send the referenced file in the same upload, or a self-contained file"
+            if plain_name(name)
+            else "it names it by a path, which is never followed (not even within a .zip): name the file by its "
+            "plain file name and send it in the same upload, or send a self-contained file"
+        )
         raise ExternalReferenceError(
             f"the {self.fmt.upper()} file refers to another file ({what} {name[:120]!r}); the server never "
-            "opens files named by an upload: send the referenced file in the same upload, or a self-contained file",
+            f"opens files named by an upload: {fix}",
             format=self.fmt,
             reference=name[:200],
             reference_kind=what,

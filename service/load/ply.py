@@ -97,7 +97,8 @@ def _walk(
                 names = [p for p, _, _ in props]
                 if not {"x", "y", "z"} <= set(names):
                     return None
-                vertices = np.stack([rows[f"_{names.index(c)}"].astype(np.float64) for c in "xyz"], axis=1)
+                with np.errstate(invalid="ignore"):  # a signalling NaN widened: non-finite values are refused later
+                    vertices = np.stack([rows[f"_{names.index(c)}"].astype(np.float64) for c in "xyz"], axis=1)
             continue
         steps = [(p, struct.Struct(order + t), None if c is None else struct.Struct(order + c)) for p, t, c in props]
         keep = "vertex_indices" if any(p == "vertex_indices" for p, _, _ in props) else "vertex_index"

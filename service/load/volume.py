@@ -340,7 +340,12 @@ def _reason(exc: BaseException, printed: str, tmp_paths: tuple[str, ...]) -> str
         text = text.replace(f"file {p}", "the file").replace(p, "the file")  # meshio: "Couldn't read file <path>"
     text = re.sub(r"/\S*/(tmp|Temp)\S*", "the file", text)
     text = re.sub(r"\x1b\[[0-9;]*m|\[/?[a-z ]+\]", "", text)  # terminal colours and rich markup
-    return text[:200]
+    return _printable(text)[:200]
+
+
+def _printable(text: str) -> str:
+    """The text with what cannot be shown (a damaged file's own bytes, quoted by its reader) as '?'."""
+    return "".join(ch if ch.isprintable() and ch != "\ufffd" else "?" for ch in text)
 
 
 # ----------------------------------------------------------------------------------------------
@@ -494,7 +499,7 @@ def _vtk_errors(text: str, path: str) -> str:
         lines = [ln.strip() for ln in chunk.splitlines()[1:] if ln.strip()]
         if lines:
             msg = re.sub(r"^\w+ \(0x[0-9a-f]+\): ", "", lines[0]).replace(path, "the file")
-            return re.sub(r"/\S*/(tmp|Temp)\S*", "the file", msg)[:200]
+            return _printable(re.sub(r"/\S*/(tmp|Temp)\S*", "the file", msg))[:200]
     return ""
 
 

@@ -91,8 +91,18 @@ def test_a_buffer_named_by_a_path_is_not_read_even_where_it_exists(tmp_path: Pat
     inner.mkdir()
     path = write_gltf(inner, rename={"gltf_buffer_0.bin": "../gltf_buffer_0.bin"})
     assert (tmp_path / "gltf_buffer_0.bin").exists()
-    with pytest.raises(ExternalReferenceError, match="a path or URL"):
+    with pytest.raises(ExternalReferenceError, match="a path or URL") as info:
         analyze(path)
+    # a .zip follows no paths either (three.js's DamagedHelmetGpuInstancing names ../glTF/DamagedHelmet.bin):
+    # the advice is the one that works
+    assert "one .zip" not in info.value.message and "plain file name" in info.value.message
+    zipped = io.BytesIO()
+    with zipfile.ZipFile(zipped, "w") as archive:
+        archive.write(path, "model/" + path.name)
+        archive.write(tmp_path / "gltf_buffer_0.bin", "gltf_buffer_0.bin")
+    with pytest.raises(ExternalReferenceError) as info:
+        load_body(zipped.getvalue(), filename="model.zip")
+    assert "not even within a .zip" in info.value.message
 
 
 def test_a_uri_encoded_name_finds_its_file(tmp_path: Path) -> None:

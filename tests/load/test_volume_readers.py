@@ -550,3 +550,11 @@ def test_an_xdmf_file_with_its_data_in_its_xml_needs_no_hdf5() -> None:
     assert doc["mass"] == pytest.approx(8 / 6, rel=1e-15)
     assert doc["center_of_mass"] == pytest.approx([0.5, 0.5, 0.5], rel=1e-15)
     assert "h5py" not in sys.modules or hasattr(sys.modules["h5py"], "File")  # no stand-in left behind
+
+
+def test_a_damaged_files_own_bytes_quoted_by_its_reader_are_shown_printable() -> None:
+    # a copy of three.js's liver.vtk damaged by a text conversion: VTK quotes the bytes it stopped at
+    data = b"# vtk DataFile Version 3.0\nx\nASCII\nDATASET UNSTRUCTURED_GRID\nPOINTS 1 float\n0 0 0\nva\xef\xbf\xbd\x19\x07b\n"
+    with pytest.raises(LoadError) as info:
+        load_body(data, filename="liver.vtk")
+    assert info.value.message.isprintable() and "\ufffd" not in info.value.message
