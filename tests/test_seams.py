@@ -322,3 +322,14 @@ def test_many_disjoint_shells_get_no_overlap_warning() -> None:
     props = mass_properties(MeshBody(vertices, faces), density=1.0)
     assert props.mass == pytest.approx(3000.0, rel=props.relative_error_estimate)
     assert not any("overlap" in w for w in props.warnings)
+
+
+def test_a_double_sided_sheet_is_refused_as_such() -> None:
+    # trimesh's chair_model.obj: every triangle stored twice, once in each winding; closed as a 2-chain, it
+    # encloses nothing, and the refusal says why rather than "flat or degenerate"
+    v, f = box(1.0, 2.0, 3.0)
+    sheet = f[:6]  # three faces of the box: an open sheet, made closed by its reverse copy
+    with pytest.raises(ZeroVolumeError) as info:
+        mass_properties(MeshBody(v, np.vstack([sheet, sheet[:, [0, 2, 1]]])), density=1.0)
+    assert "12 of its 12 triangles" in info.value.message
+    assert "double-sided" in info.value.message

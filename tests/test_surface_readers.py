@@ -949,3 +949,15 @@ def test_a_binary_ply_no_reader_can_walk_is_refused_in_a_sentence(head: list[str
     assert read_binary_ply(text) is None
     with pytest.raises(ServiceError):
         analyze(text, filename="broken.ply")
+
+
+def test_a_binary_stl_whose_size_disagrees_with_its_count_says_by_how_much() -> None:
+    # PyMesh's tests/data/empty.stl: a count of 0 and one stray newline; numpy-stl reads such files, trimesh
+    # refuses them: refused, with the sizes, so that the extra bytes (or the missing ones) can be seen
+    from tests.support.meshes import box_stl
+
+    data = box_stl(1.0, 2.0, 3.0)
+    with pytest.raises(UnreadableFileError, match=r"declares 12 triangles \(684 bytes\) but holds 685, 1 more"):
+        load_body(data + b"\n", filename="box.stl")
+    with pytest.raises(UnreadableFileError, match=r"declares 12 triangles \(684 bytes\) but holds 634: it is truncated"):
+        load_body(data[:-50], filename="box.stl")

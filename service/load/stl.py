@@ -42,8 +42,22 @@ def read_stl(data: bytes | memoryview) -> tuple[NDArray[np.float64], NDArray[np.
     head = bytes(buf[:512]).removeprefix(b"\xef\xbb\xbf").lstrip()  # an editor's UTF-8 byte-order mark
     if head[:5].lower() == b"solid":  # the keywords are lower case, but older CAD tools write them in capitals
         return _ascii(bytes(buf).removeprefix(b"\xef\xbb\xbf"))
-    raise UnreadableFileError(
-        "the STL file is neither ASCII (starting with 'solid') nor binary of consistent length; it may be truncated"
+    raise UnreadableFileError(_not_binary(len(buf), count if len(buf) >= 84 else None))
+
+
+def _not_binary(size: int, count: int | None) -> str:
+    """Why a file that is not ASCII STL is not binary STL either, with the sizes that disagree."""
+    if count is None:
+        return f"the STL file is neither ASCII (starting with 'solid') nor binary ({size} bytes, fewer than a binary header's 84)"
+    expected = 84 + 50 * count
+    if size < expected:
+        return (
+            f"the STL file is not ASCII (it does not start with 'solid'), and as binary it declares {count} triangles "
+            f"({expected} bytes) but holds {size}: it is truncated"
+        )
+    return (
+        f"the STL file is not ASCII (it does not start with 'solid'), and as binary it declares {count} triangles "
+        f"({expected} bytes) but holds {size}, {size - expected} more: cut what follows its last triangle, or export it again"
     )
 
 

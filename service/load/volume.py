@@ -241,6 +241,10 @@ def read_volume_parts(
             "check that it is the mesh you meant to send",
             format=fmt,
         )
+    if fmt == "msh" and _gmsh_node_count(data) == 0:  # meshio's own answer: "zero-size array to reduction ..."
+        raise EmptyGeometryError(
+            f"{_label(filename, fmt)} holds no nodes (its $Nodes section is empty); send a mesh with 3-D cells", format=fmt
+        )
     if fmt == "msh" and data[:64].lstrip().startswith(b"$NOD"):  # MSH 1: $NOD, $ELM, no $MeshFormat
         raise UnsupportedFormatError(
             f"{_label(filename, fmt)} is in Gmsh's version-1 format ($NOD and $ELM sections), which its reader "
@@ -254,6 +258,22 @@ def read_volume_parts(
         label = _label(filename, fmt)
         mesh = _read_vtk(data, fmt, label) if fmt in VTK_FORMATS else _read_meshio(data, fmt, label, filename, companions)
     return _parts(mesh, label, length_scale)
+
+
+_GMSH_VERSION = re.compile(rb"\s*\$MeshFormat\s+(\d+)\.\d+\s+(\d)")
+_GMSH_NODES = re.compile(rb"\$Nodes[^\S\n]*\r?\n[^\S\n]*(\d+)(?:[^\S\n]+(\d+))?")
+
+
+def _gmsh_node_count(data: bytes) -> int | None:
+    """The node count a Gmsh file's ``$Nodes`` header declares (MSH 2: the count, in text even in a binary
+    file; MSH 4 text: blocks, then nodes); None where it cannot be read (a binary MSH 4 header is binary)."""
+    version, nodes = _GMSH_VERSION.match(data[:64]), _GMSH_NODES.search(data)
+    if version is None or nodes is None:
+        return None
+    if version.group(1) == b"2":
+        return int(nodes.group(1))
+    text = version.group(2) == b"0"
+    return int(nodes.group(2)) if version.group(1) == b"4" and text and nodes.group(2) is not None else None
 
 
 def is_avs_ucd(data: bytes) -> bool:

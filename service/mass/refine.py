@@ -98,7 +98,7 @@ def refine(geometry: Geometry, tolerances: Tolerances) -> Refined:
             return found
     origin = local_origin(geometry.points)
     s = geometry.sums(origin, None)
-    _check_volume(s, geometry.kind)
+    _check_volume(s, geometry.kind, geometry.cells)
     c, cov = _covariance(s)
     values, vectors = jacobi_eigh(_inertia_from_covariance(cov), tolerances)
     rotation = vectors.T  # columns: axes in the input frame
@@ -117,7 +117,7 @@ def refine(geometry: Geometry, tolerances: Tolerances) -> Refined:
         previous = values
         if settled:
             break
-    _check_volume(s, geometry.kind)
+    _check_volume(s, geometry.kind, geometry.cells)
     return _finished(geometry, s, com, rotation, values, None if settled else step)
 
 
@@ -434,11 +434,37 @@ def moment_errors(
     return max(worst, 4 * EPS), errors
 
 
-def _check_volume(s: Sums, kind: str) -> None:
+def _check_volume(s: Sums, kind: str, cells: NDArray[np.int64] | None = None) -> None:
     if kind in ("apex", "tet") and abs(s.m0) <= 64 * EPS * s.noise:
+        twins = _reverse_twins(cells) if kind == "apex" and cells is not None else 0
+        if twins:
+            raise ZeroVolumeError(
+                f"the mesh encloses no volume: {twins} of its {len(cells) if cells is not None else 0} triangles are "
+                "stored twice, once in each winding (a double-sided surface, a sheet rather than a solid); send the "
+                "solid's closed outer surface, or use model=shell with a thickness",
+                volume=s.m0,
+                double_sided_triangles=twins,
+            )
         raise ZeroVolumeError(
             "the mesh encloses no volume (it is flat or degenerate); send a solid or use model=shell with a thickness",
             volume=s.m0,
         )
     if kind == "tri" and s.m0 <= 0:
         raise ZeroVolumeError("the surface has zero area; send a mesh with non-degenerate triangles")
+
+
+def _reverse_twins(cells: NDArray[np.int64]) -> int:
+    """How many triangles have a twin of the same three corners wound the other way (double-sided sheets)."""
+    if len(cells) < 2:
+        return 0
+    order = np.argsort(cells, axis=1)
+    corners = np.take_along_axis(cells, order, axis=1)
+    # the winding of each triangle as written: whether sorting its corners took an odd permutation
+    odd = (order[:, 0] > order[:, 1]) ^ (order[:, 1] > order[:, 2]) ^ (order[:, 0] > order[:, 2])
+    unique, inverse = np.unique(corners, axis=0, return_inverse=True)
+    inverse = inverse.ravel()
+    # a set of corners stored with both windings: its triangles are twins of each other
+    wound_odd, wound_even = np.zeros(len(unique), dtype=bool), np.zeros(len(unique), dtype=bool)
+    wound_odd[inverse[odd]] = True
+    wound_even[inverse[~odd]] = True
+    return int(np.count_nonzero((wound_odd & wound_even)[inverse]))

@@ -11,7 +11,7 @@ from collections.abc import Sequence
 
 import pytest
 
-from inertia.errors import UnreadableFileError, UnsupportedFormatError
+from inertia.errors import EmptyGeometryError, UnreadableFileError, UnsupportedFormatError
 from inertia.pipeline import AnalysisOptions, analyze
 
 # the 18-node prism in Gmsh's order: corners, then edge midpoints 0-1, 0-2, 0-3, 1-2, 1-4, 2-5, 3-4, 3-5, 4-5,
@@ -279,3 +279,17 @@ def test_freefems_own_msh_format_is_named_as_such() -> None:
     with pytest.raises(UnsupportedFormatError) as info:
         analyze(text.encode(), filename="aile.msh")
     assert "FreeFem" in info.value.message and "'aile.msh' is not a Gmsh file" in info.value.message
+
+
+@pytest.mark.parametrize(
+    "text",
+    [
+        b"$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n0\n$EndNodes\n$Elements\n0\n$EndElements\n",
+        b"$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Nodes\n0 0 0 0\n$EndNodes\n$Elements\n0 0 0 0\n$EndElements\n",
+    ],
+    ids=["msh2", "msh4"],
+)
+def test_an_msh_file_without_nodes_is_empty_geometry(text: bytes) -> None:
+    # PyMesh's tests/data/empty.msh: meshio answered "zero-size array to reduction operation maximum ..."
+    with pytest.raises(EmptyGeometryError, match="holds no nodes"):
+        analyze(text, filename="empty.msh")
