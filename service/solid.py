@@ -152,12 +152,12 @@ def _orient_outward(
         noise = np.bincount(label, weights=_volume_magnitudes(x, faces), minlength=count)
         solid = np.abs(np.bincount(label, weights=det, minlength=count)) > 64 * EPS * noise
         return faces, _overlap_note(x, faces, label, solid)
+    del x  # not held while the components are found: the peak of a one-shell mesh's pass
     total = float(det.sum())
     count, label = face_components(faces, topo)
     if count == 1:  # one shell: the file's winding or its reverse; no shell noise to weigh
         return (faces[:, [0, 2, 1]], [INVERTED]) if total < 0 else (faces, [])
-    scale = _volume_magnitudes(x, faces)  # each face's rounding scale, for the shells' noise
-    del x
+    scale = _volume_magnitudes(vertices - local_origin(vertices), faces)  # each face's rounding scale, for the shells' noise
     vol = np.bincount(label, weights=det, minlength=count)
     if count > 1 and np.any(vol < 0) and not _each_closed(faces, label):
         # components split at non-manifold edges (two rooms sharing a wall) are not shells by themselves:
