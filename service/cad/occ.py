@@ -139,8 +139,9 @@ def _translated(exc: BaseException, what: str) -> ServiceError:
     return UnreadableFileError(f"OpenCASCADE could not {what}: {text}", library="OpenCASCADE")
 
 
-def read_solids(data: bytes, fmt: str) -> tuple[list[Solid], str | None]:
-    """The solids of a STEP or IGES file and the length unit it declares (None: not stated)."""
+def read_solids(data: bytes, fmt: str) -> tuple[list[Solid], str | None, list[str]]:
+    """The solids of a STEP or IGES file, the length unit it declares (None: not stated), and notes on what
+    was left out."""
     try:
         return _read(data, fmt)
     except ServiceError:
@@ -167,7 +168,7 @@ def _refuse_external(data: bytes, fmt: str) -> None:
         )
 
 
-def _read(data: bytes, fmt: str) -> tuple[list[Solid], str | None]:
+def _read(data: bytes, fmt: str) -> tuple[list[Solid], str | None, list[str]]:
     _refuse_external(data, fmt)
     from OCP.IFSelect import IFSelect_RetDone
     from OCP.TCollection import TCollection_ExtendedString
@@ -194,7 +195,8 @@ def _read(data: bytes, fmt: str) -> tuple[list[Solid], str | None]:
             raise UnreadableFileError(
                 f"OpenCASCADE read the {fmt.upper()} file but could not build its shapes", library="OpenCASCADE"
             )
-    return _solids(doc), unit
+    solids, notes = _solids(doc)
+    return solids, unit, notes
 
 
 def _reader(fmt: str) -> Any:
@@ -239,8 +241,14 @@ def _iges_unit(section: Any) -> str:
     return "" if name is None else str(name.ToCString()).strip().lower()
 
 
-def _solids(doc: Any) -> list[Solid]:
-    """Every solid of the assembly tree, located, named after its product (or sub-shape) label."""
+def _solids(doc: Any) -> tuple[list[Solid], list[str]]:
+    """Every solid of the assembly tree, located, named after its product (or sub-shape) label; notes on the
+    shells and faces left out.
+
+    Shells and faces that bound no solid (surface bodies) hold no volume: beside solids they are left out
+    with a warning that counts them, as CAD tools' mass properties weigh solid bodies only; a file of
+    nothing else is refused as not watertight.
+    """
     from OCP.collections import Sequence_TDF_Label
     from OCP.TopAbs import TopAbs_FACE, TopAbs_SHELL, TopAbs_SOLID
     from OCP.TopLoc import TopLoc_Location
@@ -255,9 +263,9 @@ def _solids(doc: Any) -> list[Solid]:
     loose = 0
     for i in range(1, roots.Length() + 1):
         shape = XCAFDoc_ShapeTool.GetShape_s(roots.Value(i))
-        # shells and faces that belong to no solid: an open body
+        # shells and faces that belong to no solid: surface bodies, or an open body
         loose += _count(shape, TopAbs_SHELL, TopAbs_SOLID) + _count(shape, TopAbs_FACE, TopAbs_SHELL)
-    if loose:
+    if loose and not solids:
         raise NotWatertightError(
             f"the CAD file holds {loose} shell(s) or face(s) that bound no solid, so it is not a closed body; "
             "export closed solids (sew the surfaces into a solid in the CAD tool)",
@@ -265,7 +273,16 @@ def _solids(doc: Any) -> list[Solid]:
         )
     if not solids:
         raise EmptyGeometryError("the CAD file holds no solid; export the part as a solid body")
-    return _unique_names(solids)
+    notes = (
+        [
+            f"the CAD file also holds {loose} shell(s) or face(s) that bound no solid (surface bodies, or a body "
+            f"left open); they hold no volume and were left out, as CAD tools' mass properties leave them: the "
+            f"result is its {len(solids)} solid(s); if one of those surfaces was meant as a solid, sew it closed"
+        ]
+        if loose
+        else []
+    )
+    return _unique_names(solids), notes
 
 
 MAX_DEPTH = 64  # assembly nesting deeper than this is a reference cycle, not a design

@@ -36,8 +36,8 @@ def read_cad_parts(data: bytes, fmt: str, units: str | None) -> tuple[list[Part]
         raise UnsupportedFormatError(f"reading CAD files needs the 'cad' extra: {exc}", extra="cad") from exc
     from . import occ
 
-    solids, declared = occ.read_solids(data, fmt)
-    warnings: list[str] = []
+    solids, declared, notes = occ.read_solids(data, fmt)
+    warnings: list[str] = list(notes)
     file_scale = LENGTH_UNITS.get(declared) if declared else None
     if units is not None:
         if file_scale is None:

@@ -227,6 +227,14 @@ def test_open_shell_is_not_watertight() -> None:
         analyze(write_step([("lid", open_shell())]), filename="lid.step")
 
 
+def test_an_open_shell_beside_solids_is_left_out_by_count() -> None:
+    # SparkFun's VCNL4040.step: ten closed solids and a stray open shell of three faces; CAD tools' mass
+    # properties weigh solid bodies only, and the whole file was refused for the shell
+    doc = analyze(write_step([("plate", box(*BOX, CORNER)), ("lid", open_shell())]), filename="sensor.step").as_dict()
+    check_body(doc, box_reference(*BOX, CORNER))
+    assert any("1 shell(s) or face(s) that bound no solid" in w and "left out" in w for w in doc["warnings"])
+
+
 def test_garbage_step_is_unreadable() -> None:
     from inertia.errors import LoadError
 
