@@ -193,7 +193,11 @@ def _parser() -> argparse.ArgumentParser:
     sub = parser.add_subparsers(dest="command", required=True)
 
     a = sub.add_parser("analyze", help="analyse one mesh or points file (.json/.csv/.xyz)")
-    a.add_argument("file", help="mesh, volume mesh or points file (.json/.csv/.xyz); the format from its name or --format")
+    a.add_argument(
+        "file",
+        help="mesh, volume mesh, CAD (.step/.iges, with the 'cad' extra) or points file (.json/.csv/.xyz); "
+        "the format from its name or --format",
+    )
     add_analysis_options(a)
     a.add_argument(
         "--omega",
