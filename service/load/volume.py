@@ -79,7 +79,7 @@ from ..cells import CELL_NODES, VOXEL_TO_HEXAHEDRON
 from ..errors import EmptyGeometryError, ExternalReferenceError, InputTooLargeError, UnreadableFileError, UnsupportedFormatError
 from .guard import INFLATE_RATIO, inflate_budget, own_name, refuse_reference
 from .polygons import fan_split_note, fan_triangles
-from .sniff import VOLUME_FORMATS, VTK_FORMATS, VTK_XML_TYPES, vtk_xml_root_type, vtk_xml_type
+from .sniff import VOLUME_FORMATS, VTK_FORMATS, VTK_XML_TYPES, vtk_xml_root_type
 
 __all__ = ["read_volume_parts", "VTK_FORMATS", "VTK_CELL_TYPES"]
 
@@ -260,20 +260,26 @@ def read_volume_parts(
     return _parts(mesh, label, length_scale)
 
 
-_GMSH_VERSION = re.compile(rb"\s*\$MeshFormat\s+(\d+)\.\d+\s+(\d)")
+_GMSH_FORMAT = re.compile(rb"\s*\$MeshFormat\s+(\d+)\.(\d+)\s+(\d)")
 _GMSH_NODES = re.compile(rb"\$Nodes[^\S\n]*\r?\n[^\S\n]*(\d+)(?:[^\S\n]+(\d+))?")
+
+
+def _gmsh_format(data: bytes) -> tuple[int, int, bool] | None:
+    """A Gmsh file's version (major, minor) and whether it is text, from its ``$MeshFormat``; None without one."""
+    found = _GMSH_FORMAT.match(data[:64])
+    return None if found is None else (int(found.group(1)), int(found.group(2)), found.group(3) == b"0")
 
 
 def _gmsh_node_count(data: bytes) -> int | None:
     """The node count a Gmsh file's ``$Nodes`` header declares (MSH 2: the count, in text even in a binary
     file; MSH 4 text: blocks, then nodes); None where it cannot be read (a binary MSH 4 header is binary)."""
-    version, nodes = _GMSH_VERSION.match(data[:64]), _GMSH_NODES.search(data)
+    version, nodes = _gmsh_format(data), _GMSH_NODES.search(data)
     if version is None or nodes is None:
         return None
-    if version.group(1) == b"2":
+    major, _, text = version
+    if major == 2:
         return int(nodes.group(1))
-    text = version.group(2) == b"0"
-    return int(nodes.group(2)) if version.group(1) == b"4" and text and nodes.group(2) is not None else None
+    return int(nodes.group(2)) if major == 4 and text and nodes.group(2) is not None else None
 
 
 def is_avs_ucd(data: bytes) -> bool:
@@ -491,12 +497,11 @@ def _vtk_xml_reader(data: bytes, fmt: str, label: str) -> str:
     declares (as the file says, whatever its extension), the legacy reader for a legacy file, else the
     extension's own (which then says what is wrong)."""
     head = data[:1024]
-    declared = vtk_xml_type(head)
-    if declared:
-        return declared
+    name = vtk_xml_root_type(head)
+    if name in VTK_XML_TYPES:
+        return VTK_XML_TYPES[name]
     if head.lstrip().startswith(b"# vtk DataFile"):
         return "vtk"
-    name = vtk_xml_root_type(head)
     if name is not None:
         parallel = " (a parallel file's pieces are separate files: send each piece's own file)" if name.startswith("P") else ""
         raise UnsupportedFormatError(
@@ -890,7 +895,8 @@ def _read_meshio(data: bytes, fmt: str, label: str, filename: str | None, compan
     if fmt == "msh":
         _gmsh_node_order(mesh)
     out = _mesh_from_meshio(mesh, label)
-    if fmt == "msh" and re.match(rb"\s*\$MeshFormat\s+[12]\.", data[:64]):  # MSH 4 lists an element once
+    version = _gmsh_format(data) if fmt == "msh" else None
+    if version is not None and version[0] <= 2:  # MSH 4 lists an element once
         _drop_repeated_cells(out, label)
     ghosts = mesh.cell_data.get("vtkGhostType")
     if ghosts is not None:
@@ -906,12 +912,10 @@ def _read_meshio(data: bytes, fmt: str, label: str, filename: str | None, compan
     return out
 
 
-# Medit's keywords whose entry count comes next (libMeshb's GmfKwdFmt), and the version keyword
+# the Medit keywords meshio reads whose entry count comes next (libMeshb's GmfKwdFmt)
 _MEDIT_COUNTED = (
     b"Vertices|Edges|Triangles|Quadrilaterals|Tetrahedra|Prisms|Pyramids|Hexahedra|Hexaedra|Corners|Normals|"
-    b"NormalAtVertices|RequiredVertices|RequiredEdges|RequiredTriangles|RequiredQuadrilaterals|RequiredTetrahedra|"
-    b"RequiredPrisms|RequiredPyramids|RequiredHexahedra|Ridges|Tangents|TangentAtVertices|"
-    b"SubDomainFromMesh|VertexOnGeometricVertex|VertexOnGeometricEdge|EdgeOnGeometricEdge"
+    b"NormalAtVertices|SubDomainFromMesh|VertexOnGeometricVertex|VertexOnGeometricEdge|EdgeOnGeometricEdge"
 )
 _MEDIT_VERSION_APART = re.compile(rb"(?m)^([ \t]*MeshVersionFormatted)[ \t]*\r?\n\s*(\d+)")
 _MEDIT_COUNT_BESIDE = re.compile(rb"(?m)^([ \t]*(?:" + _MEDIT_COUNTED + rb"))[ \t]+(\d+)[ \t]*(?=\r?$)")
@@ -933,9 +937,10 @@ def medit_layout(data: bytes) -> bytes:
 # Medit blocks that weigh nothing and that meshio refuses or misreads: libMeshb's "required" entities (ids of
 # what a remesher must keep; meshio knows RequiredVertices alone, and counts its lines, so a blank line after
 # the count breaks it, as it does Ridges and Tangents), and ParMmg's parallel communicators (a distributed
-# mesh's pieces). Each goes from its keyword to the next keyword: a block's entries are numbers.
+# mesh's pieces). Each goes from its keyword (and a count beside it) to the next keyword: a block's entries
+# are numbers.
 _MEDIT_WEIGHTLESS = re.compile(
-    rb"(?m)^[ \t]*(?:Required[A-Za-z]*|Parallel[A-Za-z]*|Ridges|Tangents|TangentAtVertices)[ \t]*\r?$"
+    rb"(?m)^[ \t]*(?:Required[A-Za-z]*|Parallel[A-Za-z]*|Ridges|Tangents|TangentAtVertices)(?:[ \t]+\d+)?[ \t]*\r?$"
     rb"(?:\n(?![ \t]*[A-Za-z]).*$)*\n?"
 )
 _MEDIT_DIMENSION = re.compile(rb"(?m)^[ \t]*Dimension\s+(\d+)")
@@ -1343,7 +1348,8 @@ def _gmsh_retry(data: bytes, exc: UnreadableFileError, label: str) -> bytes | No
     cause = exc.__cause__
     if not isinstance(cause, ValueError) or "Incompatible cell data" not in str(cause):
         return None
-    padded = _msh2_two_tags(data) if re.match(rb"\s*\$MeshFormat\s+2\.\d+\s+0\s", data[:64]) else None
+    version = _gmsh_format(data)
+    padded = _msh2_two_tags(data) if version is not None and version[0] == 2 and version[2] else None
     if padded is not None:
         return padded
     if "'gmsh:" in str(cause):
@@ -1400,11 +1406,11 @@ def gmsh_entity_physicals(data: bytes) -> dict[tuple[int, int], list[int]]:
     ``tag x y z numPhysicalTags tags...`` (4.0: a box of six numbers instead of x y z), then curves,
     surfaces and volumes ``tag minX minY minZ maxX maxY maxZ numPhysicalTags tags... numBounding tags...``.
     """
-    head = re.match(rb"\s*\$MeshFormat\s+(4\.\d+)\s+0\s", data[:64])
+    version = _gmsh_format(data)
     section = _GMSH_ENTITIES.search(data)
-    if head is None or section is None:
+    if version is None or version[0] != 4 or not version[2] or section is None:
         return {}
-    point_box = 6 if head.group(1) == b"4.0" else 3
+    point_box = 6 if version[1] == 0 else 3
     try:
         tokens = [int(float(t)) for t in section.group(0).split()[1:-1]]
         counts, pos = tokens[:4], 4
@@ -1545,9 +1551,10 @@ def _surface_part(mesh: _Mesh, surface: _Surface, label: str, length_scale: floa
     used, faces = np.unique(tris, return_inverse=True)  # only the surface's own points
     vertices = mesh.points[used]
     faces = faces.reshape(-1, 3)
-    rest = ", ".join(f"{n} {t}" for t, n in sorted(mesh.other.items()) if t not in _SURFACE_CELL_NAMES)
+    left_out = [(t, n) for t, n in sorted(mesh.other.items()) if t not in _SURFACE_CELL_NAMES]
+    rest = ", ".join(f"{n} {t}" for t, n in left_out)
     if mesh.polydata:  # a surface by its kind: only what was left out needs saying
-        cells = ", ".join(_count(n, f"{t} cell") for t, n in sorted(mesh.other.items()) if t not in _SURFACE_CELL_NAMES)
+        cells = ", ".join(_count(n, f"{t} cell") for t, n in left_out)
         notes = [f"{label} also holds {cells}, which bound no solid and were left out"] if cells else []
     else:
         notes = [
