@@ -195,8 +195,9 @@ class Buffers:
         )
 
 
-def accessor_values(doc: Any, index: Any, buffers: Buffers, fmt: str) -> NDArray[np.float64]:
-    """An accessor's values as (count, width) float64, normalized integers scaled (glTF 2.0 section 3.6.2)."""
+def accessor_values(doc: Any, index: Any, buffers: Buffers, fmt: str, normalize: bool = True) -> NDArray[np.float64]:
+    """An accessor's values as (count, width) float64, normalized integers scaled (glTF 2.0 section 3.6.2)
+    unless ``normalize`` is False (the integers as stored)."""
     accessors = doc.get("accessors") or []
     if not isinstance(index, int) or not (0 <= index < len(accessors)) or not isinstance(accessors[index], dict):
         raise UnreadableFileError(f"the {fmt.upper()} file names accessor {index!r}, which it does not define", format=fmt)
@@ -229,7 +230,7 @@ def accessor_values(doc: Any, index: Any, buffers: Buffers, fmt: str) -> NDArray
     values = np.empty((count, width), dtype=np.float64)
     for k in range(width):  # each component: a strided view of the buffer, copied out
         values[:, k] = np.ndarray((count,), dtype=dtype, buffer=raw, offset=start + k * dtype.itemsize, strides=(stride,))
-    if acc.get("normalized") and component in NORMALIZED_DIVISORS:
+    if normalize and acc.get("normalized") and component in NORMALIZED_DIVISORS:
         values = np.maximum(values / NORMALIZED_DIVISORS[component], -1.0)
     return values
 

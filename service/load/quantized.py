@@ -50,7 +50,7 @@ def normalized_position_scales(doc: Any, data: bytes, fmt: str, companions: Mapp
             component = acc.get("componentType")
             divisors.add(NORMALIZED_DIVISORS[component] if acc.get("normalized") and component in NORMALIZED_DIVISORS else None)
             if acc.get("normalized") and component in _SIGNED and "bufferView" in acc:
-                raw = _raw(doc, key, buffers, fmt)
+                raw = accessor_values(doc, key, buffers, fmt, normalize=False)
                 if raw.size and float(raw.min()) < -NORMALIZED_DIVISORS[component]:
                     raise UnsupportedFormatError(
                         f"the {fmt.upper()} file's mesh {index} stores a quantized position of {int(raw.min())}, which "
@@ -69,13 +69,6 @@ def normalized_position_scales(doc: Any, data: bytes, fmt: str, companions: Mapp
         if scaled:
             out[index] = scaled.pop()
     return out
-
-
-def _raw(doc: Any, key: int, buffers: Buffers, fmt: str) -> Any:
-    """An accessor's stored integers (its ``normalized`` flag set aside)."""
-    acc = doc["accessors"][key]
-    plain = {**doc, "accessors": [*doc["accessors"][:key], {**acc, "normalized": False}, *doc["accessors"][key + 1 :]]}
-    return accessor_values(plain, key, buffers, fmt)
 
 
 def scale_normalized_positions(doc: Any, divisors: Mapping[int, float]) -> int:

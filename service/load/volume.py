@@ -1424,7 +1424,7 @@ def gmsh_entity_physicals(data: bytes) -> dict[tuple[int, int], list[int]]:
                 pos += 1 + n_phys
                 if dim > 0:
                     pos += 1 + abs(tokens[pos])
-    except (ValueError, IndexError):
+    except (ValueError, IndexError, OverflowError):  # a token that is no number, "inf", a count past the end
         return {}
     return out
 
