@@ -9,6 +9,9 @@ their boundary's area (CAD B-reps) puts it, in m^2, into the part's
 
 from __future__ import annotations
 
+import weakref
+from typing import Any
+
 import numpy as np
 from numpy.typing import NDArray
 
@@ -22,12 +25,41 @@ SURFACE_AREA_KEY = "surface_area"
 AREA_BLOCK = 1 << 16  # triangles per block: ~10 MB of temporaries, not ~150 bytes per triangle at once
 
 
+# The last area computed and weak references to the two arrays it came from.  An analysis asks for a
+# closed surface's area twice, with the same arrays when the file needed no repair: the resolution check
+# (``mass.refine``) and then the surface_area section; each is ~0.15 s at 5e6 triangles.  Only arrays whose
+# values cannot change are remembered (read-only down to their memory, as a body's are), and a pair is
+# known by identity, so a new surface is never given an old area.
+_last: tuple[weakref.ref[NDArray[Any]], weakref.ref[NDArray[Any]], float] | None = None
+
+
+def _immutable(arr: NDArray[Any]) -> bool:
+    """Whether no one can write to ``arr``'s values: it and every array below it are read-only, over bytes or its own memory."""
+    a: object = arr
+    while isinstance(a, np.ndarray):
+        if a.flags.writeable:
+            return False
+        a = a.base
+    return a is None or isinstance(a, bytes)
+
+
 def triangle_area(vertices: NDArray[np.float64], faces: NDArray[np.int64]) -> float:
     """Total area of the triangles ``faces`` over ``vertices`` (in the vertices' units squared)."""
+    global _last
     v = np.asarray(vertices, dtype=np.float64)
     f = np.asarray(faces, dtype=np.int64)
     if len(f) == 0:
         return 0.0
+    last = _last  # one read: another thread may set it meanwhile
+    if last is not None and last[0]() is v and last[1]() is f:
+        return last[2]
+    area = _triangle_area(v, f)
+    if _immutable(v) and _immutable(f):
+        _last = (weakref.ref(v), weakref.ref(f), area)
+    return area
+
+
+def _triangle_area(v: NDArray[np.float64], f: NDArray[np.int64]) -> float:
     origin = v[f[0, 0]]
     # each triangle's |n| in blocks (temporaries bounded), then one pairwise sum over all of them
     norms = np.empty(len(f))

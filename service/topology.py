@@ -461,8 +461,10 @@ def _components(n: int, a: NDArray[np.signedinteger], b: NDArray[np.signedintege
         join = ra != rb
         if not np.any(join):
             break
-        ra = ra[join]
-        rb = rb[join]
+        every = bool(np.all(join))  # the first round joins every edge: no compressed copies of all of them
+        if not every:
+            ra = ra[join]
+            rb = rb[join]
         hi = np.maximum(ra, rb)
         np.minimum(ra, rb, out=ra)
         del rb
@@ -470,8 +472,12 @@ def _components(n: int, a: NDArray[np.signedinteger], b: NDArray[np.signedintege
         del hi, ra
         while _jump(parent):  # until every node points at its root
             pass
-        a, b = a[join].astype(index, copy=False), b[join].astype(index, copy=False)
+        if not every:
+            a, b = a[join], b[join]
+        a, b = a.astype(index, copy=False), b.astype(index, copy=False)
     roots = parent == np.arange(n, dtype=index)
+    if n and int(np.count_nonzero(roots)) == 1:  # one component (the usual solid): no labels to number
+        return 1, np.zeros(n, dtype=np.int64)
     rank: NDArray[np.signedinteger] = np.cumsum(roots, dtype=index)
     del roots
     rank -= 1

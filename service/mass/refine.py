@@ -33,8 +33,8 @@ from numpy.typing import NDArray
 from ..blocks import for_each_block
 from ..eigen import jacobi_eigh, jacobi_lists
 from ..errors import InsufficientPrecisionError, ZeroVolumeError
-from ..integrals import Sums, local_origin, point_records
-from ..surface import twice_areas
+from ..integrals import Sums, local_origin
+from ..surface import triangle_area
 from ..tolerances import EPS, Tolerances
 from . import points as small_points
 from .geometry import Geometry
@@ -294,32 +294,21 @@ def _check_resolution(
     """
     x = geometry.points
     delta = geometry.coordinate_eps * float(np.abs(x).max())
-    y = np.empty_like(x)
     rows = range(0, len(x), _BLOCK)
     reach_rows = np.empty((len(rows), 3))
 
     def reach_block(start: int) -> None:
-        # row by row, as on the whole array: y, its principal-frame coordinates (columns of rotation are
+        # row by row, as on the whole array: x - com, its principal-frame coordinates (columns of rotation are
         # the axes), and each point's largest squared distance from each axis
-        block = np.subtract(x[start : start + _BLOCK], com, out=y[start : start + _BLOCK])
-        along = block @ rotation
+        along = (x[start : start + _BLOCK] - com) @ rotation
         sq = along * along
         total = sq.sum(axis=1)  # once, not once per axis
         reach_rows[start // _BLOCK] = [np.max(total - sq[:, k]) for k in range(3)]
 
     for_each_block(reach_block, rows)
     reach = reach_rows.max(axis=0)
-    records = point_records(y)  # one gather of 24 bytes per corner, not numpy's slower 2-D fancy indexing
-    starts = range(0, len(geometry.cells), _BLOCK)
-    block_area = np.empty(len(starts))
-
-    def block(start: int) -> None:  # rows of np.cross + np.linalg.norm's rounding, per block
-        block_area[start // _BLOCK] = twice_areas(records, geometry.cells[start : start + _BLOCK]).sum()
-
-    for_each_block(block, starts)
-    area = 0.0
-    for twice in block_area.tolist():  # added in block order, as one thread would
-        area += 0.5 * twice
+    # the surface's area as the surface_area section computes it, which then takes it from here (surface.py)
+    area = triangle_area(x, geometry.cells)
     weight = 1.0 if geometry.weight is None else float(np.max(geometry.weight))
     moved = math.sqrt(3.0) * delta * area  # volume the resolution can move
     volume = abs(s.measure)
