@@ -603,7 +603,6 @@ def _draco_without_fallback(doc: dict[str, Any]) -> None:
     "change, words",
     [
         (lambda d: d["accessors"][d["meshes"][0]["primitives"][0]["attributes"]["POSITION"]].update(sparse={"count": 1}), "sparse"),
-        (lambda d: d["meshes"][0]["primitives"][0].update(mode=6), "triangle fan"),
         (lambda d: d.update(extensionsRequired=["KHR_draco_mesh_compression"]), "(Draco mesh compression)"),
         (lambda d: d.update(extensionsRequired=["ACME_gizmo"]), "ACME_gizmo, which this service does not decode;"),
         (_draco_without_fallback, "mesh 'box' only with KHR_draco_mesh_compression"),
@@ -617,6 +616,75 @@ def test_gltf_geometry_trimesh_would_misread_is_refused(change: Callable[[dict[s
     with pytest.raises(UnsupportedFormatError) as err:
         analyze(json.dumps(doc).encode(), filename="x.gltf")
     assert words in err.value.message
+
+
+# glTF 2.0 section 3.7.2.1: a fan v0, v1, ..., vn is the triangles {v(i+1), v(i+2), v0}.  The unit right
+# tetrahedron as one fan about the origin, [0, 2, 1, 3, 2], and the far face (1, 2, 3) as a triangle list.
+_TETRA = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]], dtype="<f4")
+_FAN = [0, 2, 1, 3, 2]
+
+
+def _tetra_fan_doc(indexed: bool) -> tuple[dict[str, Any], bytes]:
+    """The document and its one buffer's bytes: positions, then (indexed) the fan's and the triangle's indices."""
+    if indexed:
+        positions, fan_positions = _TETRA, _TETRA
+        binary = _TETRA.tobytes() + np.array([*_FAN, 1, 2, 3], dtype="<u2").tobytes()
+    else:  # the fan's own vertices in fan order, the triangle's after them
+        fan_positions = _TETRA[_FAN]
+        positions = _TETRA[[1, 2, 3]]
+        binary = fan_positions.tobytes() + positions.tobytes()
+    views = [{"buffer": 0, "byteOffset": 0, "byteLength": fan_positions.nbytes}]
+    accessors: list[dict[str, Any]] = [{"bufferView": 0, "componentType": 5126, "count": len(fan_positions), "type": "VEC3"}]
+    if indexed:
+        views.append({"buffer": 0, "byteOffset": 48, "byteLength": 16})
+        accessors += [
+            {"bufferView": 1, "componentType": 5123, "count": 5, "type": "SCALAR"},
+            {"bufferView": 1, "byteOffset": 10, "componentType": 5123, "count": 3, "type": "SCALAR"},
+        ]
+        fan = {"attributes": {"POSITION": 0}, "indices": 1, "mode": 6}
+        triangle = {"attributes": {"POSITION": 0}, "indices": 2}
+    else:
+        views.append({"buffer": 0, "byteOffset": fan_positions.nbytes, "byteLength": positions.nbytes})
+        accessors.append({"bufferView": 1, "componentType": 5126, "count": 3, "type": "VEC3"})
+        fan = {"attributes": {"POSITION": 0}, "mode": 6}
+        triangle = {"attributes": {"POSITION": 1}}
+    doc = {
+        "asset": {"version": "2.0"},
+        "scene": 0,
+        "scenes": [{"nodes": [0]}],
+        "nodes": [{"mesh": 0}],
+        "meshes": [{"primitives": [fan, triangle]}],
+        "accessors": accessors,
+        "bufferViews": views,
+        "buffers": [{"byteLength": len(binary)}],
+    }
+    return doc, binary
+
+
+def _glb_bytes(doc: dict[str, Any], binary: bytes) -> bytes:
+    text = json.dumps(doc).encode()
+    text += b" " * (-len(text) % 4)
+    binary += b"\0" * (-len(binary) % 4)
+    body = struct.pack("<II", len(text), 0x4E4F534A) + text + struct.pack("<II", len(binary), 0x004E4942) + binary
+    return struct.pack("<4sII", b"glTF", 2, 12 + len(body)) + body
+
+
+@pytest.mark.parametrize("container", ["gltf", "glb"])
+@pytest.mark.parametrize("indexed", [True, False])
+def test_gltf_triangle_fans_are_read(container: str, indexed: bool) -> None:
+    doc, binary = _tetra_fan_doc(indexed)
+    if container == "glb":
+        data = _glb_bytes(doc, binary)
+    else:
+        doc["buffers"][0]["uri"] = "data:application/octet-stream;base64," + base64.b64encode(binary).decode()
+        data = json.dumps(doc).encode()
+    res = analyze(data, filename=f"tetra.{container}", options=AnalysisOptions(density=1.0)).as_dict()
+    # the unit right tetrahedron: volume 1/6, centre (1/4, 1/4, 1/4); about the centre I_xx = 1/30 - 1/48 = 1/80 and
+    # I_xy = -(1/120 - 1/96) = 1/480 (integrals of x^2 and xy over it: 1/60 and 1/120)
+    assert res["mass"] == pytest.approx(1 / 6, rel=1e-14)
+    np.testing.assert_allclose(res["center_of_mass"], [0.25, 0.25, 0.25], rtol=1e-14)
+    expected = np.full((3, 3), 1 / 480) + np.eye(3) * (1 / 80 - 1 / 480)
+    np.testing.assert_allclose(res["inertia_tensor"], expected, rtol=1e-13, atol=1e-17)
 
 
 # --- several files in one upload -------------------------------------------------------------------------

@@ -35,6 +35,7 @@ __all__ = [
     "Buffers",
     "accessor_values",
     "expand_instances",
+    "glb_binary",
     "with_document",
 ]
 
@@ -178,7 +179,7 @@ class Buffers:
         if uri is None:
             if self.fmt != "glb" or index != 0:
                 raise UnreadableFileError(f"the {self.fmt.upper()} file's buffer {index} has no uri", format=self.fmt)
-            return _glb_binary(self.data)
+            return glb_binary(self.data)
         if isinstance(uri, str) and uri.startswith("data:"):
             try:
                 return base64.b64decode(uri.split(",", 1)[1])
@@ -235,7 +236,7 @@ def accessor_values(doc: Any, index: Any, buffers: Buffers, fmt: str, normalize:
     return values
 
 
-def _glb_binary(data: bytes) -> bytes:
+def glb_binary(data: bytes) -> bytes:
     """The BIN chunk of a GLB container (glTF 2.0 section 4.4), the first chunk after the JSON one."""
     if len(data) < 20:
         raise UnreadableFileError("the GLB file is shorter than its header", format="glb")

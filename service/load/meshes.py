@@ -126,12 +126,13 @@ def read_trimesh_parts(
 
     notes = _check_gltf_document(data, fmt) if fmt in ("gltf", "glb") else []
     if fmt in ("gltf", "glb"):  # instances of EXT_mesh_gpu_instancing as nodes, which trimesh draws
+        from .fans import fans_as_triangles
         from .instancing import expand_instances, with_document
         from .quantized import normalized_position_scales, scale_normalized_positions
 
         doc = _gltf_document(data, fmt)
         cameras = _without_cameras(doc)
-        original = data
+        original, _ = guarded_read(lambda: fans_as_triangles(doc, data, fmt, companions), fmt)
         data, placed = guarded_read(lambda: expand_instances(original, fmt, doc, companions), fmt)
         # normalized integer positions (KHR_mesh_quantization), which trimesh reads as the raw integers
         divisors = guarded_read(lambda: normalized_position_scales(doc, original, fmt, companions), fmt)
@@ -355,8 +356,7 @@ def _check_gltf_document(data: bytes, fmt: str) -> list[str]:
     glTF 2.0 specification: required extensions that change the geometry
     (Draco or meshopt compression; quantized positions are scaled back by
     ``quantized``), sparse accessors
-    (section 3.6.2.3; trimesh does not apply them), triangle fans (mode 6),
-    skinned meshes (posed by their joints, section 3.7.3: the node's own
+    (section 3.6.2.3; trimesh does not apply them), skinned meshes (posed by their joints, section 3.7.3: the node's own
     transform is ignored) and morph targets with non-zero default weights
     (section 3.7.2.2) are refused with a sentence; point and line primitives
     (modes 0-3) hold no volume and are left out with a note.
@@ -414,10 +414,6 @@ def _check_gltf_document(data: bytes, fmt: str) -> list[str]:
             if mode in (0, 1, 2, 3):
                 lines += 1
                 continue
-            if mode == 6:
-                raise refuse(
-                    f"stores mesh {label!r} as a triangle fan (mode 6), which this service does not read; export it as triangles"
-                )
             attrs: dict[str, Any] = prim["attributes"] if isinstance(prim.get("attributes"), dict) else {}
             position = attrs.get("POSITION")
             extensions = prim.get("extensions")
