@@ -21,6 +21,7 @@ import trimesh
 from benchmarks.cases import box, cube, obj_bytes
 from inertia.errors import (
     EmptyGeometryError,
+    InvalidParameterError,
     NotWatertightError,
     ServiceError,
     UnreadableFileError,
@@ -248,6 +249,15 @@ def test_a_bare_3mf_model_part_is_named_for_what_it_is() -> None:
         analyze(xml, filename="part.3mf")
     with pytest.raises(UnsupportedFormatError, match=r"\.model file is the XML part inside a 3MF package"):
         analyze(xml, filename="3dmodel.model")
+
+
+def test_a_3mf_in_the_draft_093_namespace_is_named_as_such() -> None:
+    # lib3mf's v093 test files: the 2013/01 namespace of the draft before 3MF 1.0 (object ids from 0); "invalid"
+    # told the sender nothing about why
+    xml = model(f'<object id="0" type="model">{mesh_xml(*cube(2.0))}</object>', '<item objectid="0"/>')
+    xml = xml.replace(CORE, "http://schemas.microsoft.com/3dmanufacturing/2013/01")
+    with pytest.raises(UnsupportedFormatError, match=r"3MF 0\.93 .* re-save it with a current 3MF exporter"):
+        analyze(package(xml), filename="old.3mf")
 
 
 def test_3mf_production_objects_in_another_model_part_are_read() -> None:
@@ -616,6 +626,57 @@ def test_gltf_geometry_trimesh_would_misread_is_refused(change: Callable[[dict[s
     with pytest.raises(UnsupportedFormatError) as err:
         analyze(json.dumps(doc).encode(), filename="x.gltf")
     assert words in err.value.message
+
+
+def test_gltf_infinite_positions_are_counted_as_stored_under_a_placement() -> None:
+    # assimp's BoxWithInfinites: infinite x coordinates under a node matrix, where inf x 0 made NaN (and numpy
+    # warned on stderr, before the JSON error); the refusal counts what the file stores
+    doc = gltf_box_doc()
+    prim = doc["meshes"][0]["primitives"][0]
+    acc = doc["accessors"][prim["attributes"]["POSITION"]]
+    view = doc["bufferViews"][acc["bufferView"]]
+    buf = doc["buffers"][view["buffer"]]
+    raw = bytearray(base64.b64decode(buf["uri"].split(",", 1)[1]))
+    start = view.get("byteOffset", 0) + acc.get("byteOffset", 0)
+    positions = np.frombuffer(raw, dtype="<f4", count=3 * acc["count"], offset=start).reshape(-1, 3).copy()
+    positions[:2, 0] = np.inf
+    raw[start : start + positions.nbytes] = positions.tobytes()
+    buf["uri"] = "data:application/octet-stream;base64," + base64.b64encode(bytes(raw)).decode()
+    _mesh_node(doc)["matrix"] = [0, 0, -1, 0, 0, 1, 0, 0, 1, 0, 0, 0, 0, 0, 0, 1]  # a quarter turn about y
+    with pytest.raises(InvalidParameterError, match="contain 2 non-finite value"):
+        analyze(json.dumps(doc).encode(), filename="infinite.gltf")
+
+
+def _two_parents(doc: dict[str, Any]) -> None:
+    # the mesh node under the scene's root and under a second root moved 5 m: one of its places was dropped
+    doc["nodes"] += [{"children": [0]}, {"children": [0], "translation": [5.0, 0.0, 0.0]}]
+    doc["scenes"][0]["nodes"] = [1, 2]
+
+
+def _root_and_child(doc: dict[str, Any]) -> None:
+    doc["nodes"].append({"children": [0], "translation": [5.0, 0.0, 0.0]})
+    doc["scenes"][0]["nodes"] = [0, 1]
+
+
+def _cycle(doc: dict[str, Any]) -> None:
+    doc["nodes"] += [{"children": [2]}, {"children": [1, 0]}, {}]  # 1 -> 2 -> 1, the mesh node under 2
+    doc["scenes"][0]["nodes"] = [3]
+
+
+@pytest.mark.parametrize(
+    "change, words",
+    [
+        (_two_parents, "node 0 is a child of nodes 1 and 2"),
+        (_root_and_child, "node 0 is a root of scene 0 and a child of node 1"),
+        (_cycle, "has a cycle"),
+    ],
+)
+def test_gltf_node_hierarchy_that_is_not_trees_is_refused(change: Callable[[dict[str, Any]], None], words: str) -> None:
+    # glTF 2.0 section 3.5.2: the node hierarchy is a set of disjoint strict trees
+    doc = gltf_box_doc()
+    change(doc)
+    with pytest.raises(UnreadableFileError, match=words):
+        analyze(json.dumps(doc).encode(), filename="graph.gltf")
 
 
 # glTF 2.0 section 3.7.2.1: a fan v0, v1, ..., vn is the triangles {v(i+1), v(i+2), v0}.  The unit right

@@ -24,7 +24,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..body import MeshBody, Part
-from ..errors import EmptyGeometryError, UnreadableFileError, UnsupportedFormatError
+from ..errors import EmptyGeometryError, InvalidParameterError, UnreadableFileError, UnsupportedFormatError
 from .safe import guarded_read
 
 __all__ = ["read_trimesh_parts", "read_surface_parts", "mesh_part"]
@@ -171,6 +171,21 @@ def read_trimesh_parts(
         vertices = np.asarray(geom.vertices, dtype=np.float64)
         faces = np.asarray(geom.faces)
         t = np.asarray(transform, dtype=np.float64)
+        bad = int(np.count_nonzero(~np.isfinite(vertices)))
+        if bad:  # refused as stored (API.md: invalid_parameter), not as a placement would make them (inf x 0 = NaN)
+            raise InvalidParameterError(
+                f"the {fmt.upper()} file's vertex coordinates of {str(geom_name)!r} contain {bad} non-finite value(s) "
+                "(NaN or infinity); fix the file",
+                field="vertex coordinates",
+                part=str(geom_name),
+            )
+        if not np.all(np.isfinite(t)):
+            raise InvalidParameterError(
+                f"the {fmt.upper()} file places {str(geom_name)!r} with a transform holding non-finite numbers "
+                "(NaN or infinity); fix the file",
+                field="transform",
+                part=str(geom_name),
+            )
         if not np.array_equal(t, np.eye(4)):
             if vertices.ndim == 2 and vertices.shape[1] == 3:
                 vertices = vertices @ t[:3, :3].T + t[:3, 3]
@@ -465,6 +480,7 @@ def _check_gltf_document(data: bytes, fmt: str) -> list[str]:
             "scenes the file is a library of objects); export it with a scene that holds the part's nodes",
             format=fmt,
         )
+    _check_node_trees(nodes, scenes, fmt)
     if any(isinstance(n, dict) and "skin" in n and "mesh" in n for n in nodes):
         raise refuse(
             "holds a skinned mesh, whose shape is set by its joints (the node's own transform is "
@@ -473,6 +489,47 @@ def _check_gltf_document(data: bytes, fmt: str) -> list[str]:
     if lines:
         notes.append(f"{lines} point or line primitive(s) of the glTF file hold no volume and were left out")
     return notes
+
+
+def _check_node_trees(nodes: list[Any], scenes: Any, fmt: str) -> None:
+    """Refuse a node hierarchy that is not a set of disjoint strict trees (glTF 2.0 section 3.5.2): a node with
+    two parents, or a scene root that is also a child, stands in two places, of which a reader draws one; a
+    cycle places nothing."""
+    parents: dict[int, list[int]] = {}
+    for i, node in enumerate(nodes):
+        children = node.get("children") if isinstance(node, dict) else None
+        for child in children if isinstance(children, list) else []:
+            if isinstance(child, int) and not isinstance(child, bool):
+                parents.setdefault(child, []).append(i)
+    fix = "; to draw a mesh twice, give it two nodes"
+    for child, its in sorted(parents.items()):
+        if len(its) > 1:
+            raise UnreadableFileError(
+                f"the {fmt.upper()} file's node {child} is a child of nodes {its[0]} and {its[1]}, but a glTF node has "
+                f"at most one parent (glTF 2.0 section 3.5.2), so where it stands is not defined{fix}",
+                format=fmt,
+            )
+    for s, scene in enumerate(scenes if isinstance(scenes, list) else []):
+        roots = scene.get("nodes") if isinstance(scene, dict) else None
+        for root in roots if isinstance(roots, list) else []:
+            if isinstance(root, int) and root in parents:
+                raise UnreadableFileError(
+                    f"the {fmt.upper()} file's node {root} is a root of scene {s} and a child of node {parents[root][0]}, "
+                    f"but a glTF scene's roots have no parent (glTF 2.0 section 3.5.2){fix}",
+                    format=fmt,
+                )
+    for start in parents:
+        seen = {start}
+        node = start
+        while node in parents:  # one parent each by now: walk up to a root, or round a cycle
+            node = parents[node][0]
+            if node in seen:
+                raise UnreadableFileError(
+                    f"the {fmt.upper()} file's node hierarchy has a cycle through node {node}, so its nodes are placed "
+                    "nowhere (glTF 2.0 section 3.5.2: the hierarchy is a set of trees); fix the file",
+                    format=fmt,
+                )
+            seen.add(node)
 
 
 def _declared_unit(scene: Any, fmt: str) -> str | None:

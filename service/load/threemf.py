@@ -60,6 +60,7 @@ from ..errors import EmptyGeometryError, InvalidParameterError, NotWatertightErr
 __all__ = ["ThreeMF", "read_3mf", "InvalidPackageError"]
 
 CORE = "http://schemas.microsoft.com/3dmanufacturing/core/2015/02"
+DRAFT_093 = "http://schemas.microsoft.com/3dmanufacturing/2013/01"  # 3MF 0.93, before the 1.0 specification
 PROD = "http://schemas.microsoft.com/3dmanufacturing/production/2015/06"
 MAT = "http://schemas.microsoft.com/3dmanufacturing/material/2015/02"
 SLICE = "http://schemas.microsoft.com/3dmanufacturing/slice/2015/07"
@@ -552,6 +553,13 @@ def _transform(text: str | None, where: str) -> NDArray[np.float64]:
 
 
 def _parse_model(model: Any, path: str, is_root: bool, reader: _Reader) -> _Part:
+    if model.tag == f"{{{DRAFT_093}}}model":
+        raise UnsupportedFormatError(
+            f"{path} is written in the namespace of 3MF 0.93 ({DRAFT_093}), a draft from before version 1.0 of "
+            "the specification, which this service does not read; re-save it with a current 3MF exporter",
+            format="3mf",
+            namespace=DRAFT_093,
+        )
     if model.tag != f"{{{CORE}}}model":
         raise _invalid(f"{path} does not hold a 3MF model element in the core namespace", "chapter 3")
     unit_name = model.get("unit", "millimeter")
