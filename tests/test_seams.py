@@ -333,3 +333,14 @@ def test_a_double_sided_sheet_is_refused_as_such() -> None:
         mass_properties(MeshBody(v, np.vstack([sheet, sheet[:, [0, 2, 1]]])), density=1.0)
     assert "12 of its 12 triangles" in info.value.message
     assert "double-sided" in info.value.message
+
+
+def test_a_sheet_stored_twice_in_the_same_winding_is_refused_as_double_sided() -> None:
+    # assimp's regr_3429812.obj: a quad and its two triangles, the same winding; the repair of the winding turns
+    # one copy over, and the refusal must not say the file stored them "once in each winding"
+    v = np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [0.0, 1.0, 0.0]])
+    sheet = np.array([[3, 2, 1], [3, 1, 0]])
+    with pytest.raises(ZeroVolumeError) as info:
+        mass_properties(MeshBody(v, np.vstack([sheet, sheet])), density=1.0)
+    assert "4 of its 4 triangles are stored twice" in info.value.message
+    assert "each winding" not in info.value.message

@@ -679,6 +679,34 @@ def test_gltf_node_hierarchy_that_is_not_trees_is_refused(change: Callable[[dict
         analyze(json.dumps(doc).encode(), filename="graph.gltf")
 
 
+def _primitives_as_object(doc: dict[str, Any]) -> None:
+    doc["meshes"][0]["primitives"] = doc["meshes"][0]["primitives"][0]  # assimp's wrongTypes/badArray.gltf
+
+
+def _view_past_buffer(doc: dict[str, Any]) -> None:
+    doc["bufferViews"][0]["byteLength"] = 5000  # assimp's IncorrectVertexArrays/Cube.gltf: views past the buffer
+
+
+def _accessor_past_buffer(doc: dict[str, Any]) -> None:
+    doc["accessors"][0]["count"] = 5000
+
+
+@pytest.mark.parametrize(
+    "change, words",
+    [
+        (_primitives_as_object, r"mesh 0 has no array of primitives \(meshes\[0\]\.primitives"),
+        (_view_past_buffer, r"buffer view 0 runs past the end of buffer 0 \(bytes 0 to 5000 of its 144\)"),
+        (_accessor_past_buffer, r"accessor 0 runs past its buffer \(mesh 0\)"),
+    ],
+)
+def test_a_gltf_file_trimesh_cannot_read_has_its_fault_named(change: Callable[[dict[str, Any]], None], words: str) -> None:
+    # these were all "a value of the wrong kind or count"
+    doc = gltf_box_doc()
+    change(doc)
+    with pytest.raises(UnreadableFileError, match=words):
+        analyze(json.dumps(doc).encode(), filename="broken.gltf")
+
+
 # glTF 2.0 section 3.7.2.1: a fan v0, v1, ..., vn is the triangles {v(i+1), v(i+2), v0}.  The unit right
 # tetrahedron as one fan about the origin, [0, 2, 1, 3, 2], and the far face (1, 2, 3) as a triangle list.
 _TETRA = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]], dtype="<f4")

@@ -24,7 +24,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..body import MeshBody, Part
-from ..errors import EmptyGeometryError, InvalidParameterError, UnreadableFileError, UnsupportedFormatError
+from ..errors import EmptyGeometryError, InvalidParameterError, ServiceError, UnreadableFileError, UnsupportedFormatError
 from .safe import guarded_read
 
 __all__ = ["read_trimesh_parts", "read_surface_parts", "mesh_part"]
@@ -153,6 +153,9 @@ def read_trimesh_parts(
             fmt,
         )
     except UnreadableFileError:
+        fault = _gltf_fault(data, fmt, companions) if fmt in ("gltf", "glb") else None
+        if fault is not None:
+            raise fault from None
         own = _own_binary_ply(data, length_scale) if fmt == "ply" else None  # faces of several lengths, a \r header
         if own is None:
             raise
@@ -489,6 +492,66 @@ def _check_gltf_document(data: bytes, fmt: str) -> list[str]:
     if lines:
         notes.append(f"{lines} point or line primitive(s) of the glTF file hold no volume and were left out")
     return notes
+
+
+def _gltf_fault(data: bytes, fmt: str, companions: Mapping[str, bytes] | None) -> ServiceError | None:
+    """For a glTF file trimesh could not read: the first fault of its meshes that can be named, else None.
+
+    A buffer view that runs past its buffer's bytes (glTF 2.0 section 3.6.1), a mesh's primitives that are not
+    an array of objects with attributes (section 5.23-5.24), or an accessor of a primitive that names no buffer
+    view or runs past its buffer (section 3.6.2).
+    """
+    from .instancing import Buffers, accessor_values
+
+    doc = _gltf_document(data, fmt)
+    if not isinstance(doc, dict):
+        return None
+    meshes = doc.get("meshes", [])
+    if not isinstance(meshes, list):
+        return UnreadableFileError(f"the {fmt.upper()} file's meshes are not an array; the file is corrupt", format=fmt)
+    accessors: list[Any] = doc["accessors"] if isinstance(doc.get("accessors"), list) else []
+    buffers = Buffers(doc, data, fmt, companions or {})
+    views: list[Any] = doc["bufferViews"] if isinstance(doc.get("bufferViews"), list) else []
+    for vi, view in enumerate(views):
+        b = view.get("buffer") if isinstance(view, dict) else None
+        offset, length = (view.get("byteOffset", 0), view.get("byteLength")) if isinstance(view, dict) else (None, None)
+        if not (isinstance(b, int) and isinstance(offset, int) and isinstance(length, int)):
+            continue
+        try:
+            size = len(buffers.get(b))
+        except ServiceError as exc:
+            return exc
+        if offset + length > size:
+            return UnreadableFileError(
+                f"the {fmt.upper()} file's buffer view {vi} runs past the end of buffer {b} (bytes {offset} to "
+                f"{offset + length} of its {size}); the file is corrupt or truncated",
+                format=fmt,
+            )
+    for mi, mesh in enumerate(meshes):
+        primitives = mesh.get("primitives") if isinstance(mesh, dict) else None
+        if not isinstance(primitives, list) or not all(isinstance(p, dict) for p in primitives):
+            return UnreadableFileError(
+                f"the {fmt.upper()} file's mesh {mi} has no array of primitives (meshes[{mi}].primitives, glTF 2.0 "
+                "section 5.23); the file is corrupt, re-export it",
+                format=fmt,
+            )
+        for prim in primitives:
+            attributes = prim.get("attributes")
+            if not isinstance(attributes, dict):
+                return UnreadableFileError(
+                    f"a primitive of the {fmt.upper()} file's mesh {mi} has no attributes object; the file is corrupt",
+                    format=fmt,
+                )
+            for key in [*attributes.values(), prim.get("indices")]:
+                acc = accessors[key] if isinstance(key, int) and 0 <= key < len(accessors) else None
+                sparse = isinstance(acc, dict) and "sparse" in acc
+                if key is None or sparse:
+                    continue
+                try:
+                    accessor_values(doc, key, buffers, fmt, normalize=False)
+                except ServiceError as exc:
+                    return type(exc)(f"{exc.message} (mesh {mi}); the file is corrupt or truncated", **exc.details)
+    return None
 
 
 def _check_node_trees(nodes: list[Any], scenes: Any, fmt: str) -> None:

@@ -429,8 +429,9 @@ def _check_volume(s: Sums, kind: str, cells: NDArray[np.int64] | None = None) ->
         if twins:
             raise ZeroVolumeError(
                 f"the mesh encloses no volume: {twins} of its {len(cells) if cells is not None else 0} triangles are "
-                "stored twice, once in each winding (a double-sided surface, a sheet rather than a solid); send the "
-                "solid's closed outer surface, or use model=shell with a thickness",
+                "stored twice, as the two sides of one sheet (a double-sided surface, not a solid; copies stored "
+                "with the same winding are read so too); send the solid's closed outer surface, or use model=shell "
+                "with a thickness",
                 volume=s.m0,
                 double_sided_triangles=twins,
             )
