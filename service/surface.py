@@ -27,20 +27,10 @@ AREA_BLOCK = 1 << 16  # triangles per block: ~10 MB of temporaries, not ~150 byt
 
 # The last area computed and weak references to the two arrays it came from.  An analysis asks for a
 # closed surface's area twice, with the same arrays when the file needed no repair: the resolution check
-# (``mass.refine``) and then the surface_area section; each is ~0.15 s at 5e6 triangles.  Only arrays whose
-# values cannot change are remembered (read-only down to their memory, as a body's are), and a pair is
-# known by identity, so a new surface is never given an old area.
+# (``mass.refine``) and then the surface_area section; each is ~0.15 s at 5e6 triangles.  Only read-only
+# arrays are remembered (a body's are: ``body.MeshBody`` freezes them, and nothing writes to the memory
+# below them), and a pair is known by identity, so a new surface is never given an old area.
 _last: tuple[weakref.ref[NDArray[Any]], weakref.ref[NDArray[Any]], float] | None = None
-
-
-def _immutable(arr: NDArray[Any]) -> bool:
-    """Whether no one can write to ``arr``'s values: it and every array below it are read-only, over bytes or its own memory."""
-    a: object = arr
-    while isinstance(a, np.ndarray):
-        if a.flags.writeable:
-            return False
-        a = a.base
-    return a is None or isinstance(a, bytes)
 
 
 def triangle_area(vertices: NDArray[np.float64], faces: NDArray[np.int64]) -> float:
@@ -54,7 +44,7 @@ def triangle_area(vertices: NDArray[np.float64], faces: NDArray[np.int64]) -> fl
     if last is not None and last[0]() is v and last[1]() is f:
         return last[2]
     area = _triangle_area(v, f)
-    if _immutable(v) and _immutable(f):
+    if not (v.flags.writeable or f.flags.writeable):
         _last = (weakref.ref(v), weakref.ref(f), area)
     return area
 
