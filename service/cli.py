@@ -303,6 +303,18 @@ def joined_negative_values(argv: Sequence[str]) -> list[str]:
     return out
 
 
+# The service's sentences give advice in the API's words (``pass units=mm``, ``use model=shell``); in a table or
+# error line of the command the same advice reads as its options (``--units mm``).  The JSON output keeps the
+# API's words, as the API returns them.
+ADVICE_OPTIONS = frozenset({"units", "format", "model", "thickness", "density", "mass", "geometry", "deflection"})
+_ADVICE = re.compile(r"\b([a-z]+)=([^\s,;()]*[^\s,;().]|\.\.\.)")
+
+
+def as_options(text: str) -> str:
+    """``text`` with each ``name=value`` of an analysis option written as the command's ``--name value``."""
+    return _ADVICE.sub(lambda m: f"--{m[1]} {m[2]}" if m[1] in ADVICE_OPTIONS else m[0], text)
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     args = _parser().parse_args(joined_negative_values(sys.argv[1:] if argv is None else argv))
     as_json = bool(getattr(args, "json", False))
@@ -316,7 +328,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         if as_json:
             print(json.dumps(exc.as_dict()), file=sys.stderr)
         else:
-            print(f"error: {exc.message} ({exc.code})", file=sys.stderr)
+            print(f"error: {as_options(exc.message)} ({exc.code})", file=sys.stderr)
         return exit_code(exc)
     except BrokenPipeError:  # output piped into head & co.: not an error of ours
         sys.stderr.close()
@@ -341,7 +353,7 @@ def _analyze(args: argparse.Namespace) -> int:
     if getattr(args, "export", None) and not args.json:
         print(export_text(document))
         for w in document.warnings:
-            print(f"warning: {w}", file=sys.stderr)
+            print(f"warning: {as_options(w)}", file=sys.stderr)
         return 0
     if args.json:
         try:
@@ -533,7 +545,7 @@ def render_table(doc: AnalysisDocument, output_units: str = "si") -> str:
     rows.append(("elapsed", f"{diag.elapsed_s * 1e3:.2f} ms"))
     width = max(len(k) for k, _ in rows)
     lines += [f"  {k:<{width}}  {v}" for k, v in rows]
-    lines += [f"  warning: {w}" for w in doc.warnings]
+    lines += [f"  warning: {as_options(w)}" for w in doc.warnings]
     return "\n".join(lines)
 
 

@@ -16,7 +16,7 @@ from pathlib import Path
 
 import pytest
 
-from inertia.cli import _parser, main
+from inertia.cli import ADVICE_OPTIONS, _parser, as_options, main
 
 ROOT = Path(__file__).resolve().parents[1]
 BOX = str(ROOT / "sample_meshes" / "box.stl")
@@ -82,6 +82,27 @@ def test_motion_lines_carry_units(capsys: pytest.CaptureFixture[str]) -> None:
     for line in motion:
         label = next(k for k in units if k in line)
         assert line.rstrip().endswith(units[label]), line
+
+
+def test_advice_reads_as_the_commands_options_in_table_mode(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    # an open box: "... analyse it as a thin surface with model=shell and a thickness" is the API's wording
+    faces = Path(BOX).read_bytes()
+    count = int.from_bytes(faces[80:84], "little")
+    open_box = tmp_path / "open.stl"
+    open_box.write_bytes(faces[:80] + (count - 1).to_bytes(4, "little") + faces[84 : 84 + 50 * (count - 1)])
+    assert main(["analyze", str(open_box)]) == 4
+    table = capsys.readouterr().err
+    assert "--model shell" in table and "model=shell" not in table
+    assert main(["analyze", str(open_box), "--json"]) == 4
+    assert "model=shell" in json.loads(capsys.readouterr().err)["error"]["message"]
+
+
+def test_every_advised_option_is_an_option_of_analyze() -> None:
+    parser = _parser()
+    subparsers = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction))
+    flags = {s for action in subparsers.choices["analyze"]._actions for s in action.option_strings}
+    assert {f"--{name}" for name in ADVICE_OPTIONS} <= flags
+    assert as_options("pass units=mm, or format=..., not mass_unit=u") == "pass --units mm, or --format ..., not mass_unit=u"
 
 
 def test_every_option_has_help() -> None:
