@@ -373,10 +373,12 @@ def _check_gltf_document(data: bytes, fmt: str) -> list[str]:
 
     glTF 2.0 specification: required extensions that change the geometry
     (Draco or meshopt compression; quantized positions are scaled back by
-    ``quantized``), sparse accessors
-    (section 3.6.2.3; trimesh does not apply them), skinned meshes (posed by their joints, section 3.7.3: the node's own
-    transform is ignored) and morph targets with non-zero default weights
-    (section 3.7.2.2) are refused with a sentence; point and line primitives
+    ``quantized``), sparse accessors (section 3.6.2.3; trimesh does not
+    apply them), skinned meshes (posed by their joints, section 3.7.3: the
+    node's own transform is ignored), morph targets with non-zero default
+    weights (section 3.7.2.2) and node hierarchies that are not trees
+    (section 3.5.2) are refused with a sentence; triangle fans (mode 6) are
+    rewritten as triangles (``fans``); point and line primitives
     (modes 0-3) hold no volume and are left out with a note.
     """
     doc = _gltf_document(data, fmt)
@@ -581,18 +583,22 @@ def _check_node_trees(nodes: list[Any], scenes: Any, fmt: str) -> None:
                     f"but a glTF scene's roots have no parent (glTF 2.0 section 3.5.2){fix}",
                     format=fmt,
                 )
+    rooted: set[int] = set()  # nodes whose line of parents ends at a root: each node is walked once
     for start in parents:
-        seen = {start}
+        path = [start]
+        on_path = {start}
         node = start
-        while node in parents:  # one parent each by now: walk up to a root, or round a cycle
+        while node in parents and node not in rooted:  # one parent each by now: up to a root, or round a cycle
             node = parents[node][0]
-            if node in seen:
+            if node in on_path:
                 raise UnreadableFileError(
                     f"the {fmt.upper()} file's node hierarchy has a cycle through node {node}, so its nodes are placed "
                     "nowhere (glTF 2.0 section 3.5.2: the hierarchy is a set of trees); fix the file",
                     format=fmt,
                 )
-            seen.add(node)
+            path.append(node)
+            on_path.add(node)
+        rooted.update(path)
 
 
 def _declared_unit(scene: Any, fmt: str) -> str | None:
