@@ -434,7 +434,7 @@ def _rotation_note(name: str, placed: list[tuple[float, float]]) -> str:
     return (
         f"3MF object {name!r}: {len(placed)} placement(s) are rotations written to few digits (up to {off:.2g} from "
         f"orthonormal); each was placed by the nearest rotation, as its exporter meant (as written, the digits "
-        f"would also scale a piece's volume by up to {abs(scale):.9g})"
+        f"would also change a piece's volume by up to {abs(abs(scale) - 1.0):.2g} of it)"
     )
 
 
