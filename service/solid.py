@@ -78,8 +78,10 @@ def closed_surface(body: MeshBody) -> tuple[NDArray[np.float64], NDArray[np.int6
             open_edges=topo.open_edges,
             **({"part": body.name} if body.name else {}),
         )
+    as_stored = None  # the faces as the file winds them, where their winding had to be made consistent
     if not topo.closed:
-        faces, flipped = orient_consistently(faces, topo)
+        as_stored = faces
+        faces, _ = orient_consistently(faces, topo)
         topo = surface_topology(faces, len(vertices))
         if not topo.closed:
             shared = (
@@ -94,8 +96,13 @@ def closed_surface(body: MeshBody) -> tuple[NDArray[np.float64], NDArray[np.int6
                 unbalanced_edges=topo.unbalanced_edges,
                 **({"nonmanifold_edges": topo.nonmanifold_edges} if topo.nonmanifold_edges else {}),
             )
-        warnings.append(f"inconsistent winding repaired ({flipped} of {len(faces)} faces flipped)")
     faces, more = _orient_outward(vertices, faces, topo)
+    if as_stored is not None:
+        # counted against the file: the consistent winding keeps the first face's, so a file whose first face
+        # alone was reversed had every other face flipped, then all of them turned outward again
+        flipped = int(np.count_nonzero(np.any(faces != as_stored, axis=1)))
+        warnings.append(f"inconsistent winding repaired ({flipped} of {len(faces)} faces flipped)")
+        more = [w for w in more if w != INVERTED]
     warnings.extend(more)
     return vertices, faces, tuple(warnings)
 

@@ -142,7 +142,19 @@ def test_inconsistent_winding_is_repaired_with_a_warning() -> None:
     good = mass_properties(MeshBody(v, f))
     repaired = mass_properties(MeshBody(v, broken))
     np.testing.assert_allclose(repaired.inertia.matrix, good.inertia.matrix, rtol=1e-14, atol=1e-12)
-    assert any("inconsistent winding repaired" in w for w in repaired.warnings)
+    assert any("inconsistent winding repaired (3 of" in w for w in repaired.warnings)
+
+
+@pytest.mark.parametrize("reversed_face", [0, 7])
+def test_repaired_winding_counts_the_faces_turned_from_the_files(reversed_face: int) -> None:
+    # one facet of a box reversed: with it first, the consistent winding kept its way and flipped the other
+    # eleven, then the whole was turned outward ("11 of 12 flipped" and "inverted"): one face was turned in all
+    v, f = box(1.0, 2.0, 3.0)
+    broken = f.copy()
+    broken[reversed_face] = broken[reversed_face][[0, 2, 1]]
+    repaired = mass_properties(MeshBody(v, broken))
+    assert repaired.mass == pytest.approx(6000.0, rel=1e-15)
+    assert [w for w in repaired.warnings if "winding" in w] == ["inconsistent winding repaired (1 of 12 faces flipped)"]
 
 
 def test_open_mesh_is_refused_with_open_edge_count() -> None:
