@@ -52,12 +52,24 @@ def test_an_obj_vertex_with_two_coordinates_is_refused_with_its_line() -> None:
         (b"v 0 0 0 2\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", "weight"),
         (b"v 0 0 x\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", "not a number"),
         (b"v 0 0 0\nf 1 a 3\n", "not an integer"),
+        # tinyobjloader's issue-140-zero-face-idx.obj: 0 is no vertex number, whatever comes before it
+        (b"v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 0/0/0 1/1/1 2/2/2\n", "OBJ numbers vertices from 1"),
+        (b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 0 1 2\n", "OBJ numbers vertices from 1"),
+        (b"v 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", "gives 2 numbers;"),
+        (b"v 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", "gives 1 number;"),
     ],
 )
 def test_bad_obj_lines_are_named(text: bytes, words: str) -> None:
     with pytest.raises(UnreadableFileError) as err:
         analyze(text, filename="bad.obj")
     assert words in err.value.message
+
+
+def test_msvc_spelling_of_nan_in_an_obj_file_is_named() -> None:
+    # tinyobjloader's test-nan.obj: '#' began a comment, and "gives 1 numbers" hid the NaN behind it
+    text = b"v 1.#IND -1.#IND 1.#IND\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"
+    with pytest.raises(InvalidParameterError, match=r"line 1 .* holds '1\.#IND', how Microsoft's C library writes"):
+        analyze(text, filename="nan.obj")
 
 
 def test_obj_quads_negative_indices_and_colours_read_exactly() -> None:

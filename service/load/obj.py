@@ -23,14 +23,20 @@ Everything else (``vt``, ``vn``, ``usemtl``, ``mtllib``, ``s``, ``l``,
 
 from __future__ import annotations
 
+import re
+
 import numpy as np
 from numpy.typing import NDArray
 
-from ..errors import EmptyGeometryError, UnreadableFileError, UnsupportedFormatError
+from ..errors import EmptyGeometryError, InvalidParameterError, UnreadableFileError, UnsupportedFormatError
 from .polygons import fan_split_note, fan_triangles
 from .safe import is_number
 
 __all__ = ["read_obj"]
+
+
+# 1.#IND, 1.#INF, 1.#QNAN, 1.#SNAN (with a sign): how Microsoft's C runtime prints non-finite numbers
+_MSVC_NON_FINITE = re.compile(r"[-+]?\d\.#(?:IND|INF|QNAN|SNAN)\w*", re.IGNORECASE)
 
 
 def _fail(line_no: int, text: str, why: str) -> UnreadableFileError:
@@ -157,11 +163,18 @@ def _vertices(rows: list[list[str]], line_nos: list[int], lines: list[str]) -> N
     bad = np.flatnonzero(~np.isin(counts, (3, 4, 6, 7)))
     if len(bad):
         i = int(bad[0])
-        raise _fail(
-            line_nos[i],
-            lines[line_nos[i] - 1].strip(),
-            f"gives {counts[i]} numbers; a vertex needs x y z (and optionally w, or r g b)",
-        )
+        line = lines[line_nos[i] - 1].strip()
+        msvc = _MSVC_NON_FINITE.search(line)
+        if msvc:  # "1.#IND": the '#' began a comment, so the line seemed short of numbers
+            raise InvalidParameterError(
+                f"the OBJ file's line {line_nos[i]} ({line[:60]!r}) holds {msvc.group(0)!r}, how Microsoft's C library "
+                "writes a non-finite number (NaN or infinity), where a coordinate belongs; fix the file",
+                format="obj",
+                line=line_nos[i],
+                field="vertex coordinates",
+            )
+        numbers = f"{counts[i]} number" + ("" if counts[i] == 1 else "s")
+        raise _fail(line_nos[i], line, f"gives {numbers}; a vertex needs x y z (and optionally w, or r g b)")
     try:
         xyz = np.array([r[1:4] for r in rows], dtype=np.float64)
         weighted = np.flatnonzero(np.isin(counts, (4, 7)))
@@ -201,11 +214,7 @@ def _faces(
     bad = np.flatnonzero((refs == 0) | (idx < 0) | (idx >= before))
     if len(bad):
         i = int(face_of[bad[0]])
-        raise _fail(
-            line_nos[i],
-            lines[line_nos[i] - 1].strip(),
-            f"refers to vertex {int(refs[bad[0]])}, but only {seen[i]} vertices come before it",
-        )
+        raise _fail(line_nos[i], lines[line_nos[i] - 1].strip(), _bad_reference(int(refs[bad[0]]), seen[i]))
     triangles, tri_face = fan_triangles(idx, corners)
     return triangles, np.asarray(part, dtype=np.int64)[tri_face], idx, corners
 
@@ -233,4 +242,10 @@ def _index(corner: str, count: int, line_no: int, line: str) -> int:
         return k - 1
     if k < 0 and -k <= count:
         return count + k
-    raise _fail(line_no, line, f"refers to vertex {k}, but only {count} vertices come before it")
+    raise _fail(line_no, line, _bad_reference(k, count))
+
+
+def _bad_reference(k: int, count: int) -> str:
+    if k == 0:
+        return "refers to vertex 0, but OBJ numbers vertices from 1 (and back from -1 for the latest)"
+    return f"refers to vertex {k}, but only {count} vertices come before it"
