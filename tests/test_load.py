@@ -485,3 +485,12 @@ def test_a_malformed_ascii_stl_vertex_is_named_as_the_file_writes_it() -> None:
     with pytest.raises(UnreadableFileError) as caught:
         analyze(text, filename="invalidvertex.stl")
     assert "'blah' where a coordinate should be" in caught.value.message and "np." not in caught.value.message
+    assert "vertex line (line 5)" in caught.value.message
+
+
+def test_an_ascii_stl_facet_without_three_vertices_is_named_by_its_line() -> None:
+    # OpenSCAD's tests/data/stl/toomanyvertices.stl: a facet of four vertex lines
+    facet = "facet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\n{extra}endloop\nendfacet\n"
+    text = "solid t\n" + facet.format(extra="") + facet.format(extra="vertex 0 1 1\n") + "endsolid t\n"
+    with pytest.raises(UnreadableFileError, match=r"facet at line 9 has 4 vertices, but a facet has three"):
+        analyze(text.encode(), filename="toomanyvertices.stl")

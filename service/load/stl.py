@@ -119,6 +119,34 @@ def _welded(corners: NDArray[np.float32]) -> tuple[NDArray[np.float64], NDArray[
     return vertices, ids.reshape(-1, 3)
 
 
+def _facet_without_three_vertices(data: bytes) -> tuple[int, int] | None:
+    """(its line, its vertex count) of the first facet ... endfacet block without three vertex lines, if any."""
+    start, count = 0, -1  # count -1: outside a facet
+    for number, line in enumerate(data.splitlines(), 1):
+        word = line.split(maxsplit=1)[:1]
+        key = word[0].lower() if word else b""
+        if key == b"facet":
+            if count not in (-1, 3):
+                return start, count
+            start, count = number, 0
+        elif key == b"vertex" and count >= 0:
+            count += 1
+        elif key == b"endfacet":
+            if count != 3:
+                return start, max(count, 0)
+            count = -1
+    return (start, count) if count not in (-1, 3) else None
+
+
+def _line_of_vertex_token(data: bytes, token: bytes) -> int | None:
+    """The line of the first vertex line that holds ``token`` among its coordinates."""
+    for number, line in enumerate(data.splitlines(), 1):
+        words = line.split()
+        if words[:1] and words[0].lower() == b"vertex" and token in words[1:4]:
+            return number
+    return None
+
+
 def _ascii(data: bytes) -> tuple[NDArray[np.float64], NDArray[np.int64]]:
     tokens = np.array(data.split())
     idx = np.flatnonzero(tokens == b"vertex")
@@ -129,12 +157,23 @@ def _ascii(data: bytes) -> tuple[NDArray[np.float64], NDArray[np.int64]]:
             raise UnreadableFileError("the ASCII STL file has facets without vertices; it is corrupt")
         raise EmptyGeometryError("the STL file holds no triangles")
     if len(idx) % 3 or idx[-1] + 3 >= len(tokens):
-        raise UnreadableFileError("the ASCII STL file has a facet without exactly three vertices")
+        found = _facet_without_three_vertices(data)
+        where = (
+            f"'s facet at line {found[0]} has {found[1]} vertices, but a facet has three"
+            if found
+            else " has a facet without exactly three vertices"
+        )
+        raise UnreadableFileError(f"the ASCII STL file{where}; fix that facet or re-export the file")
     fields = tokens[idx[:, None] + np.arange(1, 4)]
     try:
         coords = fields.astype(np.float64)
     except ValueError as exc:
         bad = next((t for t in fields.ravel().tolist() if not is_number(t)), None)
         shown = "a token that is no number" if bad is None else repr(bad.decode("utf-8", "replace")[:40])
-        raise UnreadableFileError(f"the ASCII STL file has a malformed vertex line: {shown} where a coordinate should be") from exc
+        line = _line_of_vertex_token(data, bad) if bad is not None else None
+        at = f" (line {line})" if line else ""
+        raise UnreadableFileError(
+            f"the ASCII STL file has a malformed vertex line{at}: {shown} where a coordinate should be; fix that line "
+            "or re-export the file"
+        ) from exc
     return weld(coords, np.arange(len(idx), dtype=np.int64).reshape(-1, 3))
