@@ -289,11 +289,12 @@ def render(rows: list[Row], elapsed: float) -> Report:
         "3MF objects the specification does not weigh left out), vertices within 1e-11 of the diagonal merged by "
         "trimesh, then integrated exactly in rational arithmetic (`benchmarks/exact.py`); a number is *read right* when "
         f"mass (unit density, file units) and inertia tensor agree to {TOL:g}. *Refused* means the file is broken "
-        "or a 3MF Consortium MUSTFAIL sample and the service answered an error code with a sentence. Volume meshes "
+        "or a 3MF Consortium MUSTFAIL sample and the service answered an error code with a sentence. Volume meshes, "
+        "CAD files and the files trimesh cannot read "
         f"are compared to a reference file beside them to {REFERENCE_TOL:g}, or to the precision the reference states: "
         "Gmsh's own integration (`quadratic/`), VTK's own readers and cell interpolation (`vtk/`, `vtu/`), Gmsh's "
-        "OpenCASCADE mass properties (`step/`), all written by `python -m benchmarks.real_references` except "
-        "`quadratic/` (its README).",
+        "OpenCASCADE mass properties (`step/`), lib3mf's reading (`3mf_production/`, single precision: 1e-06), all "
+        "written by `python -m benchmarks.real_references` except `quadratic/` (its README).",
         "",
         "| format | read right | read, no reference | refused with reason | wrong | crashed |",
         "| --- | ---: | ---: | ---: | ---: | ---: |",

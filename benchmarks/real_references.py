@@ -1,6 +1,7 @@
 """References for the real volume and CAD files, computed by the files' own tools (not by this project).
 
-    python -m benchmarks.real_references     # rewrites tests/data/real/{vtk,vtu,inp,vtkxml}/vtk_reference.json
+    python -m benchmarks.real_references     # rewrites tests/data/real/{vtk,vtu,inp,vtkxml}/vtk_reference.json,
+                                             # tests/data/real/3mf_production/lib3mf_reference.json
                                              # and tests/data/real/step/gmsh_reference.json
 
 VTK files (legacy ``.vtk``, XML ``.vtu``, AVS UCD ``.inp``): read by VTK's own
@@ -335,12 +336,74 @@ def gmsh_references(folder: Path) -> dict[str, Any]:
     return out
 
 
+# 3MF packages whose references come from lib3mf, the 3MF Consortium's own library (``pip install lib3mf``): it
+# stores coordinates in single precision, so its reading is within ~1e-7 of the file's decimal coordinates
+# (the service reads them as doubles), and these references are compared to LIB3MF_RTOL
+LIB3MF_RTOL = 1e-6
+
+
+def lib3mf_reference(path: Path) -> dict[str, Any]:
+    """The build of a 3MF package as lib3mf reads it: every build item's ``model`` objects (components followed,
+    each transform applied as the specification's row-vector matrices), placed in the build's frame in the
+    file's unit, integrated exactly in rational arithmetic."""
+    import lib3mf
+
+    from benchmarks.exact import exact_solid
+
+    model = lib3mf.get_wrapper().CreateModel()
+    model.QueryReader("3mf").ReadFromFile(str(path))
+    vertices: list[np.ndarray] = []
+    faces: list[np.ndarray] = []
+
+    def matrix(transform: Any) -> np.ndarray:
+        rows = np.array([list(r) for r in transform.Fields], dtype=np.float64)  # 4 x 3, applied to row vectors
+        out = np.eye(4)
+        out[:3, :3] = rows[:3].T
+        out[:3, 3] = rows[3]
+        return out
+
+    def place(resource: Any, placement: np.ndarray) -> None:
+        if resource.GetType() != lib3mf.ObjectType.Model:
+            return  # support and other objects are not weighed (core specification, chapter 4.1)
+        if resource.IsMeshObject():
+            mesh = model.GetMeshObjectByID(resource.GetResourceID())
+            v = np.array([list(x.Coordinates) for x in mesh.GetVertices()], dtype=np.float64)
+            f = np.array([list(x.Indices) for x in mesh.GetTriangleIndices()], dtype=np.int64)
+            faces.append(f + sum(len(x) for x in vertices))
+            vertices.append(v @ placement[:3, :3].T + placement[:3, 3])
+            if np.linalg.det(placement[:3, :3]) < 0:
+                faces[-1] = faces[-1][:, [0, 2, 1]]
+            return
+        components = model.GetComponentsObjectByID(resource.GetResourceID())
+        for i in range(components.GetComponentCount()):
+            part = components.GetComponent(i)
+            inner = matrix(part.GetTransform()) if part.HasTransform() else np.eye(4)
+            place(part.GetObjectResource(), placement @ inner)
+
+    items = model.GetBuildItems()
+    while items.MoveNext():
+        item = items.GetCurrent()
+        place(item.GetObjectResource(), matrix(item.GetObjectTransform()) if item.HasObjectTransform() else np.eye(4))
+    volume, centre, tensor = exact_solid(np.concatenate(vertices), np.concatenate(faces))
+    return {
+        "volume": float(volume),
+        "center": [float(c) for c in centre],
+        "inertia_unit_density": [[float(v) for v in row] for row in tensor],
+        "rtol": LIB3MF_RTOL,
+        "reader": f"lib3mf {'.'.join(map(str, lib3mf.get_wrapper().GetLibraryVersion()))}, single-precision coordinates; "
+        "build items and components placed, exact rational integration",
+    }
+
+
 def main() -> int:
     for sub in ("vtk", "vtu", "inp", "vtkxml"):
         refs = vtk_references(REAL / sub)
         if refs:
             (REAL / sub / "vtk_reference.json").write_text(json.dumps(refs, indent=1) + "\n")
         print(f"{sub}: {len(refs)} references")
+    refs = {p.name: lib3mf_reference(p) for p in sorted((REAL / "3mf_production").glob("*.3mf"))}
+    (REAL / "3mf_production" / "lib3mf_reference.json").write_text(json.dumps(refs, indent=1) + "\n")
+    print(f"3mf_production: {len(refs)} references")
     refs = gmsh_references(REAL / "step")
     (REAL / "step" / "gmsh_reference.json").write_text(json.dumps(refs, indent=1) + "\n")
     print(f"step: {len(refs)} references")
