@@ -1080,6 +1080,38 @@ def test_a_binary_ply_with_quads_and_triangles_is_read(order: str, newline: str)
     assert doc["principal"]["moments"] == pytest.approx(sorted(6000 * (p + q) / 12 for p, q in ((4, 9), (1, 9), (1, 4))), rel=1e-14)
 
 
+# the 1 x 2 x 3 box with a vertex (8) in the middle of its front top edge: the top and front faces are
+# pentagons, the bottom two triangles; written quad first, the corner counts 4, 3, 5, 4, 4, 5, 3 fill exactly
+# seven quads
+_EDGE_BOX = [(0, 0, 0), (1, 0, 0), (1, 2, 0), (0, 2, 0), (0, 0, 3), (1, 0, 3), (1, 2, 3), (0, 2, 3), (0.5, 0, 3)]
+_EDGE_BOX_FACES = [(3, 7, 6, 2), (0, 3, 2), (4, 8, 5, 6, 7), (0, 4, 7, 3), (1, 2, 6, 5), (0, 1, 5, 8, 4), (0, 2, 1)]
+
+
+def _edge_box_ply(order: str, head: tuple[str, ...] = ()) -> bytes:
+    encoding = "binary_little_endian" if order == "<" else "binary_big_endian"
+    lines = ["ply", *head, f"format {encoding} 1.0", "element vertex 9", "property float x", "property float y"]
+    lines += ["property float z", "element face 7", "property list uchar int vertex_indices", "end_header"]
+    text = ("\n".join(lines) + "\n").encode() + np.asarray(_EDGE_BOX, dtype=order + "f4").tobytes()
+    return text + b"".join(struct.pack(f"{order}B{len(f)}i", len(f), *f) for f in _EDGE_BOX_FACES)
+
+
+@pytest.mark.parametrize("order", ["<", ">"])
+@pytest.mark.parametrize(
+    "head",
+    [(), ("comment made by hand",), ("obj_info drawn by hand", "comment two lines"), ("comment end_header is near",)],
+    ids=["plain", "comment-first", "obj-info-first", "end-header-in-comment"],
+)
+def test_a_binary_ply_trimesh_would_misread_is_read_as_written(order: str, head: tuple[str, ...]) -> None:
+    # trimesh reads a binary face list as if every row had the first's length (these faces fill seven quads
+    # exactly: the box came back open, or pointing at vertex 83886080), takes the byte order from the header's
+    # second line (after a comment, a big-endian file was read byte-swapped: another closed box, another mass,
+    # no word) and ends the header at any line naming end_header
+    doc = analyze(_edge_box_ply(order, head), filename="edge.ply", options=AnalysisOptions(density=1.0)).as_dict()
+    assert doc["mass"] == pytest.approx(6.0, rel=1e-15)
+    assert doc["center_of_mass"] == pytest.approx([0.5, 1.0, 1.5], rel=1e-15)
+    assert not [w for w in doc["warnings"] if "winding" in w]
+
+
 def test_a_signalling_nan_in_a_binary_ply_is_refused_without_a_word_on_stderr() -> None:
     # a corrupted copy of three.js's dolphins_le.ply: widening a float32 signalling NaN printed numpy's
     # "invalid value encountered in cast" before the error (warnings are errors in this suite)

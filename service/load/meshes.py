@@ -108,9 +108,10 @@ def mesh_part(
     if len(f) == 0:
         raise EmptyGeometryError(f"part {name!r} of the {fmt.upper()} file has no triangles", format=fmt, part=name)
     if f.min() < 0 or f.max() >= len(v):
+        bad = int(f.min()) if f.min() < 0 else int(f.max())  # the number the file gives, not the largest good one
         raise UnreadableFileError(
             f"a triangle of {name!r} in the {fmt.upper()} file refers to a vertex that does "
-            f"not exist (number {int(f.max())} of {len(v)}); the file is corrupt or truncated",
+            f"not exist (number {bad} of {len(v)}); the file is corrupt or truncated",
             format=fmt,
             part=name,
         )
@@ -140,6 +141,14 @@ def read_trimesh_parts(
         if cameras or rescaled:  # changed beside (or after) what expand_instances wrote, which is only its instances
             data = with_document(original, fmt, doc)
         notes += placed
+    if fmt == "ply":  # what trimesh's reader would misread: a header out of its order, binary faces of mixed sizes
+        from .ply import header_in_order, uniform_face_rows
+
+        data = header_in_order(data)
+        if not uniform_face_rows(data):
+            own = _own_binary_ply(data, length_scale)
+            if own is not None:
+                return own, None
     # the upload's own files, and nothing else: a name outside them (a texture that did not come along, a path)
     # is not found, never looked for on disk; images are not needed for the geometry (skip_materials)
     kwargs: dict[str, Any] = {"resolver": trimesh.resolvers.ZipResolver(dict(companions or {}))}

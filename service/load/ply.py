@@ -12,12 +12,13 @@ end in ``\\r\\n``, ``\\n`` or a bare ``\\r``.
 
 from __future__ import annotations
 
+import re
 import struct
 
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ["read_binary_ply"]
+__all__ = ["header_in_order", "read_binary_ply", "uniform_face_rows"]
 
 _TYPES = {
     "char": "b",
@@ -41,13 +42,77 @@ _TYPES = {
 Property = tuple[str, str, str | None]  # name, value type, count type (lists only)
 
 
+# the line that ends a PLY header: ``end_header`` alone on it (a comment may mention the word)
+_END = re.compile(rb"(?:\r\n|\n|\r)end_header[ \t]*(\r\n|\n|\r)")
+
+
+def header_in_order(data: bytes) -> bytes:
+    """The file with its header as trimesh's reader takes it, where it is written otherwise.
+
+    trimesh reads the byte order from the header's second line and ends the header at the first line that
+    mentions ``end_header``.  A header whose ``format`` line comes after a comment or obj_info line was read
+    as little-endian binary, so a big-endian file's numbers were byte-swapped (a closed box came back with
+    another mass and no word of it), and a comment naming ``end_header`` cut the header short.  The PLY
+    format puts ``format`` after ``ply`` and ends the header at an ``end_header`` line (plyfile and this
+    module's reader read both files so); the header is rewritten so, its data untouched.
+    """
+    end = _END.search(data)
+    if not data.startswith(b"ply") or end is None:
+        return data
+    lines = data[: end.start()].replace(b"\r\n", b"\n").replace(b"\r", b"\n").split(b"\n")
+    keep = [line for line in lines[1:] if not (line.split()[:1] in ([b"comment"], [b"obj_info"]) and b"end_header" in line)]
+    formats = [line for line in keep if line.split()[:1] == [b"format"]]
+    if len(formats) != 1 or (keep[:1] == formats and len(keep) == len(lines) - 1):
+        return data  # in order already (or no single format line: the reader says what is wrong)
+    header = [lines[0], formats[0], *(line for line in keep if line is not formats[0])]
+    return b"\n".join([*header, b"end_header\n"]) + data[end.end() :]
+
+
+def uniform_face_rows(data: bytes) -> bool:
+    """Whether every face of a binary PLY file lists as many corners as its first, as trimesh's reader assumes.
+
+    trimesh reads a binary list property as if every row had the first row's length, and refuses the file
+    only when the element's bytes then come out wrong: faces of 4, 3, 5, 4, 4, 4, 4 corners fill exactly seven
+    quads, and were read as such (a box refused as open, or as pointing at vertex 83886080).  False where the
+    faces vary, or where they cannot be laid out without walking them (another list element before them, two
+    lists in a face); True for an ASCII file or one without faces.
+    """
+    found = _header(data)
+    if found is None:
+        return True
+    order, elements, offset = found
+    for name, count, props in elements:
+        lists = [k for k, (_, _, counter) in enumerate(props) if counter is not None]
+        if name != "face":
+            if lists:
+                return False
+            offset += count * sum(struct.calcsize(order + kind) for _, kind, _ in props)
+            continue
+        if len(lists) != 1:
+            return False
+        k = lists[0]
+        before = sum(struct.calcsize(order + kind) for _, kind, _ in props[:k])
+        after = sum(struct.calcsize(order + kind) for _, kind, _ in props[k + 1 :])
+        _, index, counter = props[k]
+        assert counter is not None
+        at = offset + before
+        if count == 0 or at + struct.calcsize(order + counter) > len(data):
+            return count == 0
+        (first,) = struct.unpack_from(order + counter, data, at)
+        row = before + struct.calcsize(order + counter) + first * struct.calcsize(order + index) + after
+        if first < 0 or row <= 0 or offset + row * count > len(data):
+            return False
+        counts = np.ndarray((count,), dtype=np.dtype(order + counter), buffer=data, offset=at, strides=(row,))
+        return bool(np.all(counts == first))
+    return True
+
+
 def _header(data: bytes) -> tuple[str, list[tuple[str, int, list[Property]]], int] | None:
     """Byte order, elements (name, count, properties) and the offset of the data; None for no binary PLY."""
-    end = data.find(b"end_header")
-    if not data.startswith(b"ply") or end < 0:
+    found = _END.search(data)
+    if not data.startswith(b"ply") or found is None:
         return None
-    start = end + len(b"end_header")
-    start += 2 if data[start : start + 2] == b"\r\n" else 1 if data[start : start + 1] in (b"\n", b"\r") else 0
+    end, start = found.start(), found.end()
     lines = data[:end].decode("ascii", "replace").replace("\r\n", "\n").replace("\r", "\n").split("\n")
     order = None
     elements: list[tuple[str, int, list[Property]]] = []
