@@ -720,6 +720,91 @@ def test_a_gltf_file_trimesh_cannot_read_has_its_fault_named(change: Callable[[d
         analyze(json.dumps(doc).encode(), filename="broken.gltf")
 
 
+def _box_indices(doc: dict[str, Any]) -> tuple[dict[str, Any], np.ndarray]:
+    """The box's index accessor and its values."""
+    acc = doc["accessors"][doc["meshes"][0]["primitives"][0]["indices"]]
+    view = doc["bufferViews"][acc["bufferView"]]
+    raw = base64.b64decode(doc["buffers"][view["buffer"]]["uri"].split(",", 1)[1])
+    start = view.get("byteOffset", 0) + acc.get("byteOffset", 0)
+    return acc, np.frombuffer(raw, dtype="<u4", count=acc["count"], offset=start).copy()
+
+
+def _with_indices(doc: dict[str, Any], values: np.ndarray, component: int) -> None:
+    """The box's triangles indexed by ``values`` of ``component`` type, in a new buffer."""
+    acc, _ = _box_indices(doc)
+    raw = values.astype({5121: "<u1", 5123: "<u2", 5125: "<u4"}[component]).tobytes()
+    raw += b"\0" * (-len(raw) % 4)
+    doc["buffers"].append({"byteLength": len(raw), "uri": "data:application/octet-stream;base64," + base64.b64encode(raw).decode()})
+    doc["bufferViews"].append({"buffer": len(doc["buffers"]) - 1, "byteLength": len(raw)})
+    acc.update(bufferView=len(doc["bufferViews"]) - 1, componentType=component, count=len(values), byteOffset=0)
+    acc.pop("max", None)
+    acc.pop("min", None)
+
+
+def test_gltf_node_transforms_glTF_does_not_define_are_refused() -> None:
+    # glTF 2.0 section 5.25: a node has a matrix or translation/rotation/scale, and its matrix is affine
+    doc = gltf_box_doc()
+    node = _mesh_node(doc)
+    node["matrix"] = [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 5, 0, 0, 1]
+    node["translation"] = [-5.0, 0.0, 0.0]
+    with pytest.raises(UnreadableFileError, match="node 0 has both a matrix and translation"):
+        analyze(json.dumps(doc).encode(), filename="both.gltf")
+    node["matrix"] = [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0.5, 0, 0, 0, 1]
+    del node["translation"]
+    with pytest.raises(UnreadableFileError, match=r"last row is \[0.0, 0.0, 0.5, 1.0\]"):
+        analyze(json.dumps(doc).encode(), filename="projective.gltf")
+    node["matrix"] = [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1]  # the identity beside TRS: TRS alone places it
+    node["translation"] = [-5.0, 0.0, 0.0]
+    res = analyze(json.dumps(doc).encode(), filename="identity.gltf", options=AnalysisOptions(density=1.0)).as_dict()
+    np.testing.assert_allclose(res["center_of_mass"], [-4.5, 1.0, 1.5], rtol=1e-14)
+
+
+def test_gltf_rotation_that_is_not_a_unit_quaternion_is_named() -> None:
+    doc = gltf_box_doc()
+    _mesh_node(doc)["rotation"] = [0.0, 0.0, 2 * math.sin(math.pi / 4), 2 * math.cos(math.pi / 4)]  # 90 deg about z, x2
+    res = analyze(json.dumps(doc).encode(), filename="q.gltf", options=AnalysisOptions(density=1.0)).as_dict()
+    assert res["mass"] == pytest.approx(6.0, rel=1e-14)  # rotated, not scaled
+    np.testing.assert_allclose(res["center_of_mass"], [-1.0, 0.5, 1.5], rtol=1e-14)
+    assert any("rotation quaternion of length 2," in w for w in res["warnings"])
+
+
+@pytest.mark.parametrize("asset", [{"version": "3.0"}, {"version": "2.0", "minVersion": "2.1"}])
+def test_gltf_of_another_version_than_2_is_refused(asset: dict[str, str]) -> None:
+    doc = gltf_box_doc()
+    doc["asset"] = asset
+    with pytest.raises(UnsupportedFormatError, match=r"this service reads glTF 2\.0"):
+        analyze(json.dumps(doc).encode(), filename="v.gltf")
+
+
+def test_gltf_primitive_without_positions_is_left_out_with_a_note() -> None:
+    # POSITION is optional (section 3.7.2.1): viewers skip such a primitive; trimesh refused the whole file
+    doc = gltf_box_doc()
+    doc["meshes"][0]["primitives"].append({"attributes": {}, "mode": 4})
+    res = analyze(json.dumps(doc).encode(), filename="p.gltf", options=AnalysisOptions(density=1.0)).as_dict()
+    assert res["mass"] == pytest.approx(6.0, rel=1e-14)
+    assert any("1 primitive(s) of the glTF file have no positions" in w for w in res["warnings"])
+
+
+@pytest.mark.parametrize("component, restart", [(5121, 255), (5123, 65535)])
+def test_gltf_primitive_restart_index_is_refused(component: int, restart: int) -> None:
+    # glTF-Asset-Generator's Negative/Mesh_PrimitiveRestart: WebGL 2 viewers drop the triangles using the value
+    doc = gltf_box_doc()
+    _, values = _box_indices(doc)
+    values[-1] = restart
+    _with_indices(doc, values, component)
+    with pytest.raises(UnreadableFileError, match=f"has the index {restart}, the primitive restart value"):
+        analyze(json.dumps(doc).encode(), filename="restart.gltf")
+
+
+def test_gltf_triangle_list_with_a_partial_triangle_drops_it_with_a_note() -> None:
+    doc = gltf_box_doc()
+    _, values = _box_indices(doc)
+    _with_indices(doc, np.concatenate([values, [0, 1]]), 5123)  # 38 indices
+    res = analyze(json.dumps(doc).encode(), filename="partial.gltf", options=AnalysisOptions(density=1.0)).as_dict()
+    assert res["mass"] == pytest.approx(6.0, rel=1e-14)
+    assert any("lists 38 indices for its triangles" in w and "the last 2 were left out" in w for w in res["warnings"])
+
+
 # glTF 2.0 section 3.7.2.1: a fan v0, v1, ..., vn is the triangles {v(i+1), v(i+2), v0}.  The unit right
 # tetrahedron as one fan about the origin, [0, 2, 1, 3, 2], and the far face (1, 2, 3) as a triangle list.
 _TETRA = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]], dtype="<f4")

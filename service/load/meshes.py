@@ -14,6 +14,7 @@ from __future__ import annotations
 import io
 import itertools
 import json
+import math
 import random
 from collections.abc import Callable, Mapping
 from dataclasses import replace
@@ -128,19 +129,26 @@ def read_trimesh_parts(
     notes = _check_gltf_document(data, fmt) if fmt in ("gltf", "glb") else []
     if fmt in ("gltf", "glb"):  # instances of EXT_mesh_gpu_instancing as nodes, which trimesh draws
         from .fans import fans_as_triangles
+        from .gltf_indices import checked_indices
         from .instancing import expand_instances, with_document
         from .quantized import normalized_position_scales, scale_normalized_positions
 
         doc = _gltf_document(data, fmt)
         cameras = _without_cameras(doc)
+        unplaced = _without_positionless(doc)
         original, _ = guarded_read(lambda: fans_as_triangles(doc, data, fmt, companions), fmt)
+        cut = guarded_read(lambda: checked_indices(doc, original, fmt, companions), fmt)
         data, placed = guarded_read(lambda: expand_instances(original, fmt, doc, companions), fmt)
         # normalized integer positions (KHR_mesh_quantization), which trimesh reads as the raw integers
         divisors = guarded_read(lambda: normalized_position_scales(doc, original, fmt, companions), fmt)
         rescaled = scale_normalized_positions(doc, divisors)
-        if cameras or rescaled:  # changed beside (or after) what expand_instances wrote, which is only its instances
+        if cameras or unplaced or cut or rescaled:  # changed beside (or after) what expand_instances wrote: its instances
             data = with_document(original, fmt, doc)
-        notes += placed
+        if unplaced:
+            notes.append(
+                f"{unplaced} primitive(s) of the glTF file have no positions (glTF draws nothing for them) and were left out"
+            )
+        notes += cut + placed
     if fmt == "ply":  # what trimesh's reader would misread: a header out of its order, binary faces of mixed sizes
         from .ply import header_in_order, uniform_face_rows
 
@@ -274,6 +282,24 @@ def _without_cameras(doc: Any) -> bool:
     return found
 
 
+def _without_positionless(doc: Any) -> int:
+    """Take off the meshes' primitives that have no POSITION attribute; how many there were.
+
+    POSITION is optional (glTF 2.0 section 3.7.2.1): such a primitive draws nothing, and glTF's own viewers skip
+    it, but trimesh's reader refuses the whole file.
+    """
+    meshes = doc.get("meshes") if isinstance(doc, dict) else None
+    removed = 0
+    for mesh in meshes if isinstance(meshes, list) else []:
+        primitives = mesh.get("primitives") if isinstance(mesh, dict) else None
+        if not isinstance(primitives, list):
+            continue
+        kept = [p for p in primitives if not (isinstance(p, dict) and "POSITION" not in (p.get("attributes") or {}))]
+        removed += len(primitives) - len(kept)
+        mesh["primitives"] = kept
+    return removed
+
+
 def _ply_split_notes(scene: Any) -> list[str]:
     """``polygons.fan_split_note`` on the PLY's faces as written (trimesh keeps them as ``_ply_raw``)."""
     from .polygons import fan_split_note
@@ -405,6 +431,13 @@ def _check_gltf_document(data: bytes, fmt: str) -> list[str]:
             "e.g. with gltf-pipeline or by importing and exporting it in Blender",
             version=version or "1.0",
         )
+    minimum = str(asset.get("minVersion", "2.0")) if isinstance(asset, dict) else "2.0"
+    if (version and version.split(".")[0] != "2") or minimum not in ("2", "2.0"):
+        raise refuse(
+            f"is glTF {minimum if minimum not in ('2', '2.0') else version}, and this service reads glTF 2.0 "
+            "(asset.version and asset.minVersion, section 5.2); export it as glTF 2.0",
+            version=version,
+        )
 
     required = doc.get("extensionsRequired", [])
     unknown = (
@@ -495,6 +528,7 @@ def _check_gltf_document(data: bytes, fmt: str) -> list[str]:
             format=fmt,
         )
     _check_node_trees(nodes, scenes, fmt)
+    notes += _check_node_transforms(nodes, fmt)
     if any(isinstance(n, dict) and "skin" in n and "mesh" in n for n in nodes):
         raise refuse(
             "holds a skinned mesh, whose shape is set by its joints (the node's own transform is "
@@ -563,6 +597,48 @@ def _gltf_fault(data: bytes, fmt: str, companions: Mapping[str, bytes] | None) -
                 except ServiceError as exc:
                     return type(exc)(f"{exc.message} (mesh {mi}); the file is corrupt or truncated", **exc.details)
     return None
+
+
+_IDENTITY = [1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0]
+_QUATERNION_SLACK = 1e-5  # a rotation written in float32 is a unit quaternion to ~1e-7
+
+
+def _check_node_transforms(nodes: list[Any], fmt: str) -> list[str]:
+    """Refuse node transforms glTF 2.0 does not define (section 5.25): a matrix beside translation, rotation or
+    scale (readers apply one, the other or both), a matrix that is not affine; note rotations that are not unit
+    quaternions, which are taken as the rotations they point to (as trimesh does; a viewer that does not
+    normalise them draws the mesh scaled)."""
+    notes: list[str] = []
+    for i, node in enumerate(nodes):
+        if not isinstance(node, dict):
+            continue
+        matrix = node.get("matrix")
+        trs = [k for k in ("translation", "rotation", "scale") if k in node]
+        if isinstance(matrix, list) and len(matrix) == 16 and all(isinstance(x, (int, float)) for x in matrix):
+            if trs and [float(x) for x in matrix] != _IDENTITY:
+                raise UnreadableFileError(
+                    f"the {fmt.upper()} file's node {i} has both a matrix and {', '.join(trs)}, which glTF 2.0 "
+                    "forbids (section 5.25): readers apply one, the other or both, so where it stands is not "
+                    "defined; keep one of them",
+                    format=fmt,
+                )
+            if [float(x) for x in matrix[3::4]] != [0.0, 0.0, 0.0, 1.0]:
+                raise UnreadableFileError(
+                    f"the {fmt.upper()} file's node {i} has a matrix whose last row is {[float(x) for x in matrix[3::4]]}, "
+                    "not [0, 0, 0, 1]: glTF node matrices are translations, rotations and scales (section 5.25), "
+                    "and a projective one places no solid; fix the file",
+                    format=fmt,
+                )
+        rotation = node.get("rotation")
+        if isinstance(rotation, list) and len(rotation) == 4 and all(isinstance(x, (int, float)) for x in rotation):
+            length = math.sqrt(math.fsum(float(x) ** 2 for x in rotation))
+            if abs(length - 1.0) > _QUATERNION_SLACK:
+                notes.append(
+                    f"the glTF file's node {i} has a rotation quaternion of length {length:.6g}, not 1 as glTF 2.0 "
+                    "requires (section 5.25); it was taken as the rotation it points to (a viewer that does not "
+                    "normalise it draws the mesh scaled)"
+                )
+    return notes
 
 
 def _check_node_trees(nodes: list[Any], scenes: Any, fmt: str) -> None:
