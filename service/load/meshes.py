@@ -601,6 +601,7 @@ def _gltf_fault(data: bytes, fmt: str, companions: Mapping[str, bytes] | None) -
 
 _IDENTITY = [1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0]
 _QUATERNION_SLACK = 1e-5  # a rotation written in float32 is a unit quaternion to ~1e-7
+_AFFINE_SLACK = 1e-6  # rounding in an exporter's matrix product; its last row is dropped, as readers do
 
 
 def _check_node_transforms(nodes: list[Any], fmt: str) -> list[str]:
@@ -622,9 +623,10 @@ def _check_node_transforms(nodes: list[Any], fmt: str) -> list[str]:
                     "defined; keep one of them",
                     format=fmt,
                 )
-            if [float(x) for x in matrix[3::4]] != [0.0, 0.0, 0.0, 1.0]:
+            last = [float(x) for x in matrix[3::4]]
+            if max(abs(a - b) for a, b in zip(last, (0.0, 0.0, 0.0, 1.0))) > _AFFINE_SLACK:
                 raise UnreadableFileError(
-                    f"the {fmt.upper()} file's node {i} has a matrix whose last row is {[float(x) for x in matrix[3::4]]}, "
+                    f"the {fmt.upper()} file's node {i} has a matrix whose last row is {last}, "
                     "not [0, 0, 0, 1]: glTF node matrices are translations, rotations and scales (section 5.25), "
                     "and a projective one places no solid; fix the file",
                     format=fmt,
