@@ -28,6 +28,7 @@ from inertia.errors import (
     UnsupportedFormatError,
 )
 from inertia.load import load_body
+from inertia.load.ply import uniform_face_rows
 from inertia.load.safe import guarded_read
 from inertia.pipeline import AnalysisOptions, analyze, analyze_loaded
 
@@ -1195,6 +1196,17 @@ def test_a_binary_ply_trimesh_would_misread_is_read_as_written(order: str, head:
     assert doc["mass"] == pytest.approx(6.0, rel=1e-15)
     assert doc["center_of_mass"] == pytest.approx([0.5, 1.0, 1.5], rel=1e-15)
     assert not [w for w in doc["warnings"] if "winding" in w]
+
+
+def test_binary_ply_face_rows_are_checked_list_by_list() -> None:
+    # a texture-coordinate list after the corners: rows of one length go to trimesh, rows of several to our walker
+    head = b"ply\nformat binary_little_endian 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\n"
+    head += b"element face 2\nproperty list uchar int vertex_indices\nproperty list uchar float texcoord\nend_header\n"
+    body = np.zeros((4, 3), dtype="<f4").tobytes()
+    row = struct.pack("<B3iB6f", 3, 0, 1, 2, 6, *range(6))
+    assert uniform_face_rows(head + body + row + struct.pack("<B3iB6f", 3, 0, 2, 3, 6, *range(6)))
+    assert not uniform_face_rows(head + body + row + struct.pack("<B3iB4f", 3, 0, 2, 3, 4, *range(4)) + b"\0" * 8)
+    assert uniform_face_rows(b"ply\nformat ascii 1.0\nelement vertex 0\nend_header\n")
 
 
 def test_a_signalling_nan_in_a_binary_ply_is_refused_without_a_word_on_stderr() -> None:

@@ -69,41 +69,50 @@ def header_in_order(data: bytes) -> bytes:
 
 
 def uniform_face_rows(data: bytes) -> bool:
-    """Whether every face of a binary PLY file lists as many corners as its first, as trimesh's reader assumes.
+    """Whether every face of a binary PLY file has lists as long as the first face's, as trimesh's reader assumes.
 
     trimesh reads a binary list property as if every row had the first row's length, and refuses the file
-    only when the element's bytes then come out wrong: faces of 4, 3, 5, 4, 4, 4, 4 corners fill exactly seven
+    only when the element's bytes then come out wrong: faces of 4, 3, 5, 4, 4, 5, 3 corners fill exactly seven
     quads, and were read as such (a box refused as open, or as pointing at vertex 83886080).  False where the
-    faces vary, or where they cannot be laid out without walking them (another list element before them, two
-    lists in a face); True for an ASCII file or one without faces.
+    faces' lists vary, or where the faces cannot be laid out without walking them (a list element before
+    them); True for an ASCII file or one without faces.
     """
     found = _header(data)
     if found is None:
         return True
     order, elements, offset = found
     for name, count, props in elements:
-        lists = [k for k, (_, _, counter) in enumerate(props) if counter is not None]
         if name != "face":
-            if lists:
+            if any(counter is not None for _, _, counter in props):
                 return False
             offset += count * sum(struct.calcsize(order + kind) for _, kind, _ in props)
             continue
-        if len(lists) != 1:
+        if count == 0:
+            return True
+        # the first face laid out: where each list's count sits in a row, and the row's length
+        columns: list[tuple[int, str, int]] = []  # (offset in the row, count type, the first row's count)
+        at = 0
+        for _, kind, counter in props:
+            if counter is None:
+                at += struct.calcsize(order + kind)
+                continue
+            if offset + at + struct.calcsize(order + counter) > len(data):
+                return False
+            (first,) = struct.unpack_from(order + counter, data, offset + at)
+            if first < 0:
+                return False
+            columns.append((at, counter, first))
+            at += struct.calcsize(order + counter) + first * struct.calcsize(order + kind)
+        if at <= 0 or offset + at * count > len(data):
             return False
-        k = lists[0]
-        before = sum(struct.calcsize(order + kind) for _, kind, _ in props[:k])
-        after = sum(struct.calcsize(order + kind) for _, kind, _ in props[k + 1 :])
-        _, index, counter = props[k]
-        assert counter is not None
-        at = offset + before
-        if count == 0 or at + struct.calcsize(order + counter) > len(data):
-            return count == 0
-        (first,) = struct.unpack_from(order + counter, data, at)
-        row = before + struct.calcsize(order + counter) + first * struct.calcsize(order + index) + after
-        if first < 0 or row <= 0 or offset + row * count > len(data):
-            return False
-        counts = np.ndarray((count,), dtype=np.dtype(order + counter), buffer=data, offset=at, strides=(row,))
-        return bool(np.all(counts == first))
+        return all(
+            bool(
+                np.all(
+                    np.ndarray((count,), dtype=np.dtype(order + counter), buffer=data, offset=offset + col, strides=(at,)) == first
+                )
+            )
+            for col, counter, first in columns
+        )
     return True
 
 
