@@ -632,7 +632,8 @@ def _check_node_transforms(nodes: list[Any], fmt: str) -> list[str]:
                     format=fmt,
                 )
         rotation = node.get("rotation")
-        if isinstance(rotation, list) and len(rotation) == 4 and all(isinstance(x, (int, float)) for x in rotation):
+        places = "mesh" in node or bool(node.get("children"))  # a camera's or a light's own rotation moves no solid
+        if places and isinstance(rotation, list) and len(rotation) == 4 and all(isinstance(x, (int, float)) for x in rotation):
             length = math.sqrt(math.fsum(float(x) ** 2 for x in rotation))
             if abs(length - 1.0) > _QUATERNION_SLACK:
                 notes.append(
