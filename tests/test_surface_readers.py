@@ -26,6 +26,7 @@ from inertia.errors import (
     ServiceError,
     UnreadableFileError,
     UnsupportedFormatError,
+    ZeroVolumeError,
 )
 from inertia.load import load_body
 from inertia.load.ply import uniform_face_rows
@@ -767,6 +768,19 @@ def test_gltf_rotation_that_is_not_a_unit_quaternion_is_named() -> None:
     assert res["mass"] == pytest.approx(6.0, rel=1e-14)  # rotated, not scaled
     np.testing.assert_allclose(res["center_of_mass"], [-1.0, 0.5, 1.5], rtol=1e-14)
     assert any("rotation quaternion of length 2," in w for w in res["warnings"])
+
+
+def test_gltf_node_scaled_to_zero_is_named() -> None:
+    # glTF-Asset-Generator's case of a zero scale: it said "4 of its 4 triangles are stored twice" (a sheet)
+    doc = gltf_box_doc()
+    _mesh_node(doc)["scale"] = [1.0, 0.0, 1.0]
+    with pytest.raises(ZeroVolumeError, match=r"node 0 has the scale \[1.0, 0.0, 1.0\], which flattens"):
+        analyze(json.dumps(doc).encode(), filename="flat.gltf")
+    doc = gltf_box_doc()
+    doc["nodes"].append({"scale": [0.0, 0.0, 0.0], "camera": 0})  # a camera's node: nothing it places is weighed
+    doc["cameras"] = [{"type": "perspective", "perspective": {"yfov": 1.0, "znear": 0.1}}]
+    doc["scenes"][0]["nodes"].append(len(doc["nodes"]) - 1)
+    assert analyze(json.dumps(doc).encode(), filename="cam.gltf", options=AnalysisOptions(density=1.0)).as_dict()["mass"] == pytest.approx(6.0)
 
 
 @pytest.mark.parametrize("asset", [{"version": "3.0"}, {"version": "2.0", "minVersion": "2.1"}])

@@ -25,7 +25,14 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..body import MeshBody, Part
-from ..errors import EmptyGeometryError, InvalidParameterError, ServiceError, UnreadableFileError, UnsupportedFormatError
+from ..errors import (
+    EmptyGeometryError,
+    InvalidParameterError,
+    ServiceError,
+    UnreadableFileError,
+    UnsupportedFormatError,
+    ZeroVolumeError,
+)
 from .safe import guarded_read
 
 __all__ = ["read_trimesh_parts", "read_surface_parts", "mesh_part"]
@@ -610,6 +617,7 @@ def _check_node_transforms(nodes: list[Any], fmt: str) -> list[str]:
     quaternions, which are taken as the rotations they point to (as trimesh does; a viewer that does not
     normalise them draws the mesh scaled)."""
     notes: list[str] = []
+    placing = _nodes_placing_meshes(nodes)
     for i, node in enumerate(nodes):
         if not isinstance(node, dict):
             continue
@@ -632,7 +640,14 @@ def _check_node_transforms(nodes: list[Any], fmt: str) -> list[str]:
                     format=fmt,
                 )
         rotation = node.get("rotation")
-        places = "mesh" in node or bool(node.get("children"))  # a camera's or a light's own rotation moves no solid
+        places = i in placing  # a camera's or a light's own transform moves no solid
+        scale = node.get("scale")
+        if places and isinstance(scale, list) and any(isinstance(x, (int, float)) and x == 0 for x in scale):
+            raise ZeroVolumeError(
+                f"the {fmt.upper()} file's node {i} has the scale {scale}, which flattens what it places to no "
+                "volume (a viewer draws nothing of it); remove the node or give it a scale that is not 0",
+                format=fmt,
+            )
         if places and isinstance(rotation, list) and len(rotation) == 4 and all(isinstance(x, (int, float)) for x in rotation):
             length = math.sqrt(math.fsum(float(x) ** 2 for x in rotation))
             if abs(length - 1.0) > _QUATERNION_SLACK:
@@ -642,6 +657,23 @@ def _check_node_transforms(nodes: list[Any], fmt: str) -> list[str]:
                     "normalise it draws the mesh scaled)"
                 )
     return notes
+
+
+def _nodes_placing_meshes(nodes: list[Any]) -> set[int]:
+    """The nodes that hold a mesh or have one below them (the hierarchy is a set of trees by now)."""
+    parent: dict[int, int] = {}
+    for i, node in enumerate(nodes):
+        children = node.get("children") if isinstance(node, dict) else None
+        for child in children if isinstance(children, list) else []:
+            if isinstance(child, int) and not isinstance(child, bool):
+                parent[child] = i
+    placing: set[int] = set()
+    for i, node in enumerate(nodes):
+        at: int | None = i if isinstance(node, dict) and "mesh" in node else None
+        while at is not None and at not in placing:  # up to the root, or to a node already marked
+            placing.add(at)
+            at = parent.get(at)
+    return placing
 
 
 def _check_node_trees(nodes: list[Any], scenes: Any, fmt: str) -> None:
