@@ -780,7 +780,9 @@ def test_gltf_node_scaled_to_zero_is_named() -> None:
     doc["nodes"].append({"scale": [0.0, 0.0, 0.0], "camera": 0})  # a camera's node: nothing it places is weighed
     doc["cameras"] = [{"type": "perspective", "perspective": {"yfov": 1.0, "znear": 0.1}}]
     doc["scenes"][0]["nodes"].append(len(doc["nodes"]) - 1)
-    assert analyze(json.dumps(doc).encode(), filename="cam.gltf", options=AnalysisOptions(density=1.0)).as_dict()["mass"] == pytest.approx(6.0)
+    assert analyze(json.dumps(doc).encode(), filename="cam.gltf", options=AnalysisOptions(density=1.0)).as_dict()[
+        "mass"
+    ] == pytest.approx(6.0)
 
 
 @pytest.mark.parametrize("asset", [{"version": "3.0"}, {"version": "2.0", "minVersion": "2.1"}])
