@@ -11,7 +11,6 @@ data-URI buffer of a .gltf file; the primitive then becomes mode 4 with them.
 from __future__ import annotations
 
 import base64
-import struct
 from collections.abc import Mapping
 from typing import Any
 
@@ -64,7 +63,7 @@ def fans_as_triangles(doc: Any, data: bytes, fmt: str, companions: Mapping[str, 
         prim["mode"] = 4
     if glb_chunk:
         doc["buffers"][0]["byteLength"] = len(added)
-        return _glb(doc, bytes(added)), len(fans)
+        return with_document(data, fmt, doc, binary=bytes(added)), len(fans)
     if not added:  # every fan had fewer than three vertices
         return with_document(data, fmt, doc), len(fans)
     doc.setdefault("buffers", []).append(
@@ -94,12 +93,3 @@ def _fan_vertices(doc: Any, prim: dict[str, Any], buffers: Buffers, fmt: str) ->
     if not isinstance(count, int) or count < 0:
         raise UnreadableFileError(f"the {fmt.upper()} file's triangle fan has no valid POSITION accessor", format=fmt)
     return np.arange(count, dtype=np.int64)
-
-
-def _glb(doc: Any, binary: bytes) -> bytes:
-    """A GLB container of ``doc`` and its binary chunk (glTF 2.0 section 4.4), each padded to 4 bytes."""
-    text = with_document(b"", "gltf", doc)
-    text += b" " * (-len(text) % 4)
-    binary += b"\0" * (-len(binary) % 4)
-    body = struct.pack("<II", len(text), 0x4E4F534A) + text + struct.pack("<II", len(binary), 0x004E4942) + binary
-    return struct.pack("<4sII", b"glTF", 2, 12 + len(body)) + body

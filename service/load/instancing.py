@@ -250,12 +250,17 @@ def glb_binary(data: bytes) -> bytes:
     return data[at + 8 : at + 8 + length]
 
 
-def with_document(data: bytes, fmt: str, doc: Any) -> bytes:
-    """The file with ``doc`` as its JSON (a GLB keeps its other chunks as they are)."""
+def with_document(data: bytes, fmt: str, doc: Any, binary: bytes | None = None) -> bytes:
+    """The file with ``doc`` as its JSON: a GLB keeps its other chunks as they are, or, with ``binary``, has
+    that as its binary chunk (padded to 4 bytes with zeros)."""
     text = json.dumps(doc, separators=(",", ":")).encode()
     if fmt != "glb":
         return text
     text += b" " * (-len(text) % 4)  # chunks are 4-byte aligned, JSON padded with spaces
-    rest = data[20 + struct.unpack_from("<I", data, 12)[0] :]
+    if binary is None:
+        rest = data[20 + struct.unpack_from("<I", data, 12)[0] :]
+    else:
+        binary += b"\0" * (-len(binary) % 4)
+        rest = struct.pack("<II", len(binary), 0x004E4942) + binary  # "BIN"
     body = struct.pack("<II", len(text), 0x4E4F534A) + text + rest  # "JSON"
     return struct.pack("<4sII", b"glTF", 2, 12 + len(body)) + body

@@ -659,20 +659,26 @@ def _check_node_transforms(nodes: list[Any], fmt: str) -> list[str]:
     return notes
 
 
-def _nodes_placing_meshes(nodes: list[Any]) -> set[int]:
-    """The nodes that hold a mesh or have one below them (the hierarchy is a set of trees by now)."""
-    parent: dict[int, int] = {}
+def _node_parents(nodes: list[Any]) -> dict[int, list[int]]:
+    """Each node that is some node's child: the nodes that list it as a child, in order."""
+    parents: dict[int, list[int]] = {}
     for i, node in enumerate(nodes):
         children = node.get("children") if isinstance(node, dict) else None
         for child in children if isinstance(children, list) else []:
             if isinstance(child, int) and not isinstance(child, bool):
-                parent[child] = i
+                parents.setdefault(child, []).append(i)
+    return parents
+
+
+def _nodes_placing_meshes(nodes: list[Any]) -> set[int]:
+    """The nodes that hold a mesh or have one below them (the hierarchy is a set of trees by now)."""
+    parents = _node_parents(nodes)
     placing: set[int] = set()
     for i, node in enumerate(nodes):
         at: int | None = i if isinstance(node, dict) and "mesh" in node else None
         while at is not None and at not in placing:  # up to the root, or to a node already marked
             placing.add(at)
-            at = parent.get(at)
+            at = parents[at][0] if at in parents else None
     return placing
 
 
@@ -680,12 +686,7 @@ def _check_node_trees(nodes: list[Any], scenes: Any, fmt: str) -> None:
     """Refuse a node hierarchy that is not a set of disjoint strict trees (glTF 2.0 section 3.5.2): a node with
     two parents, or a scene root that is also a child, stands in two places, of which a reader draws one; a
     cycle places nothing."""
-    parents: dict[int, list[int]] = {}
-    for i, node in enumerate(nodes):
-        children = node.get("children") if isinstance(node, dict) else None
-        for child in children if isinstance(children, list) else []:
-            if isinstance(child, int) and not isinstance(child, bool):
-                parents.setdefault(child, []).append(i)
+    parents = _node_parents(nodes)
     fix = "; to draw a mesh twice, give it two nodes"
     for child, its in sorted(parents.items()):
         if len(its) > 1:
