@@ -761,6 +761,17 @@ def test_gltf_node_transforms_glTF_does_not_define_are_refused() -> None:
     np.testing.assert_allclose(res["center_of_mass"], [-4.5, 1.0, 1.5], rtol=1e-14)
 
 
+@pytest.mark.parametrize(
+    "key, value", [("rotation", [10**400, 0, 0, 1]), ("matrix", [10**400] + [0] * 15), ("scale", [1, 1e999, 1])]
+)
+def test_gltf_node_transform_beyond_double_precision_is_refused(key: str, value: list[Any]) -> None:
+    # an integer past 1e308 overflowed float() in the transform checks: a logged traceback and a vague message
+    doc = gltf_box_doc()
+    _mesh_node(doc)[key] = value
+    with pytest.raises(InvalidParameterError, match=f"node 0 has a {key} holding a number that is not finite"):
+        analyze(json.dumps(doc).encode(), filename="huge.gltf")
+
+
 def test_gltf_rotation_that_is_not_a_unit_quaternion_is_named() -> None:
     doc = gltf_box_doc()
     _mesh_node(doc)["rotation"] = [0.0, 0.0, 2 * math.sin(math.pi / 4), 2 * math.cos(math.pi / 4)]  # 90 deg about z, x2

@@ -159,8 +159,8 @@ def read_trimesh_parts(
     if fmt == "ply":  # what trimesh's reader would misread: a header out of its order, binary faces of mixed sizes
         from .ply import header_in_order, uniform_face_rows
 
-        data = header_in_order(data)
-        if not uniform_face_rows(data):
+        data = guarded_read(partial(header_in_order, data), fmt)
+        if not guarded_read(partial(uniform_face_rows, data), fmt):
             own = _own_binary_ply(data, length_scale)
             if own is not None:
                 return own, None
@@ -621,17 +621,17 @@ def _check_node_transforms(nodes: list[Any], fmt: str) -> list[str]:
     for i, node in enumerate(nodes):
         if not isinstance(node, dict):
             continue
-        matrix = node.get("matrix")
+        matrix = _node_numbers(node, "matrix", 16, i, fmt)
         trs = [k for k in ("translation", "rotation", "scale") if k in node]
-        if isinstance(matrix, list) and len(matrix) == 16 and all(isinstance(x, (int, float)) for x in matrix):
-            if trs and [float(x) for x in matrix] != _IDENTITY:
+        if matrix is not None:
+            if trs and matrix != _IDENTITY:
                 raise UnreadableFileError(
                     f"the {fmt.upper()} file's node {i} has both a matrix and {', '.join(trs)}, which glTF 2.0 "
                     "forbids (section 5.25): readers apply one, the other or both, so where it stands is not "
                     "defined; keep one of them",
                     format=fmt,
                 )
-            last = [float(x) for x in matrix[3::4]]
+            last = matrix[3::4]
             if max(abs(a - b) for a, b in zip(last, (0.0, 0.0, 0.0, 1.0))) > _AFFINE_SLACK:
                 raise UnreadableFileError(
                     f"the {fmt.upper()} file's node {i} has a matrix whose last row is {last}, "
@@ -639,24 +639,47 @@ def _check_node_transforms(nodes: list[Any], fmt: str) -> list[str]:
                     "and a projective one places no solid; fix the file",
                     format=fmt,
                 )
-        rotation = node.get("rotation")
-        places = i in placing  # a camera's or a light's own transform moves no solid
-        scale = node.get("scale")
-        if places and isinstance(scale, list) and any(isinstance(x, (int, float)) and x == 0 for x in scale):
+        _node_numbers(node, "translation", 3, i, fmt)
+        scale = _node_numbers(node, "scale", 3, i, fmt)
+        rotation = _node_numbers(node, "rotation", 4, i, fmt)
+        if i not in placing:  # a camera's or a light's own transform moves no solid
+            continue
+        if scale is not None and 0.0 in scale:
             raise ZeroVolumeError(
                 f"the {fmt.upper()} file's node {i} has the scale {scale}, which flattens what it places to no "
                 "volume (a viewer draws nothing of it); remove the node or give it a scale that is not 0",
                 format=fmt,
             )
-        if places and isinstance(rotation, list) and len(rotation) == 4 and all(isinstance(x, (int, float)) for x in rotation):
-            length = math.sqrt(math.fsum(float(x) ** 2 for x in rotation))
-            if abs(length - 1.0) > _QUATERNION_SLACK:
-                notes.append(
-                    f"the glTF file's node {i} has a rotation quaternion of length {length:.6g}, not 1 as glTF 2.0 "
-                    "requires (section 5.25); it was taken as the rotation it points to (a viewer that does not "
-                    "normalise it draws the mesh scaled)"
-                )
+        if rotation is not None and abs(math.hypot(*rotation) - 1.0) > _QUATERNION_SLACK:
+            notes.append(
+                f"the glTF file's node {i} has a rotation quaternion of length {math.hypot(*rotation):.6g}, not 1 as "
+                "glTF 2.0 requires (section 5.25); it was taken as the rotation it points to (a viewer that does not "
+                "normalise it draws the mesh scaled)"
+            )
     return notes
+
+
+def _node_numbers(node: dict[str, Any], key: str, size: int, index: int, fmt: str) -> list[float] | None:
+    """A node's ``key`` as floats where it is a list of ``size`` numbers (else None: the reader says what is
+    wrong); a number that is no finite double (NaN, infinity, or an integer beyond 1e308) is refused."""
+    value = node.get(key)
+    if not (
+        isinstance(value, list)
+        and len(value) == size
+        and all(isinstance(x, (int, float)) and not isinstance(x, bool) for x in value)
+    ):
+        return None
+    try:
+        numbers = [float(x) for x in value]
+    except OverflowError:
+        numbers = [math.inf]
+    if not all(math.isfinite(x) for x in numbers):
+        raise InvalidParameterError(
+            f"the {fmt.upper()} file's node {index} has a {key} holding a number that is not finite; fix the file",
+            field=key,
+            format=fmt,
+        )
+    return numbers
 
 
 def _node_parents(nodes: list[Any]) -> dict[int, list[int]]:
