@@ -14,6 +14,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from .arrays import column_bounds
 from .errors import EmptyGeometryError, InvalidParameterError
 
 __all__ = ["MeshBody", "VolumeBody", "CellBlock", "PointBody", "BrepBody", "Part", "Body", "few_points_valid", "stored_eps"]
@@ -216,7 +217,8 @@ def few_points_valid(masses: list[float], positions: list[list[float]], length_s
 
 def _check_span(masses: NDArray[np.float64], positions: NDArray[np.float64], length_scale: float) -> None:
     """Refuse a point set so small that its moments underflow float64 (a single point is fine: its moments are 0)."""
-    span = float(np.max(positions.max(axis=0) - positions.min(axis=0))) * length_scale
+    lo, hi = column_bounds(positions)
+    span = float(np.max(hi - lo)) * length_scale
     if span > 0.0 and float(masses.sum()) * span * span < _MIN_MOMENT_SCALE:
         raise InvalidParameterError(
             f"the points span only {span:.3g} m, so their moments (~ mass x span^2) would underflow float64; "
@@ -232,7 +234,8 @@ _MIN_EXTENT = _MIN_MOMENT_SCALE ** (1 / 5)
 
 def _check_extent(coordinates: NDArray[np.float64]) -> None:
     """Refuse a mesh so small, in its own units, that its moments underflow float64."""
-    extent = float(np.max(coordinates.max(axis=0) - coordinates.min(axis=0)))
+    lo, hi = column_bounds(coordinates)
+    extent = float(np.max(hi - lo))
     if 0.0 < extent < _MIN_EXTENT:
         raise InvalidParameterError(
             f"the part is only {extent:.3g} file units across, so its moments (~ size^5) would underflow float64; "
