@@ -31,6 +31,7 @@ from .blocks import for_each_block
 __all__ = ["Sums", "simplex_sums", "sums_from_rows", "point_sums", "local_origin", "CHUNK", "point_records", "gather_corners", "IJ"]
 
 CHUNK = 1 << 15  # elements per vectorised block: its (n,) temporaries (256 KB each) stay in cache
+GATHER_STEP = 1 << 12  # cells whose corner records (~300 KB) are gathered and split at a time
 
 
 @dataclass(frozen=True, slots=True)
@@ -112,11 +113,18 @@ def gather_corners(records: NDArray[np.void], cells: NDArray[np.int64]) -> list[
     """corners[k][j]: coordinate j of corner k of each cell, each a contiguous (n,) row.
 
     Each corner is gathered once as one 24-byte record (one random access per
-    corner instead of three), then the coordinates are split into rows.
+    corner instead of three), then the coordinates are split into rows.  The
+    records are gathered ``GATHER_STEP`` cells at a time, so each step's
+    records are still in the cache when they are split: gathering a whole
+    block of ``CHUNK`` cells first (2.4 MB) and splitting it afterwards took
+    three to four times as long.
     """
-    block = records.take(cells).view(np.float64).reshape(len(cells), cells.shape[1], 3)
-    rows = block.transpose(1, 2, 0).copy()  # (corners, 3, n)
-    return [list(rows[k]) for k in range(cells.shape[1])]
+    corners = cells.shape[1]
+    rows = np.empty((corners, 3, len(cells)))
+    for start in range(0, len(cells), GATHER_STEP):
+        step = records.take(cells[start : start + GATHER_STEP]).view(np.float64).reshape(-1, corners, 3)
+        rows[:, :, start : start + GATHER_STEP] = step.transpose(1, 2, 0)
+    return [list(rows[k]) for k in range(corners)]
 
 
 def _block_sums(
