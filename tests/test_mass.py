@@ -358,3 +358,19 @@ def test_the_parts_masses_add_up_to_the_whole() -> None:
     doc = analyze("\n".join(lines).encode(), filename="three.obj").as_dict()
     assert len(doc["parts"]) == 3
     assert doc["mass"] == math.fsum(p["mass"] for p in doc["parts"])
+
+
+@pytest.mark.parametrize("corners", [3, 4])
+def test_corner_gather_in_steps_is_the_plain_gather(corners: int) -> None:
+    """``gather_corners`` splits a block into steps; across and at their edges it must give ``points[cells]``."""
+    from inertia.integrals import GATHER_STEP, gather_corners, point_records
+
+    rng = np.random.default_rng(5)
+    points = rng.normal(size=(1000, 3))
+    for count in (1, GATHER_STEP - 1, GATHER_STEP, 2 * GATHER_STEP + 7):
+        cells = rng.integers(0, len(points), size=(count, corners))
+        got = gather_corners(point_records(points), cells)
+        plain = points[cells]  # (count, corners, 3)
+        for k in range(corners):
+            for j in range(3):
+                assert np.array_equal(got[k][j], plain[:, k, j])
