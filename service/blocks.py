@@ -135,34 +135,24 @@ def _executor(threads: int) -> ThreadPoolExecutor:
         return _pool
 
 
-_M_TRIM_THRESHOLD, _M_MMAP_THRESHOLD, _M_ARENA_MAX = -1, -3, -8  # mallopt's parameter numbers (malloc.h)
-KEEP_FREED = 1 << 28  # bytes: arrays up to this size come from the heap, which keeps up to this much freed
+_M_ARENA_MAX = -8  # mallopt's parameter number (malloc.h)
 
 
 def single_heap() -> bool:
-    """Every thread allocates from the main heap, which keeps the memory freed; False where that is not glibc.
+    """Every thread allocates from the main heap (glibc's ``M_ARENA_MAX`` = 1); False where that is not glibc.
 
     For a process of ours that runs block passes on several threads, the
-    ``inertia analyze`` command:
-
-    - glibc gives each thread a heap (an arena) of its own, which keeps that
-      thread's freed temporaries.  At 1e6 triangles that added 12 MB to the
-      peak (3.2x the STL file's size against 2.9x on one thread); with one
-      heap (``M_ARENA_MAX`` = 1) the peak is that of one thread, at the same speed.
-    - glibc maps every large array afresh (``mmap``) and unmaps it when freed,
-      so each pass's full-size temporaries met the kernel's page faults again:
-      37,000 of them at 5e6 triangles, 0.8-1 s of system time.  Taking arrays of
-      up to ``KEEP_FREED`` from the heap and keeping what is freed there for the
-      next pass (``M_MMAP_THRESHOLD``, ``M_TRIM_THRESHOLD``) leaves 10,000 faults
-      and 0.5-0.6 s; the peak rises from 2.18x to 2.30x the file at 5e6, and from
-      2.36x to 2.51x at 2e7, whose largest arrays are still mapped afresh.
+    ``inertia analyze`` command: glibc gives each thread a heap (an arena)
+    of its own, which keeps that thread's freed temporaries.  At 1e6
+    triangles that added 12 MB to the peak (3.2x the STL file's size
+    against 2.9x on one thread); with one heap the peak is that of one
+    thread, at the same speed.
     """
     try:
         mallopt = ctypes.CDLL(None).mallopt
     except (OSError, AttributeError):
         return False
-    settings = ((_M_ARENA_MAX, 1), (_M_MMAP_THRESHOLD, KEEP_FREED), (_M_TRIM_THRESHOLD, KEEP_FREED))
-    return all([bool(mallopt(parameter, value)) for parameter, value in settings])
+    return bool(mallopt(_M_ARENA_MAX, 1))
 
 
 def _forget_pool_in_child() -> None:

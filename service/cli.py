@@ -347,7 +347,7 @@ def _analyze(args: argparse.Namespace) -> int:
     from .blocks import single_heap
     from .pipeline import analyze
 
-    single_heap()  # the passes run on several threads: one heap, which keeps freed memory for the next pass
+    single_heap()  # a large mesh's passes run on several threads: one heap keeps the peak memory of one
 
     document = analyze(args.file, options=options_from_args(args)).document()
     if getattr(args, "export", None) and not args.json:
