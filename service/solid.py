@@ -40,7 +40,6 @@ from .blocks import for_each_block
 from .body import MeshBody
 from .errors import InvalidMeshError, NotWatertightError, ZeroVolumeError
 from .integrals import CHUNK, gather_corners, local_origin, point_records
-from .seams import merge_seams
 from .tolerances import EPS
 from .topology import SurfaceTopology, _components, face_components, orient_consistently, row_ids, surface_topology, weld
 
@@ -65,6 +64,8 @@ def closed_surface(body: MeshBody) -> tuple[NDArray[np.float64], NDArray[np.int6
     topo = surface_topology(faces, len(vertices))
     warnings: list[str] = []
     if topo.open_edges:
+        from .seams import merge_seams  # only an open surface needs it
+
         seams = merge_seams(vertices, faces, coordinate_eps=body.coordinate_eps)
         if seams.merged:
             faces = seams.faces

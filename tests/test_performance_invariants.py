@@ -152,6 +152,25 @@ def test_components_match_scipy_labels() -> None:
     np.testing.assert_array_equal(label, ref_label)
 
 
+@pytest.mark.parametrize("seed", range(4))
+def test_components_of_edges_written_smaller_end_first_match_scipy(seed: int) -> None:
+    """``ordered=True`` (every a < b, as surface_topology writes face pairs) skips sorting the first round's ends."""
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    rng = np.random.default_rng(seed)
+    n = 3000
+    a, b = rng.integers(0, n, 2500), rng.integers(0, n, 2500)
+    keep = a != b
+    lo, hi = np.minimum(a[keep], b[keep]).astype(np.int32), np.maximum(a[keep], b[keep]).astype(np.int32)
+    count, label = topology._components(n, lo, hi, ordered=True)
+    graph = coo_matrix((np.ones(len(lo), dtype=np.int8), (lo, hi)), shape=(n, n))
+    ref_count, ref_label = connected_components(graph, directed=False)
+    assert count == ref_count
+    np.testing.assert_array_equal(label, ref_label)
+    np.testing.assert_array_equal(topology._components(n, lo, hi)[1], label)  # the general first round agrees
+
+
 def _sums(points: np.ndarray, faces: np.ndarray) -> integrals.Sums:
     return integrals.simplex_sums(points - integrals.local_origin(points), faces, "apex", None)
 
