@@ -293,7 +293,11 @@ def report(results: dict[str, dict[str, Any]], stages: dict[str, dict[str, float
     lines += ["| stage | " + " | ".join(stages) + " |", "|---|" + "---|" * len(stages)]
     for n in names:
         lines.append(f"| {n} | " + " | ".join(f"{st.get(n, 0.0):.4f}" for st in stages.values()) + " |")
-    lines += ["", "The whole-process time also holds interpreter start-up and imports (~0.1 s).", ""]
+    lines += [
+        "",
+        "The whole-process time also holds interpreter start-up and imports (0.15-0.2 s: Python, numpy, our modules).",
+        "",
+    ]
     lines += [
         "## Accuracy (principal moments per unit density)",
         "",
