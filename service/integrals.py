@@ -20,6 +20,8 @@ Besides the sums, every kernel accumulates the scale of its rounding errors
 
 from __future__ import annotations
 
+import functools
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -128,7 +130,11 @@ def gather_corners(records: NDArray[np.void], cells: NDArray[np.int64]) -> list[
 
 
 def _block_sums(
-    xyz: NDArray[np.void], cells: NDArray[np.int64], kind: str, weight: NDArray[np.float64] | None
+    xyz: NDArray[np.void],
+    cells: NDArray[np.int64],
+    kind: str,
+    weight: NDArray[np.float64] | None,
+    also: Callable[[list[Vec]], None] | None = None,
 ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """Sums over one block of simplices of every row, and of their absolute values.
 
@@ -137,6 +143,8 @@ def _block_sums(
     contiguous row, the same as summing each row alone) in one call.
     """
     corners = gather_corners(xyz, cells)
+    if also is not None:
+        also(corners)
     raw, cond = _measure(corners, kind)
     f0, f1, f2 = _FACTORS[kind]
     dm = raw * f0
@@ -175,9 +183,15 @@ def simplex_sums(
     cells: NDArray[np.int64],
     kind: str,
     weight: NDArray[np.float64] | None,
+    each_block: Callable[[int, list[Vec]], None] | None = None,
 ) -> Sums:
     """Integrals of the simplices ``points[cells]``: "apex" (faces of a closed
-    surface, each with the origin), "tet" (volume cells) or "tri" (area)."""
+    surface, each with the origin), "tet" (volume cells) or "tri" (area).
+
+    ``each_block(start, corners)`` is given each block's gathered corners
+    (``gather_corners``, cells ``start:start + CHUNK``), for another quantity
+    of the same cells from the same gather; it must not change them.
+    """
     xyz = point_records(points)
     starts = range(0, len(cells), CHUNK)
     per_block = np.empty((2, ROWS, len(starts)))
@@ -185,7 +199,8 @@ def simplex_sums(
     def block(start: int) -> None:
         w = None if weight is None else weight[start : start + CHUNK]
         b = start // CHUNK
-        per_block[0, :, b], per_block[1, :, b] = _block_sums(xyz, cells[start : start + CHUNK], kind, w)
+        also = None if each_block is None else functools.partial(each_block, start)
+        per_block[0, :, b], per_block[1, :, b] = _block_sums(xyz, cells[start : start + CHUNK], kind, w, also)
 
     for_each_block(block, starts)  # blocks on several threads; each fills its own column
     total, total_abs = per_block.sum(axis=2)  # pairwise over the blocks too, in block order

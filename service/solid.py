@@ -32,6 +32,7 @@ of a shell is never re-wound on its own.
 from __future__ import annotations
 
 from collections.abc import Iterator
+from typing import NamedTuple
 
 import numpy as np
 from numpy.typing import NDArray
@@ -39,17 +40,42 @@ from numpy.typing import NDArray
 from .blocks import for_each_block
 from .body import MeshBody
 from .errors import InvalidMeshError, NotWatertightError, ZeroVolumeError
-from .integrals import CHUNK, gather_corners, local_origin, point_records
+from .integrals import CHUNK, Sums, gather_corners, local_origin, point_records, simplex_sums
 from .tolerances import EPS
 from .topology import SurfaceTopology, _components, face_components, orient_consistently, row_ids, surface_topology, weld
 
-__all__ = ["closed_surface"]
+__all__ = ["FirstPass", "OrientedSurface", "closed_surface", "oriented_surface"]
 
 INVERTED = "inverted winding corrected"  # API.md's words for a body whose faces all pointed inward
 
 
+FirstPass = tuple[NDArray[np.float64], Sums]
+"""The integrals of a closed surface about its local origin (``integrals.local_origin``), and that origin."""
+
+
+class OrientedSurface(NamedTuple):
+    """A closed surface ready to integrate, and its first integration pass where the orientation computed it."""
+
+    vertices: NDArray[np.float64]
+    faces: NDArray[np.int64]
+    warnings: tuple[str, ...]
+    first_pass: FirstPass | None
+
+
 def closed_surface(body: MeshBody) -> tuple[NDArray[np.float64], NDArray[np.int64], tuple[str, ...]]:
     """Weld, check closedness, repair winding; the geometry to integrate."""
+    vertices, faces, warnings, _ = oriented_surface(body)
+    return vertices, faces, warnings
+
+
+def oriented_surface(body: MeshBody) -> OrientedSurface:
+    """``closed_surface``, with the first integration pass of the faces it returns where that came free.
+
+    The orientation needs each face's signed volume about the local origin; the first pass of
+    ``mass.refine`` integrates the same faces about the same origin.  Both are formed from one gather
+    of the corners, and the pass is kept where the orientation left the faces as they were (the
+    usual case), else dropped: re-wound faces are integrated afresh.
+    """
     vertices, faces = (body.vertices, body.faces) if body.welded else weld(body.vertices, body.faces)
     degenerate = (faces[:, 0] == faces[:, 1]) | (faces[:, 1] == faces[:, 2]) | (faces[:, 0] == faces[:, 2])
     if np.any(degenerate):
@@ -97,7 +123,12 @@ def closed_surface(body: MeshBody) -> tuple[NDArray[np.float64], NDArray[np.int6
                 unbalanced_edges=topo.unbalanced_edges,
                 **({"nonmanifold_edges": topo.nonmanifold_edges} if topo.nonmanifold_edges else {}),
             )
-    faces, more = _orient_outward(vertices, faces, topo)
+    origin = local_origin(vertices)
+    det, first = _volumes_and_first_pass(vertices - origin, faces)
+    oriented, more = _orient_outward(vertices, faces, topo, det)
+    del det
+    first_pass = (origin, first) if oriented is faces and first is not None else None
+    faces = oriented
     if as_stored is not None:
         # counted against the file: the consistent winding keeps the first face's, so a file whose first face
         # alone was reversed had every other face flipped, then all of them turned outward again
@@ -105,26 +136,32 @@ def closed_surface(body: MeshBody) -> tuple[NDArray[np.float64], NDArray[np.int6
         warnings.append(f"inconsistent winding repaired ({flipped} of {len(faces)} faces flipped)")
         more = [w for w in more if w != INVERTED]
     warnings.extend(more)
-    return vertices, faces, tuple(warnings)
+    return OrientedSurface(vertices, faces, tuple(warnings), first_pass)
 
 
-def _signed_volumes(x: NDArray[np.float64], faces: NDArray[np.int64]) -> NDArray[np.float64]:
-    """6 x the signed volume of each tetrahedron (origin, face), a . (b x c), in blocks.
+def _volumes_and_first_pass(x: NDArray[np.float64], faces: NDArray[np.int64]) -> tuple[NDArray[np.float64], Sums | None]:
+    """6 x the signed volume of each tetrahedron (origin, face), a . (b x c), and the faces' integrals about the
+    origin of ``x`` (``integrals.simplex_sums``, "apex"), from one gather of the corners in blocks.
 
-    Formed one coordinate column at a time (contiguous arrays), about three
-    times faster than ``np.cross`` on rows for the meshes of a part library.
+    The volumes are formed one coordinate column at a time (contiguous arrays), about three times faster than
+    ``np.cross`` on rows.  The integrals are None where a value overflowed: the first pass, run again, then
+    refuses the coordinates as it always has.
     """
-    records = point_records(x)
     det = np.empty(len(faces))
 
-    def block(start: int) -> None:
-        a, b, c = gather_corners(records, faces[start : start + CHUNK])
-        det[start : start + CHUNK] = (
+    def volumes(start: int, corners: list[list[NDArray[np.float64]]]) -> None:
+        a, b, c = corners
+        det[start : start + len(a[0])] = (
             a[0] * (b[1] * c[2] - b[2] * c[1]) + a[1] * (b[2] * c[0] - b[0] * c[2]) + a[2] * (b[0] * c[1] - b[1] * c[0])
         )
 
-    for_each_block(block, range(0, len(faces), CHUNK))
-    return det
+    with np.errstate(over="ignore", invalid="ignore"):
+        sums = simplex_sums(x, faces, "apex", None, each_block=volumes)
+    finite = all(
+        np.isfinite(v).all()
+        for v in (sums.m0, sums.m1, sums.m2, sums.abs_m0, sums.abs_m2, sums.noise, sums.element_err, sums.measure)
+    )
+    return det, sums if finite else None
 
 
 def _volume_magnitudes(x: NDArray[np.float64], faces: NDArray[np.int64]) -> NDArray[np.float64]:
@@ -147,20 +184,18 @@ def _volume_magnitudes(x: NDArray[np.float64], faces: NDArray[np.int64]) -> NDAr
 
 
 def _orient_outward(
-    vertices: NDArray[np.float64], faces: NDArray[np.int64], topo: SurfaceTopology
+    vertices: NDArray[np.float64], faces: NDArray[np.int64], topo: SurfaceTopology, det: NDArray[np.float64]
 ) -> tuple[NDArray[np.int64], list[str]]:
     """Keep shells that all wind outward; otherwise orient every shell by its nesting depth: material outward,
-    cavities inward."""
-    x = vertices - local_origin(vertices)
-    det = _signed_volumes(x, faces)
+    cavities inward.  ``det``: 6 x each face's signed volume about the local origin."""
     if np.all(det >= 0):  # every face sees the local origin from outside: outward already
         count, label = face_components(faces, topo)
         if count == 1:
             return faces, []
+        x = vertices - local_origin(vertices)
         noise = np.bincount(label, weights=_volume_magnitudes(x, faces), minlength=count)
         solid = np.abs(np.bincount(label, weights=det, minlength=count)) > 64 * EPS * noise
         return faces, _overlap_note(x, faces, label, solid)
-    del x  # not held while the components are found: the peak of a one-shell mesh's pass
     total = float(det.sum())
     count, label = face_components(faces, topo)
     if count == 1:  # one shell: the file's winding or its reverse; no shell noise to weigh

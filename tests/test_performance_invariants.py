@@ -222,3 +222,52 @@ def test_twice_areas_equal_numpy_cross_and_norm_to_the_bit() -> None:
     unshifted = points[faces]
     expected = np.linalg.norm(np.cross(unshifted[:, 1] - unshifted[:, 0], unshifted[:, 2] - unshifted[:, 0]), axis=1)
     np.testing.assert_array_equal(twice_areas(integrals.point_records(points), faces), expected)
+
+
+def _bits(s: integrals.Sums) -> list[bytes]:
+    return [
+        np.asarray(getattr(s, f), dtype=np.float64).tobytes()
+        for f in ("m0", "m1", "m2", "abs_m0", "abs_m2", "noise", "element_err", "measure")
+    ]
+
+
+@pytest.mark.parametrize("inverted", [False, True])
+def test_first_pass_from_the_orientation_is_the_first_pass_or_none(inverted: bool) -> None:
+    """The orientation's gather also yields refine's first pass: the same sums to the bit, kept only for faces
+    the orientation left as they were."""
+    from inertia.mass.geometry import Geometry, body_geometry
+    from inertia.solid import oriented_surface
+
+    v, f = _torus(300, 120)  # 72,000 faces: several blocks, on the threads
+    if inverted:
+        f = f[:, [0, 2, 1]]
+    body = MeshBody(v, f, welded=True)
+    surface = oriented_surface(body)
+    if inverted:
+        assert surface.first_pass is None and "inverted winding corrected" in surface.warnings
+        return
+    assert surface.first_pass is not None
+    origin, first = surface.first_pass
+    assert np.array_equal(origin, integrals.local_origin(surface.vertices))
+    direct = integrals.simplex_sums(surface.vertices - origin, surface.faces, "apex", None)
+    assert _bits(first) == _bits(direct)
+    geometry, _ = body_geometry(body, "solid")
+    given = geometry.sums(origin, None)  # the orientation's, once
+    assert _bits(given) == _bits(direct)
+    again = geometry.sums(origin, None)  # then formed afresh, alike
+    assert again is not given and _bits(again) == _bits(direct)
+    assert Geometry(surface.vertices, surface.faces, "apex", None, first_pass=surface.first_pass).sums(origin, None) is first
+    other = Geometry(surface.vertices, surface.faces, "apex", None, first_pass=surface.first_pass)
+    assert other.sums(origin + 1.0, None) is not first  # another origin: not the one the pass was formed about
+
+
+def test_first_pass_that_overflows_is_left_to_the_pass_that_refuses_it() -> None:
+    from inertia.errors import InvalidParameterError
+    from inertia.mass import mass_properties
+    from inertia.solid import oriented_surface
+
+    v, f = _torus(12, 8)
+    body = MeshBody(v * 1e200, f, welded=True)
+    assert oriented_surface(body).first_pass is None
+    with pytest.raises(InvalidParameterError, match="overflow"):
+        mass_properties(body)
