@@ -20,8 +20,9 @@ in the same run:
     (GNU time's %M for the tool's own process, else ``os.wait4``) and CPU time are
     the best of ``--repeat`` interleaved rounds (the tools' order alternates),
     with the spread of the wall times shown: the machine may be shared.
-(b) our stages in process (read + weld of the STL, edge topology, outward
-    orientation, each integration pass), timed by
+(b) our stages in process (read + weld of the STL, edge topology, the signed
+    volumes with the first integration pass, outward orientation, each further
+    integration pass), timed by
     wrapping the stage functions around one ``pipeline.analyze`` call.
 (c) accuracy: principal moments per unit density of each tool, their
     relative differences, and our own error estimate.
@@ -174,11 +175,14 @@ def stage_breakdown(path: Path, warmup: Path) -> dict[str, float]:
 
     def pass_name() -> str:
         passes[0] += 1
+        if passes[0] == 1:  # a closed surface's first pass is formed with its signed volumes, and only handed over here
+            return "integration pass 1, where not formed with the volumes"
         return f"integration pass {passes[0]}"
 
     patches: list[tuple[Any, str, str | Callable[[], str]]] = [
         (stl, "read_stl_file", "read STL + float32 weld"),
         (solid, "surface_topology", "edge topology (watertight check)"),
+        (solid, "_volumes_and_first_pass", "signed volumes + integration pass 1 (one gather)"),
         (solid, "_orient_outward", "outward orientation"),
         (mass_geometry.Geometry, "sums", pass_name),
     ]
