@@ -42,7 +42,9 @@ for degree 2n - 1 in each collapsed variable.
 Orientation.  A cell whose node order is mirrored has det J < 0 everywhere;
 it is integrated with |det J| (as the linear tetrahedra are).  A cell whose
 det J changes sign is tangled (it folds over itself): ``tangled_cells`` counts
-them so the loader can warn.
+them so the loader can warn.  A tangled curved cell keeps the orientation of
+its corners (the straight-sided cell through them), so its folded region
+counts negatively, as Gmsh's signed Jacobians count it.
 """
 
 from __future__ import annotations
@@ -376,9 +378,56 @@ def tangled_cells(points: NDArray[np.float64], name: str, cells: NDArray[np.int6
     step = max(1, _BLOCK_POINTS // len(rule.weights))
     for start in range(0, len(cells), step):
         _, det, cond, _ = _jacobians(xyz, cells[start : start + step], rule)
-        tol = (n + 6) * 2.220446049250313e-16 * cond
-        count += int(np.count_nonzero(np.any(det > tol, axis=1) & np.any(det < -tol, axis=1)))
+        count += int(np.count_nonzero(_folded(det, cond, n)))
     return count
+
+
+def _folded(det: NDArray[np.float64], cond: NDArray[np.float64], n: int) -> NDArray[np.bool_]:
+    """Per cell: det J takes both signs at its quadrature points, each beyond its rounding."""
+    tol = (n + 6) * 2.220446049250313e-16 * cond
+    folded: NDArray[np.bool_] = np.any(det > tol, axis=1) & np.any(det < -tol, axis=1)
+    return folded
+
+
+# A curved cell's corners, as the straight-sided cell through them: (its type, its number of corners)
+_STRAIGHT = {
+    "tetra10": ("tetra", 4),
+    "hexahedron20": ("hexahedron", 8),
+    "hexahedron27": ("hexahedron", 8),
+    "wedge15": ("wedge", 6),
+    "wedge18": ("wedge", 6),
+    "pyramid13": ("pyramid", 5),
+}
+
+
+def _orientation(
+    xyz: list[NDArray[np.float64]], cells: NDArray[np.int64], rule: CellRule, det: NDArray[np.float64], cond: NDArray[np.float64]
+) -> NDArray[np.float64]:
+    """+1 or -1 per cell: the sign its det J is integrated with.
+
+    A cell whose det J keeps one sign takes that sign (a mirrored node order counts with |det J|).  A
+    curved cell that folds over itself is oriented by its corners, the straight-sided cell through them,
+    so its folded region counts negatively, as the loader's warning says; where those corners enclose
+    no volume, or the cell is straight-sided itself, by the sign of its integral.
+    """
+    sign: NDArray[np.float64] = np.sign(det @ rule.weights)
+    straight = _STRAIGHT.get(rule.name)
+    if straight is None:
+        return sign
+    folded = np.flatnonzero(_folded(det, cond, rule.shape.shape[1]))
+    if not len(folded):
+        return sign
+    name, k = straight
+    corners = cells[folded, :k]
+    if name == "tetra":  # the linear tetrahedron's map: det J = (b - a) . ((c - a) x (d - a)), one sign
+        a, b, c, d = ([x.take(corners[:, j]) for x in xyz] for j in range(4))
+        u, v, w = ([q[i] - a[i] for i in range(3)] for q in (b, c, d))
+        volume = u[0] * (v[1] * w[2] - v[2] * w[1]) + u[1] * (v[2] * w[0] - v[0] * w[2]) + u[2] * (v[0] * w[1] - v[1] * w[0])
+    else:
+        linear = cell_rule(name)
+        volume = _jacobians(xyz, corners, linear)[1] @ linear.weights
+    sign[folded] = np.where(volume != 0, np.sign(volume), sign[folded])
+    return sign
 
 
 def cell_sums(x: NDArray[np.float64], name: str, cells: NDArray[np.int64], weight: NDArray[np.float64] | None) -> Sums:
@@ -409,7 +458,7 @@ def _block_rows(
 ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """The 15 rows of ``integrals`` (m0, m1, m2, noise, diagonal error scales, measure) of one block."""
     pos, det, cond, pos_scale = _jacobians(xyz, cells, rule)
-    sign = np.sign(det @ rule.weights)  # a mirrored cell counts with |det J|
+    sign = _orientation(xyz, cells, rule, det, cond)
     dv = det * rule.weights * sign[:, None]
     noise = cond * rule.weights  # rounding scale of dv: its error is below (n + 6) u times this
     dm, dm_noise = (dv, noise) if weight is None else (dv * weight[:, None], noise * np.abs(weight)[:, None])

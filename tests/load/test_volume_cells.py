@@ -301,3 +301,50 @@ def test_assembly_of_cell_blocks_equals_one_body() -> None:
     assert whole.mass == pytest.approx(pa.mass + pb.mass, rel=1e-14)
     com = (pa.mass * pa.center_of_mass + pb.mass * pb.center_of_mass) / (pa.mass + pb.mass)
     np.testing.assert_allclose(whole.center_of_mass, com, rtol=1e-13)
+
+
+# tetra10 nodes as VTK numbers them: corners, then the edges 01, 12, 02, 03, 13, 23
+_TET10_EDGES = ((0, 1), (1, 2), (0, 2), (0, 3), (1, 3), (2, 3))
+
+
+def _tetra10_signed_volume(nodes: list[tuple[Fraction, ...]]) -> Fraction:
+    """The integral of det J over the reference tetrahedron, exactly: det J of a quadratic tetrahedron is a cubic,
+    and Stroud's T3:3-1 rule (Approximate Calculation of Multiple Integrals, 1971: the centroid with weight -4/5
+    and the four points (1/2, 1/6, 1/6, 1/6) with 9/20 each) integrates cubics exactly, with rational points."""
+
+    def det_j(r: Fraction, s: Fraction, t: Fraction) -> Fraction:
+        lam = [1 - r - s - t, r, s, t]
+        d_lam = [(-1, -1, -1), (1, 0, 0), (0, 1, 0), (0, 0, 1)]
+        grad = [tuple((4 * lam[i] - 1) * d_lam[i][k] for k in range(3)) for i in range(4)]
+        grad += [tuple(4 * (d_lam[a][k] * lam[b] + lam[a] * d_lam[b][k]) for k in range(3)) for a, b in _TET10_EDGES]
+        j = [[sum((nodes[n][i] * grad[n][k] for n in range(10)), Fraction(0)) for k in range(3)] for i in range(3)]
+        return (
+            j[0][0] * (j[1][1] * j[2][2] - j[1][2] * j[2][1])
+            - j[0][1] * (j[1][0] * j[2][2] - j[1][2] * j[2][0])
+            + j[0][2] * (j[1][0] * j[2][1] - j[1][1] * j[2][0])
+        )
+
+    quarter, half, sixth = Fraction(1, 4), Fraction(1, 2), Fraction(1, 6)
+    points: list[tuple[tuple[Fraction, ...], Fraction]] = [((quarter, quarter, quarter), Fraction(-4, 5))]
+    points += [(p[1:], Fraction(9, 20)) for p in set(itertools.permutations((half, sixth, sixth, sixth)))]
+    return sum((w * det_j(*p) for p, w in points), Fraction(0)) / 6
+
+
+@pytest.mark.parametrize("mirrored", [False, True])
+def test_folded_curved_cell_counts_its_folded_region_negatively(mirrored: bool) -> None:
+    """A tetra10 whose corners span a positive tetrahedron but whose det J changes sign (one edge node pulled far
+    out) integrates to -7/24: the warning says such a cell is integrated with its signed Jacobian, as Gmsh's
+    signed Jacobians count it, whatever the order of its nodes; it used to be negated whole (+7/24)."""
+    corners = [(0, 0, 0), (1, 0, 0), (0, 1, 0), (0, 0, 1)]
+    straight = [tuple(Fraction(c) for c in p) for p in corners]
+    straight += [tuple((straight[a][k] + straight[b][k]) / 2 for k in range(3)) for a, b in _TET10_EDGES]
+    folded = list(straight)
+    folded[7] = (Fraction(3, 4), Fraction(2), Fraction(1, 2))  # edge 03's node
+    big = [tuple(6 * c - 1 for c in p) for p in straight]  # a straight cell holding the folded one: a physical body
+    assert _tetra10_signed_volume(folded) == Fraction(-7, 24)
+    exact = _tetra10_signed_volume(folded) + _tetra10_signed_volume(big)
+    order = [0, 2, 1, 3, 6, 5, 4, 7, 9, 8] if mirrored else list(range(10))  # corners 1 and 2 swapped, with their edges
+    nodes = np.array([[float(c) for c in folded[i]] for i in order] + [[float(c) for c in p] for p in big])
+    cells = np.array([list(range(10)), list(range(10, 20))])
+    body = VolumeBody(nodes, np.empty((0, 4), np.int64), None, cells=(CellBlock("tetra10", cells, None),))
+    assert mass_properties(body, density=1.0).volume == pytest.approx(float(exact), rel=1e-13)
