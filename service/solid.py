@@ -89,6 +89,16 @@ def oriented_surface(body: MeshBody) -> OrientedSurface:
         raise ZeroVolumeError(f"every triangle of the mesh is degenerate; the file holds no solid{cause}")
     topo = surface_topology(faces, len(vertices))
     warnings: list[str] = []
+    if topo.nonmanifold_edges:  # a triangle listed twice shares each edge with its copy: four faces on an edge
+        repeated = _repeated_faces(faces)
+        once = faces[~repeated]
+        once_topo = surface_topology(once, len(vertices)) if np.any(repeated) else topo
+        if once_topo is not topo and not once_topo.open_edges:  # a closed body listed twice (an open one is refused below)
+            warnings.append(
+                f"{len(faces) - len(once)} of {len(faces)} triangles repeat another with the same corners and winding "
+                "(the file lists them twice, as under a second material); each was weighed once, not twice"
+            )
+            faces, topo = once, once_topo
     if topo.open_edges:
         from .seams import merge_seams  # only an open surface needs it
 
@@ -137,6 +147,16 @@ def oriented_surface(body: MeshBody) -> OrientedSurface:
         more = [w for w in more if w != INVERTED]
     warnings.extend(more)
     return OrientedSurface(vertices, faces, tuple(warnings), first_pass)
+
+
+def _repeated_faces(faces: NDArray[np.int64]) -> NDArray[np.bool_]:
+    """Faces that repeat an earlier face: the same three corners in the same cyclic order (the same winding)."""
+    first = np.argmin(faces, axis=1)  # each face turned to start at its smallest corner, its winding kept
+    turned = np.take_along_axis(faces, (first[:, None] + np.arange(3)) % 3, axis=1)
+    _, heads = row_ids(np.ascontiguousarray(turned).view(np.uint64))
+    repeated = np.ones(len(faces), dtype=bool)
+    repeated[heads] = False
+    return repeated
 
 
 def _volumes_and_first_pass(x: NDArray[np.float64], faces: NDArray[np.int64]) -> tuple[NDArray[np.float64], Sums | None]:

@@ -14,7 +14,7 @@ from numpy.typing import ArrayLike
 from scipy.spatial.transform import Rotation
 
 from benchmarks import exact
-from benchmarks.cases import box, l_bracket, prism
+from benchmarks.cases import box, box_inertia, l_bracket, prism
 from benchmarks.exact import exact_solid
 from inertia.body import MeshBody, PointBody, VolumeBody
 from inertia.errors import InvalidParameterError, NotWatertightError, ZeroVolumeError
@@ -374,3 +374,16 @@ def test_corner_gather_in_steps_is_the_plain_gather(corners: int) -> None:
         for k in range(corners):
             for j in range(3):
                 assert np.array_equal(got[k][j], plain[:, k, j])
+
+
+@pytest.mark.parametrize("turn", [0, 1, 2])
+def test_triangles_listed_twice_with_the_same_winding_are_weighed_once(turn: int) -> None:
+    """An OBJ that lists every triangle again under a second material encloses the body twice over (winding number
+    2 inside); the body is the one surface: each repeat is dropped, with a warning (it was weighed twice)."""
+    v, f = box(2.0, 3.0, 4.0)
+    again = np.roll(f, turn, axis=1)  # the same corners and winding, starting at another corner
+    props = mass_properties(MeshBody(v, np.vstack([f, again[:5]])), density=1.0)  # five of them repeated
+    assert props.volume == pytest.approx(24.0, rel=1e-14)
+    expected = np.sort(np.diag(box_inertia(24.0, 2.0, 3.0, 4.0)))  # closed form, density 1
+    assert np.sort(props.principal_moments).tolist() == pytest.approx(expected.tolist(), rel=1e-13)
+    assert any("5 of 17 triangles repeat another" in w for w in props.warnings)
