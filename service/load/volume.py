@@ -883,6 +883,8 @@ def _read_meshio(data: bytes, fmt: str, label: str, filename: str | None, compan
     if fmt == "mesh":
         data = medit_layout(data)
         medit_dimension(data, label)
+    if fmt == "msh":
+        _msh2_element_lengths(data, label)
     try:
         mesh = _meshio_read(data, fmt, label, filename, companions)
     except UnreadableFileError as exc:
@@ -1367,6 +1369,37 @@ def _gmsh_retry(data: bytes, exc: UnreadableFileError, label: str) -> bytes | No
 
 
 _MSH2_ELEMENTS = re.compile(rb"(\$Elements[^\S\n]*\r?\n[^\n]*\n)(.*?)(\$EndElements)", re.DOTALL)
+
+
+def _msh2_element_lengths(data: bytes, label: str) -> None:
+    """Refuse a text MSH 2 file with an element line longer or shorter than its type's node count.
+
+    An element line is ``number type ntags tag... node...`` (gmsh.info, "MSH file format version 2"), the
+    node count fixed by the type; Gmsh refuses a line that lists another count, and meshio takes the last
+    nodes of the line as the element's, silently (a hexahedron written with the type number of a
+    tetrahedron became a tetrahedron of four of its nodes).
+    """
+    version = _gmsh_format(data)
+    section = _MSH2_ELEMENTS.search(data) if version is not None and version[0] == 2 and version[2] else None
+    if section is None:
+        return
+    from meshio._common import num_nodes_per_cell
+    from meshio.gmsh.common import _gmsh_to_meshio_type
+
+    for line in section.group(2).split(b"\n"):
+        fields = line.split()
+        if len(fields) < 3 or not (fields[1].isdigit() and fields[2].isdigit()):
+            continue  # not an element line: meshio names what is wrong with it
+        kind = _gmsh_to_meshio_type.get(int(fields[1]))
+        nodes = num_nodes_per_cell.get(kind) if kind is not None else None
+        listed = len(fields) - 3 - int(fields[2])
+        if nodes is not None and listed != nodes:
+            raise UnreadableFileError(
+                f"element {fields[0].decode(errors='replace')} of {label} has type {int(fields[1])} (a {nodes}-node "
+                f"{kind}) but lists {listed} nodes after its {int(fields[2])} tags; Gmsh itself refuses such a line: "
+                "correct its type number or its nodes, or export the mesh again",
+                format="msh",
+            )
 
 
 def _msh2_two_tags(data: bytes) -> bytes | None:

@@ -293,3 +293,14 @@ def test_an_msh_file_without_nodes_is_empty_geometry(text: bytes) -> None:
     # PyMesh's tests/data/empty.msh: meshio answered "zero-size array to reduction operation maximum ..."
     with pytest.raises(EmptyGeometryError, match="holds no nodes"):
         analyze(text, filename="empty.msh")
+
+
+def test_an_msh2_element_line_with_another_node_count_than_its_type_is_refused() -> None:
+    """gmshparser's physical_v2_1.msh: a hexahedron written with the type number of a tetrahedron (4). Gmsh refuses
+    the line; meshio took its last four nodes, four corners of one face, and the file read as a flat tetrahedron."""
+    cube = [(x, y, z) for z in (0.0, 1.0) for y in (0.0, 1.0) for x in (0.0, 1.0)]
+    hexahedron = [1, 2, 4, 3, 5, 6, 8, 7]
+    with pytest.raises(UnreadableFileError, match=r"element 1 of .* has type 4 \(a 4-node tetra\) but lists 8 nodes"):
+        analyze(_msh22(cube, [(4, [1, 1], hexahedron)]), filename="bad.msh")
+    doc = analyze(_msh22(cube, [(5, [1, 1], hexahedron)]), filename="cube.msh").as_dict()  # its own type number, 5
+    assert doc["mass"] / doc["density"] == pytest.approx(1.0, rel=1e-14)
