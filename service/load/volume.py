@@ -260,14 +260,16 @@ def read_volume_parts(
     return _parts(mesh, label, length_scale)
 
 
-_GMSH_FORMAT = re.compile(rb"\s*\$MeshFormat\s+(\d+)\.(\d+)\s+(\d)")
+_GMSH_FORMAT = re.compile(rb"\s*\$MeshFormat\s+(\d+)(?:\.(\d+))?\s+(\d)")
+# Gmsh 4.0 writes its version as "4" (4.1 writes "4.1"); meshio reads a bare "4" as 4.1
+_GMSH_BARE_4 = re.compile(rb"\A(\s*\$MeshFormat\s+)4(\s)")
 _GMSH_NODES = re.compile(rb"\$Nodes[^\S\n]*\r?\n[^\S\n]*(\d+)(?:[^\S\n]+(\d+))?")
 
 
 def _gmsh_format(data: bytes) -> tuple[int, int, bool] | None:
     """A Gmsh file's version (major, minor) and whether it is text, from its ``$MeshFormat``; None without one."""
     found = _GMSH_FORMAT.match(data[:64])
-    return None if found is None else (int(found.group(1)), int(found.group(2)), found.group(3) == b"0")
+    return None if found is None else (int(found.group(1)), int(found.group(2) or 0), found.group(3) == b"0")
 
 
 def _gmsh_node_count(data: bytes) -> int | None:
@@ -885,6 +887,7 @@ def _read_meshio(data: bytes, fmt: str, label: str, filename: str | None, compan
         medit_dimension(data, label)
     if fmt == "msh":
         _msh2_element_lengths(data, label)
+        data = _GMSH_BARE_4.sub(rb"\g<1>4.0\g<2>", data, count=1)  # MSH 4.0 as Gmsh 4.0 wrote it, for meshio's 4.0 reader
     try:
         mesh = _meshio_read(data, fmt, label, filename, companions)
     except UnreadableFileError as exc:

@@ -13,6 +13,7 @@ import pytest
 
 from inertia.errors import EmptyGeometryError, UnreadableFileError, UnsupportedFormatError
 from inertia.pipeline import AnalysisOptions, analyze
+from tests.support.paths import ROOT
 
 # the 18-node prism in Gmsh's order: corners, then edge midpoints 0-1, 0-2, 0-3, 1-2, 1-4, 2-5, 3-4, 3-5, 4-5,
 # then the centres of the quadrilateral faces 0-1-4-3, 0-2-5-3, 1-2-5-4
@@ -304,3 +305,13 @@ def test_an_msh2_element_line_with_another_node_count_than_its_type_is_refused()
         analyze(_msh22(cube, [(4, [1, 1], hexahedron)]), filename="bad.msh")
     doc = analyze(_msh22(cube, [(5, [1, 1], hexahedron)]), filename="cube.msh").as_dict()  # its own type number, 5
     assert doc["mass"] / doc["density"] == pytest.approx(1.0, rel=1e-14)
+
+
+def test_an_msh_4_0_file_as_gmsh_writes_it_is_read() -> None:
+    """Gmsh 4.0 writes its version as "4", which meshio took for 4.1 and failed on ("unmatched data"); the box is
+    1 x 2 x 3, meshed by Gmsh itself (tests/data/gmsh/README.md)."""
+    path = ROOT / "tests" / "data" / "gmsh" / "box_v40.msh"
+    assert path.read_bytes().startswith(b"$MeshFormat\n4 0 8\n")
+    doc = analyze(str(path)).as_dict()
+    assert doc["mass"] / doc["density"] == pytest.approx(6.0, rel=1e-14)
+    assert doc["center_of_mass"] == pytest.approx([0.5, 1.0, 1.5], rel=1e-14)
