@@ -225,7 +225,8 @@ def read_volume_parts(
             "(.msh), e.g. with MFEM's own mesh tools",
             format=fmt,
         )
-    if fmt == "msh" and data.lstrip()[:1] not in (b"$", b""):  # every Gmsh section starts with $
+    if fmt == "msh" and data.strip() and not _GMSH_SECTION.match(data[:64]):
+        # every Gmsh section starts with $ and its name (a binary file of MuJoCo's own .msh format may start with $)
         named = f"the .msh file {os.path.basename(filename)!r}" if filename else "the .msh file"
         first = data.lstrip().split(b"\n", 1)[0].split()
         freefem = len(first) == 3 and all(t.isdigit() for t in first)  # "vertices triangles boundary-edges"
@@ -239,6 +240,13 @@ def read_volume_parts(
         raise UnreadableFileError(
             f"{named} is not a Gmsh file: it does not start with a $ section ($MeshFormat); "
             "check that it is the mesh you meant to send",
+            format=fmt,
+        )
+    if fmt == "msh" and b"$PartitionedEntities" in data:
+        raise UnsupportedFormatError(
+            f"{_label(filename, fmt)} is partitioned ($PartitionedEntities, with ghost elements), which its reader "
+            "(meshio) does not read; save it again unpartitioned (gmsh.model.mesh.unpartition() in Gmsh's API, then "
+            "write it), or as VTK (.vtu)",
             format=fmt,
         )
     if fmt == "msh" and _gmsh_node_count(data) == 0:  # meshio's own answer: "zero-size array to reduction ..."
@@ -260,6 +268,7 @@ def read_volume_parts(
     return _parts(mesh, label, length_scale)
 
 
+_GMSH_SECTION = re.compile(rb"\s*\$[A-Za-z]")  # a section name after its $: $MeshFormat, $NOD ...
 _GMSH_FORMAT = re.compile(rb"\s*\$MeshFormat\s+(\d+)(?:\.(\d+))?\s+(\d)")
 # Gmsh 4.0 writes its version as "4" (4.1 writes "4.1"); meshio reads a bare "4" as 4.1
 _GMSH_BARE_4 = re.compile(rb"\A(\s*\$MeshFormat\s+)4(\s)")

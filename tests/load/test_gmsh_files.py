@@ -315,3 +315,18 @@ def test_an_msh_4_0_file_as_gmsh_writes_it_is_read() -> None:
     doc = analyze(str(path)).as_dict()
     assert doc["mass"] / doc["density"] == pytest.approx(6.0, rel=1e-14)
     assert doc["center_of_mass"] == pytest.approx([0.5, 1.0, 1.5], rel=1e-14)
+
+
+def test_a_binary_msh_that_starts_with_a_dollar_sign_is_named_no_gmsh_file() -> None:
+    # MuJoCo's own binary .msh (its test cube.msh): four int32 counts, the first 36 = b"$\x00\x00\x00"
+    data = b"$\x00\x00\x00" + bytes(4) * 3 + bytes(range(200))
+    with pytest.raises(UnreadableFileError, match=r"is not a Gmsh file: it does not start with a \$ section"):
+        analyze(data, filename="cube.msh")
+
+
+def test_a_partitioned_msh_file_is_refused_by_name() -> None:
+    # Gmsh's partitioned output ($PartitionedEntities, $GhostElements): meshio read its partition entities' tags as
+    # undefined numbers ("refers to 7 ... without defining it")
+    data = b"$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$PartitionedEntities\n2\n0\n0 0 0 0\n$EndPartitionedEntities\n"
+    with pytest.raises(UnsupportedFormatError, match=r"is partitioned \(\$PartitionedEntities"):
+        analyze(data, filename="box.msh")
