@@ -1628,9 +1628,12 @@ def _count(n: int, noun: str) -> str:
 
 def _unsupported_cells(label: str, counts: Mapping[str, int]) -> str:
     listed = ", ".join(f"{n} {t}" for t, n in sorted(counts.items()))
+    # Gmsh's default second order adds a node at each quadrilateral face (pyramid14, Gmsh's 14-node pyramid):
+    # its "incomplete" second order leaves those out (13 nodes), which is read
+    incomplete = "; in Gmsh, set Mesh.SecondOrderIncomplete = 1 for 13-node pyramids" if "pyramid14" in counts else ""
     return (
         f"{label} holds 3-D cells we cannot integrate exactly ({listed}); convert them to tetrahedra, "
-        "hexahedra, wedges or pyramids (linear or quadratic), for example with Gmsh"
+        f"hexahedra, wedges or pyramids (linear or quadratic), for example with Gmsh{incomplete}"
     )
 
 
