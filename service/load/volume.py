@@ -249,6 +249,11 @@ def read_volume_parts(
             "write it), or as VTK (.vtu)",
             format=fmt,
         )
+    if fmt == "msh" and _GMSH_SECTION.match(data[:64]) and not re.search(rb"\$(Elements|ELM)\b", data):
+        raise EmptyGeometryError(  # meshio's own answer: "$Element section not found."
+            f"{_label(filename, fmt)} holds no elements (it has no $Elements section); send a mesh with 3-D cells",
+            format=fmt,
+        )
     if fmt == "msh" and _gmsh_node_count(data) == 0:  # meshio's own answer: "zero-size array to reduction ..."
         raise EmptyGeometryError(
             f"{_label(filename, fmt)} holds no nodes (its $Nodes section is empty); send a mesh with 3-D cells", format=fmt

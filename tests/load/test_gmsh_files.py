@@ -330,3 +330,10 @@ def test_a_partitioned_msh_file_is_refused_by_name() -> None:
     data = b"$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$PartitionedEntities\n2\n0\n0 0 0 0\n$EndPartitionedEntities\n"
     with pytest.raises(UnsupportedFormatError, match=r"is partitioned \(\$PartitionedEntities"):
         analyze(data, filename="box.msh")
+
+
+def test_an_msh_file_without_elements_is_empty_geometry() -> None:
+    # gmsh-parser's t9.msh: a format line and four empty entity lists, no $Nodes, no $Elements
+    data = b"$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Entities\n0 0 0 0\n$EndEntities\n"
+    with pytest.raises(EmptyGeometryError, match=r"holds no elements \(it has no \$Elements section\)"):
+        analyze(data, filename="t9.msh")
