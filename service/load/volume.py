@@ -249,7 +249,8 @@ def read_volume_parts(
             "write it), or as VTK (.vtu)",
             format=fmt,
         )
-    if fmt == "msh" and _GMSH_SECTION.match(data[:64]) and not re.search(rb"\$(Elements|ELM)\b", data):
+    version = _gmsh_format(data) if fmt == "msh" else None  # a version meshio reads: 2 or 4
+    if version is not None and version[0] in (2, 4) and not re.search(rb"\$Elements\b", data):
         raise EmptyGeometryError(  # meshio's own answer: "$Element section not found."
             f"{_label(filename, fmt)} holds no elements (it has no $Elements section); send a mesh with 3-D cells",
             format=fmt,
