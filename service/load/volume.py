@@ -1404,18 +1404,23 @@ def _msh2_element_lengths(data: bytes, label: str) -> None:
     from meshio._common import num_nodes_per_cell
     from meshio.gmsh.common import _gmsh_to_meshio_type
 
+    length: dict[tuple[bytes, bytes], int] = {}  # (type, ntags) as written -> the line's field count (0: unknown)
     for line in section.group(2).split(b"\n"):
         fields = line.split()
-        if len(fields) < 3 or not (fields[1].isdigit() and fields[2].isdigit()):
+        if len(fields) < 3:
             continue  # not an element line: meshio names what is wrong with it
-        kind = _gmsh_to_meshio_type.get(int(fields[1]))
-        nodes = num_nodes_per_cell.get(kind) if kind is not None else None
-        listed = len(fields) - 3 - int(fields[2])
-        if nodes is not None and listed != nodes:
+        key = (fields[1], fields[2])
+        expected = length.get(key)
+        if expected is None:
+            kind = _gmsh_to_meshio_type.get(int(key[0])) if key[0].isdigit() and key[1].isdigit() else None
+            nodes = num_nodes_per_cell.get(kind, 0) if kind is not None else 0
+            expected = length[key] = 3 + int(key[1]) + nodes if nodes else 0
+        if expected and len(fields) != expected:
+            kind, tags = _gmsh_to_meshio_type[int(key[0])], int(key[1])
             raise UnreadableFileError(
-                f"element {fields[0].decode(errors='replace')} of {label} has type {int(fields[1])} (a {nodes}-node "
-                f"{kind}) but lists {listed} nodes after its {int(fields[2])} tags; Gmsh itself refuses such a line: "
-                "correct its type number or its nodes, or export the mesh again",
+                f"element {fields[0].decode(errors='replace')} of {label} has type {int(key[0])} (a "
+                f"{num_nodes_per_cell[kind]}-node {kind}) but lists {len(fields) - 3 - tags} nodes after its {tags} "
+                "tags; Gmsh itself refuses such a line: correct its type number or its nodes, or export the mesh again",
                 format="msh",
             )
 
