@@ -389,14 +389,14 @@ def _folded(det: NDArray[np.float64], cond: NDArray[np.float64], n: int) -> NDAr
     return folded
 
 
-# A curved cell's corners, as the straight-sided cell through them: (its type, its number of corners)
+# A curved cell's corners (its first nodes), as the straight-sided cell through them
 _STRAIGHT = {
-    "tetra10": ("tetra", 4),
-    "hexahedron20": ("hexahedron", 8),
-    "hexahedron27": ("hexahedron", 8),
-    "wedge15": ("wedge", 6),
-    "wedge18": ("wedge", 6),
-    "pyramid13": ("pyramid", 5),
+    "tetra10": "tetra",
+    "hexahedron20": "hexahedron",
+    "hexahedron27": "hexahedron",
+    "wedge15": "wedge",
+    "wedge18": "wedge",
+    "pyramid13": "pyramid",
 }
 
 
@@ -417,14 +417,13 @@ def _orientation(
     folded = np.flatnonzero(_folded(det, cond, rule.shape.shape[1]))
     if not len(folded):
         return sign
-    name, k = straight
-    corners = cells[folded, :k]
-    if name == "tetra":  # the linear tetrahedron's map: det J = (b - a) . ((c - a) x (d - a)), one sign
+    corners = cells[folded, : CELL_NODES.get(straight, 4)]  # a linear tetrahedron (not a cell of this module): 4
+    if straight == "tetra":  # the linear tetrahedron's map: det J = (b - a) . ((c - a) x (d - a)), one sign
         a, b, c, d = ([x.take(corners[:, j]) for x in xyz] for j in range(4))
         u, v, w = ([q[i] - a[i] for i in range(3)] for q in (b, c, d))
         volume = u[0] * (v[1] * w[2] - v[2] * w[1]) + u[1] * (v[2] * w[0] - v[0] * w[2]) + u[2] * (v[0] * w[1] - v[1] * w[0])
     else:
-        linear = cell_rule(name)
+        linear = cell_rule(straight)
         volume = _jacobians(xyz, corners, linear)[1] @ linear.weights
     sign[folded] = np.where(volume != 0, np.sign(volume), sign[folded])
     return sign
