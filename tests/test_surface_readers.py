@@ -17,6 +17,8 @@ from typing import Any, cast
 import numpy as np
 import pytest
 import trimesh
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from benchmarks.cases import box, cube, obj_bytes
 from inertia.errors import (
@@ -29,7 +31,7 @@ from inertia.errors import (
     ZeroVolumeError,
 )
 from inertia.load import load_body
-from inertia.load.ply import uniform_face_rows
+from inertia.load.ply import read_ascii_ply, rows_on_their_lines, uniform_face_rows
 from inertia.load.safe import guarded_read
 from inertia.pipeline import AnalysisOptions, analyze, analyze_loaded
 
@@ -1223,6 +1225,90 @@ def test_a_binary_ply_trimesh_would_misread_is_read_as_written(order: str, head:
     assert doc["mass"] == pytest.approx(6.0, rel=1e-15)
     assert doc["center_of_mass"] == pytest.approx([0.5, 1.0, 1.5], rel=1e-15)
     assert not [w for w in doc["warnings"] if "winding" in w]
+
+
+def _ascii_box_ply(joins: Callable[[int], str], newline: str = "\n", kind: str = "float") -> bytes:
+    """The 1 x 2 x 3 box as an ASCII PLY file whose numbers are joined by ``joins(k)`` (k: the gap's index)
+    after the header: a space, a line break, or a blank line."""
+    head = ["ply", "format ascii 1.0", "element vertex 8", *(f"property {kind} {c}" for c in "xyz")]
+    head += [f"element face {len(_BOX_QUADS)}", "property list uchar int vertex_indices", "end_header"]
+    words = [repr(v) for corner in _BOX_CORNERS for v in corner]
+    words += [str(w) for quad in _BOX_QUADS for w in (len(quad), *quad)]
+    body = words[0] + "".join(joins(k) + word for k, word in enumerate(words[1:]))
+    return (newline.join(head) + newline + body.replace("\n", newline) + newline).encode()
+
+
+def _row_ends() -> set[int]:
+    """The gaps of ``_ascii_box_ply``'s numbers that end a row: a line break in a file of one row per line."""
+    ends, at = set(), 0
+    for width in [3] * len(_BOX_CORNERS) + [1 + len(q) for q in _BOX_QUADS]:
+        at += width
+        ends.add(at - 1)
+    return ends
+
+
+_ONE_ROW_PER_LINE = _ascii_box_ply(lambda k: "\n" if k in _row_ends() else " ")
+
+
+@pytest.mark.parametrize(
+    ("joins", "newline"),
+    [
+        (lambda k: "\n" if k in _row_ends() or k == 4 else " ", "\n"),  # a vertex row wrapped onto a second line
+        (lambda k: "\n" if k in _row_ends() and k % 2 else " ", "\n"),  # rows two by two on one line
+        (lambda k: "\n\n" if k == 40 else "\n" if k in _row_ends() else " ", "\n"),  # a blank line among the faces
+        (lambda k: " ", "\r\n"),  # every number on one line
+        (lambda k: "\n" if k % 5 == 0 else " ", "\r\n"),  # a line break every five numbers
+    ],
+    ids=["wrapped-row", "two-rows-a-line", "blank-line", "one-line", "every-five"],
+)
+def test_an_ascii_ply_is_read_as_numbers_whatever_its_lines(joins: Callable[[int], str], newline: str) -> None:
+    # the format's ASCII data is numbers separated by white space (rply and VCG read words, not lines); trimesh
+    # reads one row per line, so a wrapped row or a blank line shifted every row after it: the closed box was
+    # refused as "not watertight (8 open edges)"
+    data = _ascii_box_ply(joins, newline)
+    assert not rows_on_their_lines(data)
+    doc = analyze(data, filename="box.ply").as_dict()
+    assert doc["mass"] / doc["density"] == 6.0  # the 1 x 2 x 3 box, exact
+    assert doc["center_of_mass"] == pytest.approx([0.5, 1.0, 1.5], rel=1e-15)
+    assert doc["principal"]["moments"] == pytest.approx(sorted(6000 * (p + q) / 12 for p, q in ((4, 9), (1, 9), (1, 4))), rel=1e-14)
+    # the same numbers a row per line go through trimesh's reader: the same result, bit for bit
+    assert rows_on_their_lines(_ONE_ROW_PER_LINE)
+    regular = analyze(_ONE_ROW_PER_LINE, filename="box.ply").as_dict()
+    for key in ("mass", "center_of_mass", "inertia_tensor", "principal", "warnings"):
+        assert doc[key] == regular[key]
+
+
+@settings(max_examples=25, deadline=None)
+@given(st.lists(st.sampled_from([" ", "\n", " \n ", "\t", "\n\n"]), min_size=53, max_size=53))
+def test_an_ascii_ply_gives_one_result_however_its_numbers_are_split(gaps: list[str]) -> None:
+    data = _ascii_box_ply(lambda k: gaps[k])
+    doc = analyze(data, filename="box.ply").as_dict()
+    regular = analyze(_ONE_ROW_PER_LINE, filename="box.ply").as_dict()
+    for key in ("mass", "center_of_mass", "inertia_tensor", "principal", "warnings"):
+        assert doc[key] == regular[key]
+
+
+def test_an_ascii_ply_read_by_words_keeps_the_declared_float_type() -> None:
+    # "0.1" in a float property is the float32 0.100000001 for every PLY reader, wrapped or not
+    a = repr(0.1)
+    data = _ascii_box_ply(lambda k: " ").replace(b" 2.0 ", f" {a} ".encode(), 1)
+    vertices, _, _ = cast(Any, read_ascii_ply(data))
+    assert vertices[2, 1] == float(np.float32(0.1)) != 0.1
+    vertices, _, _ = cast(Any, read_ascii_ply(data.replace(b"property float", b"property double")))
+    assert vertices[2, 1] == 0.1
+
+
+@pytest.mark.parametrize(
+    "tail",
+    [b"", b" 7", b" x"],
+    ids=["a-number-short", "a-number-over", "a-word"],
+)
+def test_an_ascii_ply_whose_numbers_do_not_fill_its_elements_is_left_to_trimesh(tail: bytes) -> None:
+    data = _ascii_box_ply(lambda k: " ")
+    data = (data.rstrip()[: data.rstrip().rindex(b" ")] if not tail else data.rstrip() + tail) + b"\n"
+    assert read_ascii_ply(data) is None
+    with pytest.raises(ServiceError):  # trimesh's reading of it, as before: not a body
+        analyze(data, filename="box.ply")
 
 
 def test_binary_ply_face_rows_are_checked_list_by_list() -> None:

@@ -19,7 +19,7 @@ import random
 from collections.abc import Callable, Mapping
 from dataclasses import replace
 from functools import partial
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -34,6 +34,9 @@ from ..errors import (
     ZeroVolumeError,
 )
 from .safe import guarded_read
+
+if TYPE_CHECKING:
+    from .ply import PlyFaces
 
 __all__ = ["read_trimesh_parts", "read_surface_parts", "mesh_part"]
 
@@ -156,12 +159,17 @@ def read_trimesh_parts(
                 f"{unplaced} primitive(s) of the glTF file have no positions (glTF draws nothing for them) and were left out"
             )
         notes += cut + placed
-    if fmt == "ply":  # what trimesh's reader would misread: a header out of its order, binary faces of mixed sizes
-        from .ply import header_in_order, uniform_face_rows
+    if fmt == "ply":  # what trimesh's reader would misread: a header out of its order, binary faces of mixed
+        # sizes, ASCII rows not each on a line of their own
+        from .ply import header_in_order, read_ascii_ply, rows_on_their_lines, uniform_face_rows
 
         data = guarded_read(partial(header_in_order, data), fmt)
         if not guarded_read(partial(uniform_face_rows, data), fmt):
-            own = _own_binary_ply(data, length_scale)
+            own = _own_ply(data, length_scale)
+            if own is not None:
+                return own, None
+        if not guarded_read(partial(rows_on_their_lines, data), fmt):
+            own = _own_ply(data, length_scale, read_ascii_ply)
             if own is not None:
                 return own, None
     # the upload's own files, and nothing else: a name outside them (a texture that did not come along, a path)
@@ -180,7 +188,7 @@ def read_trimesh_parts(
         fault = _gltf_fault(data, fmt, companions) if fmt in ("gltf", "glb") else None
         if fault is not None:
             raise fault from None
-        own = _own_binary_ply(data, length_scale) if fmt == "ply" else None  # faces of several lengths, a \r header
+        own = _own_ply(data, length_scale) if fmt == "ply" else None  # faces of several lengths, a \r header
         if own is None:
             raise
         return own, None
@@ -232,13 +240,13 @@ def read_trimesh_parts(
     return parts, _declared_unit(scene, fmt)
 
 
-def _own_binary_ply(data: bytes, length_scale: float) -> list[Part] | None:
-    """A binary PLY file trimesh could not read, by ``ply.read_binary_ply``; None where that cannot read it
-    either (trimesh's error then stands)."""
+def _own_ply(data: bytes, length_scale: float, read: Callable[[bytes], PlyFaces | None] | None = None) -> list[Part] | None:
+    """A PLY file trimesh would misread, by ``read`` (default ``ply.read_binary_ply``); None where that cannot
+    read it either (trimesh's reading then stands)."""
     from .ply import read_binary_ply
     from .polygons import fan_split_note, fan_triangles
 
-    found = read_binary_ply(data)
+    found = guarded_read(partial(read or read_binary_ply, data), "ply")
     if found is None:
         return None
     vertices, corners, counts = found

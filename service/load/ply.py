@@ -1,4 +1,4 @@
-"""Binary PLY files that trimesh's reader refuses: face lists of more than one length.
+"""PLY files that trimesh's reader misreads: binary face lists of more than one length, ASCII rows off their lines.
 
 trimesh reads a binary element's list property as if every row had the length of
 the first (``trimesh.exchange.ply``), so a file mixing triangles and quads (Rhino's
@@ -8,6 +8,13 @@ reader walks the rows: scalar properties by their declared types, each list by
 its count.  Only the vertices' x, y, z and the faces' ``vertex_indices`` (or
 ``vertex_index``) are kept; other elements are stepped over.  Header lines may
 end in ``\\r\\n``, ``\\n`` or a bare ``\\r``.
+
+trimesh also reads an ASCII file line by line, one row per line: a row wrapped
+onto a second line, two rows on one line or a blank line between rows shifted
+every row after it (a closed box came back open).  The format's ASCII data is a
+sequence of numbers separated by white space, and its readers (rply, VCG/MeshLab's)
+read it so; ``read_ascii_ply`` walks the numbers in the same way, for the files
+whose rows are not each on a line of their own.
 """
 
 from __future__ import annotations
@@ -18,7 +25,7 @@ import struct
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ["header_in_order", "read_binary_ply", "uniform_face_rows"]
+__all__ = ["PlyFaces", "header_in_order", "read_ascii_ply", "read_binary_ply", "rows_on_their_lines", "uniform_face_rows"]
 
 _TYPES = {
     "char": "b",
@@ -40,6 +47,8 @@ _TYPES = {
 }
 
 Property = tuple[str, str, str | None]  # name, value type, count type (lists only)
+# what the readers give: the vertices, every face's corners one after another, the corners per face
+PlyFaces = tuple[NDArray[np.float64], NDArray[np.int64], NDArray[np.int64]]
 
 
 # the line that ends a PLY header: ``end_header`` alone on it (a comment may mention the word)
@@ -78,7 +87,7 @@ def uniform_face_rows(data: bytes) -> bool:
     them); True for an ASCII file or one without faces.
     """
     found = _header(data)
-    if found is None:
+    if found is None or found[0] == "ascii":
         return True
     order, elements, offset = found
     for name, count, props in elements:
@@ -117,7 +126,8 @@ def uniform_face_rows(data: bytes) -> bool:
 
 
 def _header(data: bytes) -> tuple[str, list[tuple[str, int, list[Property]]], int] | None:
-    """Byte order, elements (name, count, properties) and the offset of the data; None for no binary PLY."""
+    """Byte order ("<", ">", or "ascii"), elements (name, count, properties) and the offset of the data; None for
+    no PLY this module reads."""
     found = _END.search(data)
     if not data.startswith(b"ply") or found is None:
         return None
@@ -128,7 +138,7 @@ def _header(data: bytes) -> tuple[str, list[tuple[str, int, list[Property]]], in
     for line in lines:
         words = line.split()
         if words[:1] == ["format"] and len(words) >= 2:
-            order = {"binary_little_endian": "<", "binary_big_endian": ">"}.get(words[1])
+            order = {"binary_little_endian": "<", "binary_big_endian": ">", "ascii": "ascii"}.get(words[1])
         elif words[:1] == ["element"] and len(words) == 3 and words[2].isdigit():
             elements.append((words[1], int(words[2]), []))
         elif words[:1] == ["property"] and elements:
@@ -141,12 +151,12 @@ def _header(data: bytes) -> tuple[str, list[tuple[str, int, list[Property]]], in
     return None if order is None else (order, elements, start)
 
 
-def read_binary_ply(data: bytes) -> tuple[NDArray[np.float64], NDArray[np.int64], NDArray[np.int64]] | None:
+def read_binary_ply(data: bytes) -> PlyFaces | None:
     """The vertices (x, y, z in their declared types), every face's corners one after another, and the
     corners per face, of a binary PLY file; None where it is no binary PLY with vertices and faces this
     reader can walk (the caller's own error then stands)."""
     found = _header(data)
-    if found is None:
+    if found is None or found[0] == "ascii":
         return None
     try:
         return _walk(data, *found)
@@ -154,9 +164,7 @@ def read_binary_ply(data: bytes) -> tuple[NDArray[np.float64], NDArray[np.int64]
         return None
 
 
-def _walk(
-    data: bytes, order: str, elements: list[tuple[str, int, list[Property]]], offset: int
-) -> tuple[NDArray[np.float64], NDArray[np.int64], NDArray[np.int64]] | None:
+def _walk(data: bytes, order: str, elements: list[tuple[str, int, list[Property]]], offset: int) -> PlyFaces | None:
     vertices: NDArray[np.float64] | None = None
     corners: list[int] = []
     counts: list[int] = []
@@ -194,3 +202,77 @@ def _walk(
     if vertices is None or not counts or offset > len(data):
         return None
     return vertices, np.asarray(corners, dtype=np.int64), np.asarray(counts, dtype=np.int64)
+
+
+def rows_on_their_lines(data: bytes) -> bool:
+    """Whether an ASCII PLY file has each row of its elements on a line of its own, as trimesh's reader assumes.
+
+    A row wrapped onto the next line, two rows on one line or a blank line among them changes the count of
+    lines, unless another such change makes up for it (lines after the last row, which trimesh leaves alone,
+    count too: ``read_ascii_ply`` then declines the file); True for a binary file, or one this module cannot
+    lay out.
+    """
+    found = _header(data)
+    if found is None or found[0] != "ascii":
+        return True
+    _, elements, start = found
+    rows = sum(count for _, count, _ in elements)
+    body = data[start:].strip()
+    newline = b"\n" if b"\n" in body else b"\r"  # \r\n counts as one line break, as trimesh's splitlines has it
+    lines = body.count(newline) + 1 if body else 0
+    return lines == rows
+
+
+def read_ascii_ply(data: bytes) -> PlyFaces | None:
+    """The vertices (x, y, z rounded to their declared types), every face's corners one after another, and
+    the corners per face, of an ASCII PLY file read as numbers separated by white space, whatever its lines;
+    None where the numbers do not fill its elements exactly (the caller's own reading then stands)."""
+    found = _header(data)
+    if found is None or found[0] != "ascii":
+        return None
+    _, elements, start = found
+    try:
+        numbers = np.asarray(data[start:].split(), dtype=np.float64)
+    except ValueError:  # a word that is no number
+        return None
+    vertices: NDArray[np.float64] | None = None
+    corners: list[NDArray[np.float64]] = []
+    counts: list[int] = []
+    at = 0
+    for name, count, props in elements:
+        if all(counter is None for _, _, counter in props):  # fixed rows: one reshape
+            width = len(props)
+            if width == 0 or at + width * count > len(numbers):
+                return None
+            rows = numbers[at : at + width * count].reshape(count, width)
+            at += width * count
+            if name == "vertex":
+                names = [p for p, _, _ in props]
+                if not {"x", "y", "z"} <= set(names):
+                    return None
+                with np.errstate(invalid="ignore", over="ignore"):  # non-finite values are refused later
+                    vertices = np.stack(
+                        [rows[:, names.index(c)].astype(props[names.index(c)][1]).astype(np.float64) for c in "xyz"], axis=1
+                    )
+            continue
+        keep = "vertex_indices" if any(p == "vertex_indices" for p, _, _ in props) else "vertex_index"
+        for _ in range(count):
+            for prop, _, counter in props:
+                if counter is None:
+                    at += 1
+                    continue
+                if at >= len(numbers):
+                    return None
+                n = numbers[at]
+                if not (n.is_integer() and 0 <= n <= len(numbers) - at - 1):
+                    return None
+                if name == "face" and prop == keep:
+                    corners.append(numbers[at + 1 : at + 1 + int(n)])
+                    counts.append(int(n))
+                at += 1 + int(n)
+    if vertices is None or not counts or at != len(numbers):
+        return None
+    flat = np.concatenate(corners)
+    if not np.all(flat == np.round(flat)):  # an index that is no integer
+        return None
+    return vertices, flat.astype(np.int64), np.asarray(counts, dtype=np.int64)
