@@ -180,8 +180,8 @@ def test_binary_stl_read_in_blocks_at_their_offsets_equals_the_whole_read(
     monkeypatch.setattr(os, "pread", lambda fd, n, at: real_pread(fd, max(1, n // 3), at))  # short reads
     blocks.set_block_threads(3)
     with path.open("rb") as fh:
-        vertices, faces = stl.read_stl_file(fh, len(data))
-    ref_vertices, ref_faces = stl.read_stl(data)
+        vertices, faces, _ = stl.read_stl_file(fh, len(data))
+    ref_vertices, ref_faces, _ = stl.read_stl(data)
     np.testing.assert_array_equal(vertices, ref_vertices)
     np.testing.assert_array_equal(faces, ref_faces)
 

@@ -38,7 +38,7 @@ def test_stl_weld_merges_negative_zero_with_zero() -> None:
     tri = TETRA[TETRA_FACES].astype(np.float32)
     tri[0, 0] = [-0.0, -0.0, 0.0]  # the origin, written once with negative zeros
     tri[2, 0] = [0.0, -0.0, -0.0]
-    vertices, faces = read_stl(triangles_stl_bytes(tri))
+    vertices, faces, _ = read_stl(triangles_stl_bytes(tri))
     assert vertices.shape == (4, 3)
     np.testing.assert_array_equal(vertices[faces], TETRA[TETRA_FACES])
     assert not np.any(np.signbit(vertices))
@@ -47,7 +47,7 @@ def test_stl_weld_merges_negative_zero_with_zero() -> None:
 def test_stl_weld_keeps_points_one_ulp_apart_and_numbers_by_first_appearance() -> None:
     tri = TETRA[TETRA_FACES].astype(np.float32)
     tri[3, 2, 2] = np.nextafter(np.float32(1.0), np.float32(2.0))  # a fifth, distinct point
-    vertices, faces = read_stl(triangles_stl_bytes(tri))
+    vertices, faces, _ = read_stl(triangles_stl_bytes(tri))
     assert len(vertices) == 5
     np.testing.assert_array_equal(vertices[faces], tri.astype(np.float64))
     first = [int(np.flatnonzero(faces.ravel() == k)[0]) for k in range(len(vertices))]
@@ -67,8 +67,8 @@ def test_ascii_stl_comes_back_welded_like_binary() -> None:
         )
         + "endsolid t\n"
     )
-    vertices, faces = read_stl(text.encode())
-    binary_vertices, binary_faces = read_stl(triangles_stl_bytes(tri.astype(np.float32)))
+    vertices, faces, _ = read_stl(text.encode())
+    binary_vertices, binary_faces, _ = read_stl(triangles_stl_bytes(tri.astype(np.float32)))
     assert vertices.shape == (4, 3)
     np.testing.assert_array_equal(vertices, binary_vertices)
     np.testing.assert_array_equal(faces, binary_faces)

@@ -1364,12 +1364,50 @@ def test_a_binary_ply_no_reader_can_walk_is_refused_in_a_sentence(head: list[str
 
 
 def test_a_binary_stl_whose_size_disagrees_with_its_count_says_by_how_much() -> None:
-    # PyMesh's tests/data/empty.stl: a count of 0 and one stray newline; numpy-stl reads such files, trimesh
-    # refuses them: refused, with the sizes, so that the extra bytes (or the missing ones) can be seen
+    # a record's worth of bytes or more beyond the count, or fewer bytes than it: refused, with the sizes, so
+    # that the extra bytes (or the missing ones) can be seen (trimesh refuses any difference)
     from tests.support.meshes import box_stl
 
     data = box_stl(1.0, 2.0, 3.0)
-    with pytest.raises(UnreadableFileError, match=r"declares 12 triangles \(684 bytes\) but holds 685, 1 more"):
-        load_body(data + b"\n", filename="box.stl")
+    with pytest.raises(UnreadableFileError, match=r"declares 12 triangles \(684 bytes\) but holds 734, 50 more"):
+        load_body(data + b"\n" * 50, filename="box.stl")
     with pytest.raises(UnreadableFileError, match=r"declares 12 triangles \(684 bytes\) but holds 634: it is truncated"):
         load_body(data[:-50], filename="box.stl")
+    # PyMesh's tests/data/empty.stl: a count of 0 and one stray newline, no triangle to read
+    with pytest.raises(UnreadableFileError, match=r"declares 0 triangles \(84 bytes\) but holds 85, 1 more"):
+        load_body(data[:80] + bytes(4) + b"\n", filename="empty.stl")
+
+
+@pytest.mark.parametrize("header", [b"", b"solid test.stl, written as binary"], ids=["plain", "solid-header"])
+@pytest.mark.parametrize("tail", [b"\n", b"\0" * 49], ids=["a-newline", "49-bytes"])
+@pytest.mark.parametrize("source", ["bytes", "file"])
+def test_a_binary_stl_with_fewer_bytes_than_a_record_after_its_triangles_is_read_with_a_warning(
+    header: bytes, tail: bytes, source: str, tmp_path: Path
+) -> None:
+    # numpy-stl's own tests/stl_binary/HalfDonut.stl: a header beginning with "solid", 288 triangles and one byte
+    # more; it was taken for ASCII and refused as "no triangles". numpy-stl reads it; fewer bytes than a record
+    # cannot hold a triangle the count left out, so the triangles are read and the extra bytes named
+    from tests.support.meshes import box_stl
+
+    data = box_stl(1.0, 2.0, 3.0)
+    data = header.ljust(80, b" ")[:80] + data[80:] + tail
+    if source == "file":
+        path = tmp_path / "box.stl"
+        path.write_bytes(data)
+        doc = analyze(str(path)).as_dict()
+    else:
+        doc = analyze(data, filename="box.stl").as_dict()
+    assert doc["mass"] / doc["density"] == 6.0  # the 1 x 2 x 3 box, exact
+    assert doc["center_of_mass"] == pytest.approx([0.5, 1.0, 1.5], rel=1e-15)
+    assert [w for w in doc["warnings"] if "after its last triangle" in w] == [
+        f"the binary STL file holds {len(tail)} byte(s) after its last triangle (its header declares 12 triangles, "
+        "684 bytes), too few for another one; they were ignored"
+    ]
+
+
+def test_a_binary_stl_under_a_solid_header_that_its_size_refuses_says_it_is_binary() -> None:
+    from tests.support.meshes import box_stl
+
+    data = b"solid part".ljust(80, b" ") + box_stl(1.0, 2.0, 3.0)[80:]
+    with pytest.raises(UnreadableFileError, match=r"begins with 'solid' but it holds binary data.*holds 734, 50 more"):
+        load_body(data + b"\0" * 50, filename="part.stl")

@@ -224,10 +224,11 @@ def _load_path(path: str, filename: str, format: str | None, units: str | None, 
         from .stl import read_stl_file
 
         fh.seek(0)
-        vertices, faces = read_stl_file(fh, os.fstat(fh.fileno()).st_size)
+        vertices, faces, notes = read_stl_file(fh, os.fstat(fh.fileno()).st_size)
     scale = 1.0 if units is None else length_scale(units)
     name = _stem(filename)
-    parts = (Part(name, MeshBody(vertices, faces, scale, name, welded=True, coordinate_eps=stored_eps(vertices))),)
+    body = MeshBody(vertices, faces, scale, name, welded=True, coordinate_eps=stored_eps(vertices), warnings=notes)
+    parts = (Part(name, body),)
     return Loaded(parts, filename, "stl", SourceKind.MESH, units or "m", UnitsFrom.REQUEST if units else UnitsFrom.DEFAULT)
 
 
@@ -274,9 +275,10 @@ def _load_bytes(
     if fmt == "stl":
         from .stl import read_stl
 
-        vertices, faces = read_stl(data)
+        vertices, faces, stl_notes = read_stl(data)
         name = _stem(filename)
-        parts = [Part(name, MeshBody(vertices, faces, scale, name, welded=True, coordinate_eps=stored_eps(vertices)))]
+        mesh = MeshBody(vertices, faces, scale, name, welded=True, coordinate_eps=stored_eps(vertices), warnings=stl_notes)
+        parts = [Part(name, mesh)]
         kind = SourceKind.MESH
     elif fmt in POINT_FORMATS:
         from .points import read_points_document

@@ -25,43 +25,81 @@ from ..errors import EmptyGeometryError, UnreadableFileError
 from ..topology import row_ids, weld
 from .safe import is_number
 
-__all__ = ["read_stl", "read_stl_file"]
+__all__ = ["StlMesh", "read_stl", "read_stl_file"]
 
 _READ_BLOCK = 1 << 16  # records per read: 3.2 MB of file at a time
 _GATHER_BLOCK = 1 << 16  # distinct vertices per block of the gather after the weld
+_SAMPLE = 50 * 64  # bytes of records looked at to tell a binary file from text
 _RECORD = np.dtype([("normal", "<f4", (3,)), ("vertices", "<f4", (3, 3)), ("attr", "<u2")])
 
 
-def read_stl(data: bytes | memoryview) -> tuple[NDArray[np.float64], NDArray[np.int64]]:
-    """Distinct vertices (k, 3), numbered by first appearance, and faces (n, 3) of a binary or ASCII STL file."""
+StlMesh = tuple[NDArray[np.float64], NDArray[np.int64], tuple[str, ...]]  # vertices, faces, warnings
+
+
+def read_stl(data: bytes | memoryview) -> StlMesh:
+    """Distinct vertices (k, 3), numbered by first appearance, faces (n, 3) and warnings of a binary or ASCII STL file."""
     buf = memoryview(data)
-    if len(buf) >= 84:
-        count = int(np.frombuffer(buf[80:84], dtype="<u4")[0])
-        if 84 + 50 * count == len(buf):
-            return _binary(buf, count)
+    layout = _binary_layout(bytes(buf[:84]), len(buf), bytes(buf[84 : 84 + _SAMPLE]))
+    if layout is not None:
+        count, tail = layout
+        return (*_binary(buf, count), _tail_notes(count, tail))
     head = bytes(buf[:512]).removeprefix(b"\xef\xbb\xbf").lstrip()  # an editor's UTF-8 byte-order mark
+    declared = int(np.frombuffer(buf[80:84], dtype="<u4")[0]) if len(buf) >= 84 else None
     if head[:5].lower() == b"solid":  # the keywords are lower case, but older CAD tools write them in capitals
-        return _ascii(bytes(buf).removeprefix(b"\xef\xbb\xbf"))
-    raise UnreadableFileError(_not_binary(len(buf), count if len(buf) >= 84 else None))
+        try:
+            return (*_ascii(bytes(buf).removeprefix(b"\xef\xbb\xbf")), ())
+        except EmptyGeometryError:
+            if declared is None or b"\0" not in bytes(buf[84 : 84 + _SAMPLE]):
+                raise
+            # binary records behind a header that begins with "solid" (SolidWorks and others write such headers)
+            raise UnreadableFileError(_not_binary(len(buf), declared, solid=True)) from None
+    raise UnreadableFileError(_not_binary(len(buf), declared))
 
 
-def _not_binary(size: int, count: int | None) -> str:
+def _binary_layout(header: bytes, size: int, sample: bytes) -> tuple[int, int] | None:
+    """(triangles, bytes after the last one) where the file is binary STL; None where it is not.
+
+    The header's count must fill the file exactly, or leave fewer bytes than a record after the last
+    triangle (a byte a transfer appended; numpy-stl reads such files, its own test data has one).  With bytes
+    left over the records must also hold a NUL byte, as binary records do and text never does: a text file
+    whose bytes 80-83 happen to read as a fitting count stays text.
+    """
+    if len(header) < 84:
+        return None
+    count = int(np.frombuffer(header[80:84], dtype="<u4")[0])
+    tail = size - 84 - 50 * count
+    if tail == 0 or (0 < tail < 50 and count > 0 and b"\0" in sample):
+        return count, tail
+    return None
+
+
+def _tail_notes(count: int, tail: int) -> tuple[str, ...]:
+    if not tail:
+        return ()
+    return (
+        f"the binary STL file holds {tail} byte(s) after its last triangle (its header declares {count} triangles, "
+        f"{84 + 50 * count} bytes), too few for another one; they were ignored",
+    )
+
+
+def _not_binary(size: int, count: int | None, solid: bool = False) -> str:
     """Why a file that is not ASCII STL is not binary STL either, with the sizes that disagree."""
     if count is None:
         return f"the STL file is neither ASCII (starting with 'solid') nor binary ({size} bytes, fewer than a binary header's 84)"
     expected = 84 + 50 * count
+    why = "its header begins with 'solid' but it holds binary data, no ASCII facets" if solid else "it does not start with 'solid'"
     if size < expected:
         return (
-            f"the STL file is not ASCII (it does not start with 'solid'), and as binary it declares {count} triangles "
+            f"the STL file is not ASCII ({why}), and as binary it declares {count} triangles "
             f"({expected} bytes) but holds {size}: it is truncated"
         )
     return (
-        f"the STL file is not ASCII (it does not start with 'solid'), and as binary it declares {count} triangles "
+        f"the STL file is not ASCII ({why}), and as binary it declares {count} triangles "
         f"({expected} bytes) but holds {size}, {size - expected} more: cut what follows its last triangle, or export it again"
     )
 
 
-def read_stl_file(fh: BinaryIO, size: int) -> tuple[NDArray[np.float64], NDArray[np.int64]]:
+def read_stl_file(fh: BinaryIO, size: int) -> StlMesh:
     """Like ``read_stl`` for an open file of ``size`` bytes.
 
     A binary file is read in blocks of records straight into the corner
@@ -69,29 +107,29 @@ def read_stl_file(fh: BinaryIO, size: int) -> tuple[NDArray[np.float64], NDArray
     block is read at its own offset (``os.pread``), on the block threads.
     """
     header = fh.read(84)
-    if len(header) == 84:
-        count = int(np.frombuffer(header[80:84], dtype="<u4")[0])
-        if 84 + 50 * count == size:
-            if count == 0:
-                raise EmptyGeometryError("the STL file holds no triangles")
-            corners = np.empty((count, 3, 3), dtype=np.float32)
-            fd = fh.fileno()
+    layout = _binary_layout(header, size, fh.read(_SAMPLE))
+    if layout is not None:
+        count, tail = layout
+        if count == 0:
+            raise EmptyGeometryError("the STL file holds no triangles")
+        corners = np.empty((count, 3, 3), dtype=np.float32)
+        fd = fh.fileno()
 
-            def read_block(start: int) -> None:
-                n = min(_READ_BLOCK, count - start)
-                raw = b""
-                while len(raw) < 50 * n:  # pread may return less; at the end of the file it returns nothing
-                    try:
-                        more = os.pread(fd, 50 * n - len(raw), 84 + 50 * start + len(raw))
-                    except OSError as exc:
-                        raise UnreadableFileError(f"the STL file could not be read: {exc.strerror}") from exc
-                    if not more:
-                        raise UnreadableFileError("the STL file ended before its last triangle; it may be truncated")
-                    raw += more
-                corners[start : start + n] = np.frombuffer(raw, dtype=_RECORD)["vertices"]
+        def read_block(start: int) -> None:
+            n = min(_READ_BLOCK, count - start)
+            raw = b""
+            while len(raw) < 50 * n:  # pread may return less; at the end of the file it returns nothing
+                try:
+                    more = os.pread(fd, 50 * n - len(raw), 84 + 50 * start + len(raw))
+                except OSError as exc:
+                    raise UnreadableFileError(f"the STL file could not be read: {exc.strerror}") from exc
+                if not more:
+                    raise UnreadableFileError("the STL file ended before its last triangle; it may be truncated")
+                raw += more
+            corners[start : start + n] = np.frombuffer(raw, dtype=_RECORD)["vertices"]
 
-            for_each_block(read_block, range(0, count, _READ_BLOCK))
-            return _welded(corners)
+        for_each_block(read_block, range(0, count, _READ_BLOCK))
+        return (*_welded(corners), _tail_notes(count, tail))
     fh.seek(0)
     return read_stl(fh.read())
 
