@@ -25,6 +25,8 @@ import struct
 import numpy as np
 from numpy.typing import NDArray
 
+from ..errors import UnreadableFileError
+
 __all__ = ["PlyFaces", "header_in_order", "read_ascii_ply", "read_binary_ply", "rows_on_their_lines", "uniform_face_rows"]
 
 _TYPES = {
@@ -209,8 +211,8 @@ def rows_on_their_lines(data: bytes) -> bool:
 
     A row wrapped onto the next line, two rows on one line or a blank line among them changes the count of
     lines, unless another such change makes up for it (lines after the last row, which trimesh leaves alone,
-    count too: ``read_ascii_ply`` then declines the file); True for a binary file, or one this module cannot
-    lay out.
+    count too: ``read_ascii_ply`` then declines the file); a file cut short has fewer lines, or a last line
+    shorter than a row.  True for a binary file, or one this module cannot lay out.
     """
     found = _header(data)
     if found is None or found[0] != "ascii":
@@ -220,13 +222,35 @@ def rows_on_their_lines(data: bytes) -> bool:
     body = data[start:].strip()
     newline = b"\n" if b"\n" in body else b"\r"  # \r\n counts as one line break, as trimesh's splitlines has it
     lines = body.count(newline) + 1 if body else 0
-    return lines == rows
+    last = next((props for _, count, props in reversed(elements) if count), None)
+    return lines == rows and (last is None or _fills_one_row(body.rsplit(newline, 1)[-1].split(), last))
+
+
+def _fills_one_row(words: list[bytes], props: list[Property]) -> bool:
+    """Whether ``words`` are one row of an element of ``props``, no more, no fewer (a file cut within its last
+    row still has a line for it)."""
+    at = 0
+    for _, _, counter in props:
+        if counter is None:
+            at += 1
+            continue
+        try:
+            n = int(words[at])
+        except (IndexError, ValueError):
+            return False
+        at += 1 + n
+    return at == len(words)
 
 
 def read_ascii_ply(data: bytes) -> PlyFaces | None:
     """The vertices (x, y, z rounded to their declared types), every face's corners one after another, and
-    the corners per face, of an ASCII PLY file read as numbers separated by white space, whatever its lines;
-    None where the numbers do not fill its elements exactly (the caller's own reading then stands)."""
+    the corners per face, of an ASCII PLY file read as numbers separated by white space, whatever its lines.
+
+    None where the numbers do not fill its elements exactly, as words that are no numbers or numbers left over
+    (the caller's own reading then stands); ``UnreadableFileError`` where they end before the vertex or face
+    rows its header declares: a truncated file, which read row by row gave the rows before the cut as the
+    whole mesh.
+    """
     found = _header(data)
     if found is None or found[0] != "ascii":
         return None
@@ -242,7 +266,10 @@ def read_ascii_ply(data: bytes) -> PlyFaces | None:
     for name, count, props in elements:
         if all(counter is None for _, _, counter in props):  # fixed rows: one reshape
             width = len(props)
-            if width == 0 or at + width * count > len(numbers):
+            if width == 0:
+                return None
+            if at + width * count > len(numbers):
+                _refuse_if_cut(name, count, (len(numbers) - at) // width, _geometry_read(name, vertices, counts))
                 return None
             rows = numbers[at : at + width * count].reshape(count, width)
             at += width * count
@@ -256,23 +283,47 @@ def read_ascii_ply(data: bytes) -> PlyFaces | None:
                     )
             continue
         keep = "vertex_indices" if any(p == "vertex_indices" for p, _, _ in props) else "vertex_index"
-        for _ in range(count):
+        for row in range(count):
             for prop, _, counter in props:
                 if counter is None:
                     at += 1
                     continue
                 if at >= len(numbers):
+                    _refuse_if_cut(name, count, row, _geometry_read(name, vertices, counts))
                     return None
                 n = numbers[at]
-                if not (n.is_integer() and 0 <= n <= len(numbers) - at - 1):
+                if not (n.is_integer() and n >= 0):
+                    return None
+                if n > len(numbers) - at - 1:
+                    _refuse_if_cut(name, count, row, _geometry_read(name, vertices, counts))
                     return None
                 if name == "face" and prop == keep:
                     corners.append(numbers[at + 1 : at + 1 + int(n)])
                     counts.append(int(n))
                 at += 1 + int(n)
+        if at > len(numbers):  # the last row's scalars ran past the end
+            _refuse_if_cut(name, count, count - 1, _geometry_read(name, vertices, counts))
+            return None
     if vertices is None or not counts or at != len(numbers):
         return None
     flat = np.concatenate(corners)
     if not np.all(flat == np.round(flat)):  # an index that is no integer
         return None
     return vertices, flat.astype(np.int64), np.asarray(counts, dtype=np.int64)
+
+
+def _geometry_read(element: str, vertices: NDArray[np.float64] | None, counts: list[int]) -> bool:
+    """Whether the vertex and face rows were all read before ``element``'s, which the numbers did not fill."""
+    return element not in ("vertex", "face") and vertices is not None and bool(counts)
+
+
+def _refuse_if_cut(element: str, declared: int, whole: int, geometry_read: bool) -> None:
+    """Where the numbers end before the rows an element declares: nothing to say if the vertices and faces were
+    all read before it (an element the geometry does not need, left to trimesh's reading as before), else the
+    file is refused as truncated."""
+    if geometry_read:
+        return
+    raise UnreadableFileError(
+        f"the ASCII PLY file ends after {whole} of the {declared} '{element}' rows its header declares: it is "
+        "truncated, or its header's count is wrong; export it again"
+    )
