@@ -161,8 +161,11 @@ def read_trimesh_parts(
         notes += cut + placed
     if fmt == "ply":  # what trimesh's reader would misread: a header out of its order, binary faces of mixed
         # sizes, ASCII rows not each on a line of their own
-        from .ply import header_in_order, read_ascii_ply, rows_on_their_lines, uniform_face_rows
+        from .ply import header_fault, header_in_order, read_ascii_ply, rows_on_their_lines, uniform_face_rows
 
+        problem = header_fault(data)
+        if problem is not None:
+            raise UnreadableFileError(problem, format=fmt)
         data = guarded_read(partial(header_in_order, data), fmt)
         if not guarded_read(partial(uniform_face_rows, data), fmt):
             own = _own_ply(data, length_scale)

@@ -27,7 +27,15 @@ from numpy.typing import NDArray
 
 from ..errors import UnreadableFileError
 
-__all__ = ["PlyFaces", "header_in_order", "read_ascii_ply", "read_binary_ply", "rows_on_their_lines", "uniform_face_rows"]
+__all__ = [
+    "PlyFaces",
+    "header_fault",
+    "header_in_order",
+    "read_ascii_ply",
+    "read_binary_ply",
+    "rows_on_their_lines",
+    "uniform_face_rows",
+]
 
 _TYPES = {
     "char": "b",
@@ -77,6 +85,43 @@ def header_in_order(data: bytes) -> bytes:
         return data  # in order already (or no single format line: the reader says what is wrong)
     header = [lines[0], formats[0], *(line for line in keep if line is not formats[0])]
     return b"\n".join([*header, b"end_header\n"]) + data[end.end() :]
+
+
+# type names a reader may meet: the format's (Turk), their sized aliases, and the 64-bit and half types trimesh
+# also reads
+_KNOWN_TYPES = frozenset(_TYPES) | {"int64", "uint64", "float16"}
+
+
+def header_fault(data: bytes) -> str | None:
+    """What makes a PLY file's header unreadable, in a sentence a person can act on; None where nothing does
+    (the readers take it from there).  Without this the reader's own ``KeyError`` named a type ('bool') or a run
+    of header bytes as "an entry the format requires is missing"."""
+    if not data.startswith(b"ply"):
+        return None
+    found = _END.search(data)
+    if found is None:
+        if b"end_header" in data:
+            return None  # the word at the very end, or mid-line: the readers say what they make of it
+        return "the PLY file's header has no 'end_header' line: the file is cut short, corrupt or not PLY; export it again"
+    for line in data[: found.start()].decode("ascii", "replace").splitlines():
+        words = line.split()
+        if words[:1] != ["property"]:
+            continue
+        types = words[2:4] if words[1:2] == ["list"] else words[1:2]
+        unknown = next((t for t in types if t not in _KNOWN_TYPES), None)
+        if unknown is not None or len(words) < len(types) + 2 + (words[1:2] == ["list"]):
+            shown = line.strip()[:80]
+            why = (
+                f"the type {unknown[:20]!r}, which is no PLY type"
+                if unknown is not None
+                else "no type and name as the format writes them"
+            )
+            return (
+                f"the PLY file's header line {shown!r} gives {why} (PLY types: char, uchar, short, ushort, int, uint, "
+                "float, double, or int8 to float64); the file is corrupt, or its writer used a type PLY readers do "
+                "not know: export it again"
+            )
+    return None
 
 
 def uniform_face_rows(data: bytes) -> bool:
