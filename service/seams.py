@@ -13,6 +13,12 @@ that cluster is not merged at all.  The merged polyhedron is a polyhedron in
 its own right, with the coordinates of the kept vertices, and every integral
 of it is exact; what moved, and by how much at most, is reported.
 
+A surface may also be closed as drawn but not along its edges: a corner of
+one face lies in the middle of its neighbour's side (a T-junction), so the
+neighbour's long edge and the two short ones beside it are each used once.
+``close_t_junctions`` closes such a surface with flat slivers when every open
+edge is matched that way, and with nothing else.
+
 A file may also split one closed surface into parts that are open each (OBJ
 ``g``/``o`` groups, glTF primitives): ``join_open_parts`` finds the sets of
 open parts that share their open edges and whose union is closed, and makes
@@ -21,6 +27,7 @@ each such set one body.
 
 from __future__ import annotations
 
+import itertools
 from dataclasses import dataclass
 
 import numpy as np
@@ -30,7 +37,16 @@ from .body import MeshBody, Part
 from .tolerances import DEFAULT_TOLERANCES, Tolerances
 from .topology import face_components, surface_topology, weld
 
-__all__ = ["SEAM_STEPS", "SeamMerge", "merge_seams", "close_pairs", "open_edge_vertices", "join_open_parts"]
+__all__ = [
+    "SEAM_STEPS",
+    "SeamMerge",
+    "TJunctions",
+    "close_pairs",
+    "close_t_junctions",
+    "join_open_parts",
+    "merge_seams",
+    "open_edge_vertices",
+]
 
 
 @dataclass(frozen=True, slots=True)
@@ -269,3 +285,84 @@ def join_open_parts(parts: list[Part], tolerances: Tolerances = DEFAULT_TOLERANC
         return parts, []
     out = [joined.get(i, p) for i, p in enumerate(parts) if i not in drop]
     return out, warnings
+
+
+@dataclass(frozen=True, slots=True)
+class TJunctions:
+    """The outcome of ``close_t_junctions``.
+
+    faces : the faces with the slivers appended (vertices are unchanged).
+    vertices_on_edges : how many times a vertex was found inside another face's edge.
+    largest_offset : the largest distance of such a vertex from the edge, over the edge's length.
+    """
+
+    faces: NDArray[np.int64]
+    vertices_on_edges: int
+    largest_offset: float
+
+    def warning(self) -> str:
+        offset = "exactly on it" if self.largest_offset == 0 else f"at most {self.largest_offset:.2g} of its length off it"
+        return (
+            f"{self.vertices_on_edges} T-junction(s) closed: a corner of one face lies in the middle of its neighbour's "
+            f"edge ({offset}), which left the surface open along those edges though it is closed as drawn; each was "
+            "closed with a flat sliver, and the results are those of the closed surface"
+        )
+
+
+_T_PAIRS_MAX = 20_000_000  # open edges times open-edge vertices tested; beyond it the surface is refused as open
+
+
+def close_t_junctions(
+    vertices: NDArray[np.float64], faces: NDArray[np.int64], tolerances: Tolerances = DEFAULT_TOLERANCES
+) -> TJunctions | None:
+    """Close a surface whose only open edges meet at T-junctions; None where any open edge is left unmatched.
+
+    Each open edge a -> b is split at the vertices of open edges that lie on it (within
+    ``Tolerances.t_junction_rel`` of its length, and that far from both ends), in order along it.  If the
+    pieces of all open edges then pair up, each u -> v with a v -> u, the surface is closed as drawn, and
+    the fan (b, a, t1), (b, t1, t2), ... of each split edge closes it along its edges too: the first sliver
+    pairs with a -> b, and the pieces' partners, b -> tk, ..., t1 -> a, pair with the fan's outer edges.
+    """
+    directed = np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]])
+    n = len(vertices)
+    undirected = np.minimum(directed[:, 0], directed[:, 1]) * n + np.maximum(directed[:, 0], directed[:, 1])
+    _, inverse, counts = np.unique(undirected, return_inverse=True, return_counts=True)
+    edges = directed[counts[inverse] == 1]
+    if len(edges) == 0:
+        return None
+    points = np.unique(edges)
+    if len(edges) * len(points) > _T_PAIRS_MAX:
+        return None
+    tol = tolerances.t_junction_rel
+    a, b = vertices[edges[:, 0]], vertices[edges[:, 1]]
+    along = b - a
+    length2 = np.einsum("ij,ij->i", along, along)
+    chunk = max(1, _T_PAIRS_MAX // (8 * len(points)))
+    hits: list[tuple[int, int, float, float]] = []  # (edge, vertex, position along it, offset over its length)
+    for start in range(0, len(edges), chunk):
+        stop = min(start + chunk, len(edges))
+        rel = vertices[points][None, :, :] - a[start:stop, None, :]
+        s = np.einsum("epk,ek->ep", rel, along[start:stop]) / length2[start:stop, None]
+        off2 = np.einsum("epk,epk->ep", rel, rel) / length2[start:stop, None] - s * s
+        on = (s > tol) & (s < 1 - tol) & (off2 <= tol * tol)
+        on &= points[None, :] != edges[start:stop, 0:1]
+        on &= points[None, :] != edges[start:stop, 1:2]
+        for e, p in zip(*np.nonzero(on), strict=True):
+            hits.append((start + int(e), int(points[p]), float(s[e, p]), float(np.sqrt(max(off2[e, p], 0.0)))))
+    if not hits:
+        return None
+    inner: dict[int, list[tuple[float, int]]] = {}
+    for e, p, s_ep, _ in hits:
+        inner.setdefault(e, []).append((s_ep, p))
+    pieces: list[tuple[int, int]] = []
+    slivers: list[tuple[int, int, int]] = []
+    for e, (u, v) in enumerate(edges.tolist()):
+        chain = [u, *(p for _, p in sorted(inner.get(e, []))), v]
+        pieces += list(itertools.pairwise(chain))
+        slivers += [(v, chain[k], chain[k + 1]) for k in range(len(chain) - 2)]
+    forward = np.array([u * n + v for u, v in pieces], dtype=np.int64)
+    backward = np.array([v * n + u for u, v in pieces], dtype=np.int64)
+    if not np.array_equal(np.sort(forward), np.sort(backward)):
+        return None
+    closed = np.concatenate([faces, np.array(slivers, dtype=faces.dtype).reshape(-1, 3)])
+    return TJunctions(closed, len(hits), max(off for *_, off in hits))

@@ -108,6 +108,14 @@ def oriented_surface(body: MeshBody) -> OrientedSurface:
             topo = surface_topology(faces, len(vertices))
             warnings.append(seams.warning())
     if topo.open_edges:
+        from .seams import close_t_junctions
+
+        junctions = close_t_junctions(vertices, faces)
+        if junctions is not None:
+            faces = junctions.faces
+            topo = surface_topology(faces, len(vertices))
+            warnings.append(junctions.warning())
+    if topo.open_edges:
         named = f"part {body.name!r} " if body.name else "mesh "
         raise NotWatertightError(
             f"{named}is not watertight ({topo.open_edges} open edges), so it does not bound a solid; "

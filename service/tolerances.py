@@ -33,6 +33,14 @@ class Tolerances:
     ~1e-16 of the size; 1e-12 is far above that and far below any real
     feature or gap a part can have (a 1 m part: 1 pm)."""
 
+    t_junction_rel: float = 1e-5
+    """A vertex of an open edge lies on another open edge (a T-junction: a corner of one face in the middle of
+    its neighbour's side) when its distance from that edge is at most this times the edge's length, and it is
+    that far from both ends.  Such a surface is closed as drawn, only not along its edges; polyhedra written
+    with six or seven digits (Geomview's samples) put their T-vertices 1e-6 to 3e-6 of the edge off it.  The
+    surface is closed only where every open edge is matched, so this admits nothing but cracks of at most this
+    width, which the closure fills (``seams.close_t_junctions``)."""
+
     jacobi_rel: float = 4 * EPS
     """Off-diagonal entries below this times the geometric mean of their
     diagonal pair are zero in the 3x3 Jacobi eigen-solver (relative accuracy,
