@@ -142,6 +142,7 @@ def test_off_is_read_as_geomview_specifies(text: str) -> None:
         (f"OFF\n4 5 6\n{TET_VERTICES}{TET_FACES}", UnreadableFileError, "ends after 4 of its 5 faces"),
         (f"OFF\n5 4 6\n{TET_VERTICES}{TET_FACES}", UnreadableFileError, "OFF file"),
         (f"4OFF\n4 4 6\n0 0 0 0\n1 0 0 1\n0 1 0 1\n0 0 1 1\n{TET_FACES}", UnreadableFileError, "point at infinity"),
+        (f"4OFF\n4 4 6\n0 0 0 1\n1 0 0 0\n0 1 0 1\n0 0 1 0\n{TET_FACES}", UnreadableFileError, "vertex 1 (counting from 0)"),
         ("OFF\n0 0 0\n", EmptyGeometryError, "declares 0 vertices and 0 faces"),
         (f"OFF\n4 4 6\n{TET_VERTICES}3 0 2 99999999999999999999\n{TET_FACES[8:]}", UnreadableFileError, "99999999999999999999"),
     ],

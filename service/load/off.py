@@ -46,6 +46,10 @@ def _fail(why: str, line_no: int | None = None) -> UnreadableFileError:
     return UnreadableFileError(f"the OFF file {why}{where}; check the file or re-export it", format="off", line=line_no)
 
 
+def _also(more: int) -> str:
+    return f", and {more} more {'vertex' if more == 1 else 'vertices'} like it" if more > 0 else ""
+
+
 def _shown(token: str) -> str:
     """A word of the file as a message quotes it: a binary file's "word" can be megabytes long."""
     return repr(token if len(token) <= 40 else token[:37] + "...")
@@ -124,8 +128,16 @@ def read_off(data: bytes) -> tuple[NDArray[np.float64], NDArray[np.int64], list[
     vertices, corners, counts = _geometry(lines, at, n_vertices, n_faces, coordinates, per_vertex)
     if homogeneous:
         w = vertices[:, 3]
-        if np.any(w == 0) or not np.all(np.isfinite(w)):
-            raise _fail("has a vertex whose homogeneous coordinate w is 0 (a point at infinity)")
+        bad = (w == 0) | ~np.isfinite(w)
+        if np.any(bad):
+            k = int(np.flatnonzero(bad)[0])
+            raise UnreadableFileError(
+                f"the OFF file's vertex {k} (counting from 0) has the homogeneous coordinate w = {float(w[k])!r}, so it is "
+                f"no point in space (w = 0 is a point at infinity){_also(int(np.count_nonzero(bad)) - 1)}; check the "
+                "file or re-export it",
+                format="off",
+                vertex=k,
+            )
         vertices = vertices[:, :3] / w[:, None]
     triangles, _ = fan_triangles(corners, counts)
     if len(triangles) == 0:
