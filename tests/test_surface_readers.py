@@ -31,7 +31,7 @@ from inertia.errors import (
     ZeroVolumeError,
 )
 from inertia.load import load_body
-from inertia.load.ply import read_ascii_ply, rows_on_their_lines, uniform_face_rows
+from inertia.load.ply import read_ascii_ply, uniform_face_rows
 from inertia.load.safe import guarded_read
 from inertia.pipeline import AnalysisOptions, analyze, analyze_loaded
 
@@ -1267,16 +1267,46 @@ def test_an_ascii_ply_is_read_as_numbers_whatever_its_lines(joins: Callable[[int
     # reads one row per line, so a wrapped row or a blank line shifted every row after it: the closed box was
     # refused as "not watertight (8 open edges)"
     data = _ascii_box_ply(joins, newline)
-    assert not rows_on_their_lines(data)
     doc = analyze(data, filename="box.ply").as_dict()
     assert doc["mass"] / doc["density"] == 6.0  # the 1 x 2 x 3 box, exact
     assert doc["center_of_mass"] == pytest.approx([0.5, 1.0, 1.5], rel=1e-15)
     assert doc["principal"]["moments"] == pytest.approx(sorted(6000 * (p + q) / 12 for p, q in ((4, 9), (1, 9), (1, 4))), rel=1e-14)
-    # the same numbers a row per line go through trimesh's reader: the same result, bit for bit
-    assert rows_on_their_lines(_ONE_ROW_PER_LINE)
+    # the same numbers a row per line: the same result, bit for bit
     regular = analyze(_ONE_ROW_PER_LINE, filename="box.ply").as_dict()
     for key in ("mass", "center_of_mass", "inertia_tensor", "principal", "warnings"):
         assert doc[key] == regular[key]
+
+
+def _with_vertex_lists(data: bytes) -> bytes:
+    """``data`` with a list of two texture coordinates after each vertex's z, and its first face row wrapped."""
+    head, body = data.split(b"end_header\n")
+    rows = body.decode().splitlines()
+    rows = [r + " 2 0.25 0.75" for r in rows[:8]] + [rows[8].replace(" ", "\n", 2), *rows[9:]]
+    head = head.replace(b"property float z\n", b"property float z\nproperty list uchar float uv\n")
+    return head + b"end_header\n" + "\n".join(rows).encode() + b"\n"
+
+
+@pytest.mark.parametrize(
+    "variant",
+    [
+        lambda d: d.replace(b"end_header\n", b"end_header\n\n"),  # a blank line before the first row
+        lambda d: d.replace(b"end_header\n", b"end_header\n \t \n"),  # a line of blanks there
+        lambda d: d.replace(b"\n", b"\r"),  # every line ended by a bare CR, the header's too
+        _with_vertex_lists,  # a list property among the vertices' scalars
+        lambda d: d.replace(b"element vertex", b"element note 0\nelement vertex"),  # an empty element, no properties
+    ],
+    ids=["blank-first-line", "blanks-first-line", "cr-only", "vertex-lists", "empty-element"],
+)
+def test_ascii_ply_layouts_trimesh_misread_are_read(variant: Callable[[bytes], bytes]) -> None:
+    doc = analyze(variant(_ONE_ROW_PER_LINE), filename="box.ply").as_dict()
+    assert doc["mass"] / doc["density"] == 6.0  # the 1 x 2 x 3 box, exact
+    assert doc["center_of_mass"] == pytest.approx([0.5, 1.0, 1.5], rel=1e-15)
+
+
+def test_an_ascii_ply_face_corner_that_is_no_whole_number_is_refused() -> None:
+    data = _ONE_ROW_PER_LINE[:-2] + b".5\n"  # the last corner of the last face: 7.5
+    with pytest.raises(UnreadableFileError, match=r"has a face corner \d\.5, which is no vertex number"):
+        analyze(data, filename="box.ply")
 
 
 @settings(max_examples=25, deadline=None)
@@ -1452,6 +1482,7 @@ def test_a_binary_stl_with_fewer_bytes_than_a_record_after_its_triangles_is_read
 def test_a_binary_stl_under_a_solid_header_that_its_size_refuses_says_it_is_binary() -> None:
     from tests.support.meshes import box_stl
 
-    data = b"solid part".ljust(80, b" ") + box_stl(1.0, 2.0, 3.0)[80:]
-    with pytest.raises(UnreadableFileError, match=r"begins with 'solid' but it holds binary data.*holds 734, 50 more"):
-        load_body(data + b"\0" * 50, filename="part.stl")
+    for header in (b"solid part", b"solid facets by a CAD exporter"):  # "facet" in the header: still binary
+        data = header.ljust(80, b" ") + box_stl(1.0, 2.0, 3.0)[80:]
+        with pytest.raises(UnreadableFileError, match=r"begins with 'solid' but it holds binary data.*holds 734, 50 more"):
+            load_body(data + b"\0" * 50, filename="part.stl")

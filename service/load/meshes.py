@@ -160,8 +160,8 @@ def read_trimesh_parts(
             )
         notes += cut + placed
     if fmt == "ply":  # what trimesh's reader would misread: a header out of its order, binary faces of mixed
-        # sizes, ASCII rows not each on a line of their own
-        from .ply import header_fault, header_in_order, read_ascii_ply, rows_on_their_lines, uniform_face_rows
+        # sizes, ASCII rows not each on a line of their own (every ASCII file is read here)
+        from .ply import header_fault, header_in_order, read_ascii_ply, uniform_face_rows
 
         problem = header_fault(data)
         if problem is not None:
@@ -171,10 +171,9 @@ def read_trimesh_parts(
             own = _own_ply(data, length_scale)
             if own is not None:
                 return own, None
-        if not guarded_read(partial(rows_on_their_lines, data), fmt):
-            own = _own_ply(data, length_scale, read_ascii_ply)
-            if own is not None:
-                return own, None
+        own = _own_ply(data, length_scale, read_ascii_ply)  # an ASCII file, read word by word
+        if own is not None:
+            return own, None
     # the upload's own files, and nothing else: a name outside them (a texture that did not come along, a path)
     # is not found, never looked for on disk; images are not needed for the geometry (skip_materials)
     kwargs: dict[str, Any] = {"resolver": trimesh.resolvers.ZipResolver(dict(companions or {}))}

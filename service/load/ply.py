@@ -1,4 +1,4 @@
-"""PLY files that trimesh's reader misreads: binary face lists of more than one length, ASCII rows off their lines.
+"""PLY files read here, not by trimesh: binary face lists of more than one length, and every ASCII file.
 
 trimesh reads a binary element's list property as if every row had the length of
 the first (``trimesh.exchange.ply``), so a file mixing triangles and quads (Rhino's
@@ -11,16 +11,20 @@ end in ``\\r\\n``, ``\\n`` or a bare ``\\r``.
 
 trimesh also reads an ASCII file line by line, one row per line: a row wrapped
 onto a second line, two rows on one line or a blank line between rows shifted
-every row after it (a closed box came back open).  The format's ASCII data is a
-sequence of numbers separated by white space, and its readers (rply, VCG/MeshLab's)
-read it so; ``read_ascii_ply`` walks the numbers in the same way, for the files
-whose rows are not each on a line of their own.
+every row after it (a closed box came back open), and a file cut short gave the
+rows before the cut as the whole mesh.  The format's ASCII data is a sequence of
+numbers separated by white space, and its readers (rply, VCG/MeshLab's) read it
+so; ``read_ascii_ply`` reads the numbers in the same way (in one reshape where
+every row's lists have the first row's lengths, else row by row), and refuses a
+file whose numbers end before its vertex or face rows do.  A file it cannot read
+(no faces, triangle strips, words that are no numbers) goes to trimesh as before.
 """
 
 from __future__ import annotations
 
 import re
 import struct
+import warnings
 
 import numpy as np
 from numpy.typing import NDArray
@@ -33,7 +37,6 @@ __all__ = [
     "header_in_order",
     "read_ascii_ply",
     "read_binary_ply",
-    "rows_on_their_lines",
     "uniform_face_rows",
 ]
 
@@ -251,115 +254,139 @@ def _walk(data: bytes, order: str, elements: list[tuple[str, int, list[Property]
     return vertices, np.asarray(corners, dtype=np.int64), np.asarray(counts, dtype=np.int64)
 
 
-def rows_on_their_lines(data: bytes) -> bool:
-    """Whether an ASCII PLY file has each row of its elements on a line of its own, as trimesh's reader assumes.
-
-    A row wrapped onto the next line, two rows on one line or a blank line among them changes the count of
-    lines, unless another such change makes up for it (lines after the last row, which trimesh leaves alone,
-    count too: ``read_ascii_ply`` then declines the file); a file cut short has fewer lines, or a last line
-    shorter than a row.  True for a binary file, or one this module cannot lay out.
-    """
-    found = _header(data)
-    if found is None or found[0] != "ascii":
-        return True
-    _, elements, start = found
-    rows = sum(count for _, count, _ in elements)
-    body = data[start:].strip()
-    newline = b"\n" if b"\n" in body else b"\r"  # \r\n counts as one line break, as trimesh's splitlines has it
-    lines = body.count(newline) + 1 if body else 0
-    last = next((props for _, count, props in reversed(elements) if count), None)
-    return lines == rows and (last is None or _fills_one_row(body.rsplit(newline, 1)[-1].split(), last))
-
-
-def _fills_one_row(words: list[bytes], props: list[Property]) -> bool:
-    """Whether ``words`` are one row of an element of ``props``, no more, no fewer (a file cut within its last
-    row still has a line for it)."""
-    at = 0
-    for _, _, counter in props:
-        if counter is None:
-            at += 1
-            continue
-        try:
-            n = int(words[at])
-        except (IndexError, ValueError):
-            return False
-        at += 1 + n
-    return at == len(words)
-
-
 def read_ascii_ply(data: bytes) -> PlyFaces | None:
     """The vertices (x, y, z rounded to their declared types), every face's corners one after another, and
     the corners per face, of an ASCII PLY file read as numbers separated by white space, whatever its lines.
 
-    None where the numbers do not fill its elements exactly, as words that are no numbers or numbers left over
-    (the caller's own reading then stands); ``UnreadableFileError`` where they end before the vertex or face
-    rows its header declares: a truncated file, which read row by row gave the rows before the cut as the
-    whole mesh.
+    None where the numbers do not fill its elements exactly (words that are no numbers, numbers left over, a
+    list count that is no count: rows with more values than the header declares, which trimesh reads line by
+    line), or where it has no vertices and faces (the caller's own reading then stands);
+    ``UnreadableFileError`` where they end before the vertex or face rows its header declares (a truncated
+    file, which read row by row gave the rows before the cut as the whole mesh) or where they fill every row
+    but a face corner is no whole number.
     """
     found = _header(data)
     if found is None or found[0] != "ascii":
         return None
     _, elements, start = found
     try:
-        numbers = np.asarray(data[start:].split(), dtype=np.float64)
-    except ValueError:  # a word that is no number
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")  # numpy stops at a word that is no number and warns (or raises)
+            numbers = np.fromstring(data[start:].decode("latin-1"), dtype=np.float64, sep=" ")
+    except (ValueError, DeprecationWarning):
         return None
     vertices: NDArray[np.float64] | None = None
     corners: list[NDArray[np.float64]] = []
-    counts: list[int] = []
+    counts: list[NDArray[np.int64]] = []
     at = 0
     for name, count, props in elements:
-        if all(counter is None for _, _, counter in props):  # fixed rows: one reshape
-            width = len(props)
-            if width == 0:
-                return None
-            if at + width * count > len(numbers):
-                _refuse_if_cut(name, count, (len(numbers) - at) // width, _geometry_read(name, vertices, counts))
-                return None
-            rows = numbers[at : at + width * count].reshape(count, width)
-            at += width * count
-            if name == "vertex":
-                names = [p for p, _, _ in props]
-                if not {"x", "y", "z"} <= set(names):
-                    return None
-                with np.errstate(invalid="ignore", over="ignore"):  # non-finite values are refused later
-                    vertices = np.stack(
-                        [rows[:, names.index(c)].astype(props[names.index(c)][1]).astype(np.float64) for c in "xyz"], axis=1
-                    )
+        if count == 0:
             continue
-        keep = "vertex_indices" if any(p == "vertex_indices" for p, _, _ in props) else "vertex_index"
-        for row in range(count):
-            for prop, _, counter in props:
-                if counter is None:
-                    at += 1
-                    continue
-                if at >= len(numbers):
-                    _refuse_if_cut(name, count, row, _geometry_read(name, vertices, counts))
-                    return None
-                n = numbers[at]
-                if not (n.is_integer() and n >= 0):
-                    return None
-                if n > len(numbers) - at - 1:
-                    _refuse_if_cut(name, count, row, _geometry_read(name, vertices, counts))
-                    return None
-                if name == "face" and prop == keep:
-                    corners.append(numbers[at + 1 : at + 1 + int(n)])
-                    counts.append(int(n))
-                at += 1 + int(n)
-        if at > len(numbers):  # the last row's scalars ran past the end
-            _refuse_if_cut(name, count, count - 1, _geometry_read(name, vertices, counts))
+        names = [p for p, _, _ in props]
+        if not props or (name == "vertex" and not {"x", "y", "z"} <= set(names)):
             return None
+        keep = "vertex_indices" if "vertex_indices" in names else "vertex_index"
+        want = [names.index(c) for c in "xyz"] if name == "vertex" else []
+        listed = names.index(keep) if name == "face" and keep in names else None
+        geometry_read = name not in ("vertex", "face") and vertices is not None and bool(counts)
+        rows = _uniform_rows(numbers, at, count, props, want, listed)
+        if rows is None:
+            rows = _walked_rows(numbers, at, count, props, want, listed, name, geometry_read)
+        if rows is None:
+            return None
+        at, picked, element_corners, element_counts = rows
+        if name == "vertex":
+            with np.errstate(invalid="ignore", over="ignore"):  # non-finite values are refused later
+                vertices = np.stack([picked[:, k].astype(props[j][1]).astype(np.float64) for k, j in enumerate(want)], axis=1)
+        if listed is not None:
+            corners.append(element_corners)
+            counts.append(element_counts)
     if vertices is None or not counts or at != len(numbers):
         return None
     flat = np.concatenate(corners)
-    if not np.all(flat == np.round(flat)):  # an index that is no integer
+    fractional = flat != np.round(flat)
+    if np.any(fractional):
+        raise UnreadableFileError(
+            f"the ASCII PLY file has a face corner {float(flat[np.argmax(fractional)])!r}, which is no vertex number; "
+            "fix that face or export the file again",
+            format="ply",
+        )
+    return vertices, flat.astype(np.int64), np.concatenate(counts)
+
+
+# what one element's rows give: the position after them, the wanted scalars (rows, len(want)), and the corners
+# and corner counts of the listed property
+Rows = tuple[int, NDArray[np.float64], NDArray[np.float64], NDArray[np.int64]]
+
+
+def _uniform_rows(
+    numbers: NDArray[np.float64], at: int, count: int, props: list[Property], want: list[int], listed: int | None
+) -> Rows | None:
+    """The rows in one reshape where each list has the same length in every row as in the first (the usual
+    file: scalars only, or faces of one size); None where they do not, or the first row cannot be laid out."""
+    offsets, heads, width = [], [], 0
+    for _, _, counter in props:
+        offsets.append(width)
+        if counter is None:
+            width += 1
+            continue
+        if at + width >= len(numbers):
+            return None
+        n = numbers[at + width]
+        if not (n.is_integer() and n >= 0):
+            return None
+        heads.append((width, n))
+        width += 1 + int(n)
+    if at + width * count > len(numbers):
         return None
-    return vertices, flat.astype(np.int64), np.asarray(counts, dtype=np.int64)
+    table = numbers[at : at + width * count].reshape(count, width)
+    if any(not np.all(table[:, col] == n) for col, n in heads):
+        return None
+    picked = table[:, [offsets[j] for j in want]]
+    if listed is None:
+        return at + width * count, picked, np.empty(0), np.empty(0, dtype=np.int64)
+    n = int(table[0, offsets[listed]])
+    corners = table[:, offsets[listed] + 1 : offsets[listed] + 1 + n].ravel()
+    return at + width * count, picked, corners, np.full(count, n, dtype=np.int64)
 
 
-def _geometry_read(element: str, vertices: NDArray[np.float64] | None, counts: list[int]) -> bool:
-    """Whether the vertex and face rows were all read before ``element``'s, which the numbers did not fill."""
-    return element not in ("vertex", "face") and vertices is not None and bool(counts)
+def _walked_rows(
+    numbers: NDArray[np.float64],
+    at: int,
+    count: int,
+    props: list[Property],
+    want: list[int],
+    listed: int | None,
+    element: str,
+    geometry_read: bool,
+) -> Rows | None:
+    """The rows one by one, each list by its own count; None where a count is no count, or where the numbers
+    end in an element the geometry does not need after the vertices and faces; else a cut is refused."""
+    picked = np.empty((count, len(want)))
+    corners: list[NDArray[np.float64]] = []
+    sizes = np.empty(count if listed is not None else 0, dtype=np.int64)
+    total = len(numbers)
+    for row in range(count):
+        for j, (_, _, counter) in enumerate(props):
+            if at >= total:
+                _refuse_if_cut(element, count, row, geometry_read)
+                return None
+            if counter is None:
+                if j in want:
+                    picked[row, want.index(j)] = numbers[at]
+                at += 1
+                continue
+            n = numbers[at]
+            if not (n.is_integer() and n >= 0):
+                return None
+            if at + 1 + n > total:
+                _refuse_if_cut(element, count, row, geometry_read)
+                return None
+            if j == listed:
+                corners.append(numbers[at + 1 : at + 1 + int(n)])
+                sizes[row] = int(n)
+            at += 1 + int(n)
+    return at, picked, (np.concatenate(corners) if corners else np.empty(0)), sizes
 
 
 def _refuse_if_cut(element: str, declared: int, whole: int, geometry_read: bool) -> None:
@@ -370,5 +397,6 @@ def _refuse_if_cut(element: str, declared: int, whole: int, geometry_read: bool)
         return
     raise UnreadableFileError(
         f"the ASCII PLY file ends after {whole} of the {declared} '{element}' rows its header declares: it is "
-        "truncated, or its header's count is wrong; export it again"
+        "truncated, or its header's count is wrong; export it again",
+        format="ply",
     )

@@ -48,7 +48,7 @@ def read_stl(data: bytes | memoryview) -> StlMesh:
     if head[:5].lower() == b"solid":  # the keywords are lower case, but older CAD tools write them in capitals
         try:
             return (*_ascii(bytes(buf).removeprefix(b"\xef\xbb\xbf")), ())
-        except EmptyGeometryError:
+        except (EmptyGeometryError, UnreadableFileError):  # no facets, or "facets without vertices"
             if declared is None or b"\0" not in bytes(buf[84 : 84 + _SAMPLE]):
                 raise
             # binary records behind a header that begins with "solid" (SolidWorks and others write such headers)
