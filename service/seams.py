@@ -82,8 +82,20 @@ class SeamMerge:
 def open_edge_vertices(faces: NDArray[np.int64]) -> NDArray[np.int64]:
     """Indices of the vertices on edges used by exactly one face."""
     edges = np.sort(np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]]), axis=1)
-    unique, counts = np.unique(edges, axis=0, return_counts=True)
-    return np.unique(unique[counts == 1])
+    n = int(faces.max()) + 1 if len(faces) else 1
+    keys = np.sort(edges[:, 0] * n + edges[:, 1])  # one integer per edge: a 1-D sort
+    once = keys[_single(keys)]
+    return np.unique(np.concatenate([once // n, once % n]))
+
+
+def _single(ordered: NDArray[np.int64]) -> NDArray[np.bool_]:
+    """Which entries of a sorted array occur once (a sort and two comparisons: numpy's ``unique`` with counts
+    hashes, several times slower on millions of edges)."""
+    repeat = ordered[1:] == ordered[:-1]
+    single = np.ones(len(ordered), dtype=bool)
+    single[1:] &= ~repeat
+    single[:-1] &= ~repeat
+    return single
 
 
 _SWEEP = np.array([0.8017837257372732, 0.5345224838248488, 0.2672612419124244])  # (3, 2, 1)/sqrt(14)
@@ -309,7 +321,8 @@ class TJunctions:
         )
 
 
-_T_PAIRS_MAX = 20_000_000  # open edges times open-edge vertices tested; beyond it the surface is refused as open
+_T_PAIRS_MAX = 50_000_000  # (open edge, vertex) pairs tested; beyond it the surface is refused as open
+_T_CHUNK = 1 << 20  # pairs tested at a time
 
 
 def close_t_junctions(
@@ -326,29 +339,39 @@ def close_t_junctions(
     directed = np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]])
     n = len(vertices)
     undirected = np.minimum(directed[:, 0], directed[:, 1]) * n + np.maximum(directed[:, 0], directed[:, 1])
-    _, inverse, counts = np.unique(undirected, return_inverse=True, return_counts=True)
-    edges = directed[counts[inverse] == 1]
+    order = np.argsort(undirected)
+    edges = directed[order[_single(undirected[order])]]
     if len(edges) == 0:
         return None
     points = np.unique(edges)
-    if len(edges) * len(points) > _T_PAIRS_MAX:
-        return None
     tol = tolerances.t_junction_rel
     a, b = vertices[edges[:, 0]], vertices[edges[:, 1]]
     along = b - a
     length2 = np.einsum("ij,ij->i", along, along)
-    chunk = max(1, _T_PAIRS_MAX // (8 * len(points)))
+    # candidates by a sweep along one oblique direction: a point on an edge projects between its ends' projections
+    # (widened by the tolerance), so each edge tests only the points of that slice, found by binary search
+    proj = vertices[points] @ _SWEEP
+    order = np.argsort(proj, kind="stable")
+    ranked = proj[order]
+    pa, pb = a @ _SWEEP, b @ _SWEEP
+    slack = tol * np.sqrt(length2)
+    first = np.searchsorted(ranked, np.minimum(pa, pb) - slack, side="left")
+    last = np.searchsorted(ranked, np.maximum(pa, pb) + slack, side="right")
+    sizes = last - first
+    if int(sizes.sum()) > _T_PAIRS_MAX:
+        return None
+    edge_of = np.repeat(np.arange(len(edges)), sizes)
+    rank = np.arange(len(edge_of)) - np.repeat(np.cumsum(sizes) - sizes, sizes) + np.repeat(first, sizes)
+    point_of = points[order[rank]]
     hits: list[tuple[int, int, float, float]] = []  # (edge, vertex, position along it, offset over its length)
-    for start in range(0, len(edges), chunk):
-        stop = min(start + chunk, len(edges))
-        rel = vertices[points][None, :, :] - a[start:stop, None, :]
-        s = np.einsum("epk,ek->ep", rel, along[start:stop]) / length2[start:stop, None]
-        off2 = np.einsum("epk,epk->ep", rel, rel) / length2[start:stop, None] - s * s
-        on = (s > tol) & (s < 1 - tol) & (off2 <= tol * tol)
-        on &= points[None, :] != edges[start:stop, 0:1]
-        on &= points[None, :] != edges[start:stop, 1:2]
-        for e, p in zip(*np.nonzero(on), strict=True):
-            hits.append((start + int(e), int(points[p]), float(s[e, p]), float(np.sqrt(max(off2[e, p], 0.0)))))
+    for start in range(0, len(edge_of), _T_CHUNK):
+        ei, pi = edge_of[start : start + _T_CHUNK], point_of[start : start + _T_CHUNK]
+        rel = vertices[pi] - a[ei]
+        s_ep = np.einsum("ij,ij->i", rel, along[ei]) / length2[ei]
+        off2 = np.einsum("ij,ij->i", rel, rel) / length2[ei] - s_ep * s_ep
+        on = (s_ep > tol) & (s_ep < 1 - tol) & (off2 <= tol * tol) & (pi != edges[ei, 0]) & (pi != edges[ei, 1])
+        for k in np.flatnonzero(on):
+            hits.append((int(ei[k]), int(pi[k]), float(s_ep[k]), float(np.sqrt(max(off2[k], 0.0)))))
     if not hits:
         return None
     inner: dict[int, list[tuple[float, int]]] = {}
