@@ -408,3 +408,24 @@ def test_t_junctions_are_not_closed_when_another_open_edge_has_no_partner() -> N
     v, f = _t_junction_box()
     with pytest.raises(NotWatertightError, match=r"not watertight \(9 open edges\)"):
         analyze(_obj(v, f[[k for k in range(len(f)) if k != 0]]), filename="t.obj")  # a bottom triangle gone
+
+
+def test_a_fine_top_meeting_single_quad_sides_is_closed_at_every_t_junction() -> None:
+    # the unit cube whose top is an n x n grid and whose sides and bottom are one quad each: 4 (n - 1) corners of
+    # the grid lie inside the sides' top edges
+    n = 20
+    xs = np.linspace(0.0, 1.0, n + 1)
+    gx, gy = np.meshgrid(xs, xs, indexing="ij")
+    top = np.stack([gx.ravel(), gy.ravel(), np.ones(gx.size)], axis=1)
+    idx = np.arange((n + 1) ** 2).reshape(n + 1, n + 1)
+    a, b, c, d = idx[:-1, :-1].ravel(), idx[1:, :-1].ravel(), idx[1:, 1:].ravel(), idx[:-1, 1:].ravel()
+    grid = np.concatenate([np.stack([a, b, c], axis=1), np.stack([a, c, d], axis=1)])
+    o = len(top)  # the bottom's corners (0,0,0), (1,0,0), (1,1,0), (0,1,0) follow the grid
+    t00, tn0, tnn, t0n = idx[0, 0], idx[n, 0], idx[n, n], idx[0, n]
+    rest = [[o, o + 2, o + 1], [o, o + 3, o + 2], [o, o + 1, tn0], [o, tn0, t00], [o + 1, o + 2, tnn], [o + 1, tnn, tn0]]
+    rest += [[o + 2, o + 3, t0n], [o + 2, t0n, tnn], [o + 3, o, t00], [o + 3, t00, t0n]]
+    v = np.concatenate([top, [[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]]])
+    doc = analyze(triangles_stl_bytes(v[np.concatenate([grid, rest])]), filename="grid.stl").as_dict()
+    assert doc["volume"] == pytest.approx(1.0, rel=1e-15)
+    assert doc["center_of_mass"] == pytest.approx([0.5, 0.5, 0.5], rel=1e-15)
+    assert any(w.startswith(f"{4 * (n - 1)} T-junction(s) closed") for w in doc["warnings"])
