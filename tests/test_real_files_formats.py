@@ -296,3 +296,50 @@ def test_gltf_primitives_have_the_same_part_names_on_every_read() -> None:
     second = analyze(str(path)).as_dict()
     assert first["warnings"] == second["warnings"]
     assert re.findall(r"Cube_\w+", " ".join(first["warnings"]))  # the primitives' parts are named in a warning
+
+
+def test_a_gltf_with_a_byte_order_mark_is_read_as_without_it() -> None:
+    # glTF 2.0 section 3.2 forbids the mark (the validator's json/bom.gltf); trimesh read such a file as the name of
+    # another ("an entry the format requires is missing ('model.gltf')")
+    from inertia.pipeline import analyze
+
+    text = (REAL / "gltf_multi" / "rgb_cube_with_primitives.gltf").read_bytes()
+    plain = analyze(text, filename="cube.gltf").as_dict()
+    marked = analyze(b"\xef\xbb\xbf" + text, filename="cube.gltf").as_dict()
+    for key in ("mass", "center_of_mass", "inertia_tensor", "warnings"):
+        assert marked[key] == plain[key]
+
+
+@pytest.mark.parametrize(
+    "doc",
+    [
+        {"asset": {"version": "2.0"}},
+        {"asset": {"version": "2.0"}, "buffers": [{"byteLength": 4}], "bufferViews": [{"buffer": 0, "byteLength": 4}]},
+        {"asset": {"version": "2.0"}, "images": [{"uri": "data:image/png;base64,"}], "meshes": []},
+    ],
+    ids=["asset-only", "a-buffer-without-uri", "images-only"],
+)
+def test_a_gltf_without_meshes_holds_no_triangles(doc: dict[str, Any]) -> None:
+    # the validator's valid files of buffers, views or images alone: trimesh's KeyError ('accessors', 'uri') had
+    # been read as a missing entry of a broken file
+    import json
+
+    from inertia.errors import EmptyGeometryError
+    from inertia.pipeline import analyze
+
+    with pytest.raises(EmptyGeometryError, match="holds no meshes"):
+        analyze(json.dumps(doc).encode(), filename="scene.gltf")
+
+
+def test_a_glb_longer_than_its_header_says_names_the_extra_bytes() -> None:
+    import json
+    import struct
+
+    from inertia.errors import UnreadableFileError
+
+    chunk = json.dumps({"asset": {"version": "2.0"}}).encode().ljust(32, b" ")  # 52 bytes in all
+    glb = b"glTF" + struct.pack("<II", 2, 12 + 8 + len(chunk)) + struct.pack("<II", len(chunk), 0x4E4F534A) + chunk
+    with pytest.raises(UnreadableFileError, match=r"declares 52 bytes but the file has 53; 1 more byte follows its end"):
+        load_body(glb + b"\0", filename="extra.glb")
+    with pytest.raises(UnreadableFileError, match=r"but the file has 51; it is truncated or corrupt"):
+        load_body(glb[:-1], filename="short.glb")

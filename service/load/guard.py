@@ -468,8 +468,15 @@ def _check_glb(data: bytes, ctx: _Context) -> None:
             version="1.0",
         )
     if length != len(data):
+        extra = len(data) - length
+        state = (
+            "it is truncated or corrupt"
+            if extra < 0
+            else (f"{extra} more bytes follow its end" if extra > 1 else "1 more byte follows its end")
+        )
         raise UnreadableFileError(
-            f"the GLB header declares {length} bytes but the file has {len(data)}; it is truncated or corrupt", format=ctx.fmt
+            f"the GLB header declares {length} bytes but the file has {len(data)}; {state}: export it again",
+            format=ctx.fmt,
         )
     position = 12
     while position + 8 <= len(data):

@@ -136,6 +136,15 @@ def read_trimesh_parts(
     """Parts of a PLY/GLB/glTF file (one per scene node) and the unit it declares."""
     import trimesh
 
+    if fmt == "gltf" and data.startswith(b"\xef\xbb\xbf"):
+        data = data[3:]  # a byte-order mark before the JSON (glTF 2.0 section 3.2 forbids it; trimesh cannot read past it)
+    if fmt in ("gltf", "glb"):
+        doc = _gltf_document(data, fmt)
+        if isinstance(doc, dict) and not doc.get("meshes"):  # a valid file of materials, images or cameras only
+            raise EmptyGeometryError(
+                f"the {fmt.upper()} file holds no meshes, so nothing in it has triangles; a solid needs a triangle mesh",
+                format=fmt,
+            )
     notes = _check_gltf_document(data, fmt) if fmt in ("gltf", "glb") else []
     if fmt in ("gltf", "glb"):  # instances of EXT_mesh_gpu_instancing as nodes, which trimesh draws
         from .fans import fans_as_triangles
@@ -143,7 +152,6 @@ def read_trimesh_parts(
         from .instancing import expand_instances, with_document
         from .quantized import normalized_position_scales, scale_normalized_positions
 
-        doc = _gltf_document(data, fmt)
         cameras = _without_cameras(doc)
         unplaced = _without_positionless(doc)
         original, _ = guarded_read(lambda: fans_as_triangles(doc, data, fmt, companions), fmt)
