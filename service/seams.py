@@ -85,7 +85,15 @@ def open_edge_vertices(faces: NDArray[np.int64]) -> NDArray[np.int64]:
     n = int(faces.max()) + 1 if len(faces) else 1
     keys = np.sort(edges[:, 0] * n + edges[:, 1])  # one integer per edge: a 1-D sort
     once = keys[_single(keys)]
-    return np.unique(np.concatenate([once // n, once % n]))
+    return _distinct(np.concatenate([once // n, once % n]), n)
+
+
+def _distinct(indices: NDArray[np.int64], n: int) -> NDArray[np.int64]:
+    """The distinct values of ``indices`` (all in 0..n-1), in increasing order: ``np.unique`` by a mask of
+    n flags, without a sort (numpy's ``unique`` sorted or hashed each part's millions of indices)."""
+    seen = np.zeros(n, dtype=bool)
+    seen[indices] = True
+    return np.flatnonzero(seen)
 
 
 def _single(ordered: NDArray[np.int64]) -> NDArray[np.bool_]:
@@ -150,7 +158,7 @@ def merge_seams(
     the largest coordinate, the gap their rounding leaves between two writings
     of one point (1e-12 of the size is below a single step there).
     """
-    used = vertices[np.unique(faces)]
+    used = vertices[_distinct(faces.ravel(), len(vertices))]
     diagonal = float(np.linalg.norm(used.max(axis=0) - used.min(axis=0)))
     tol, basis = tolerances.seam_rel * diagonal, "1e-12 of the part's size"
     if coordinate_eps >= 2.0**-24:
@@ -343,7 +351,7 @@ def close_t_junctions(
     edges = directed[order[_single(undirected[order])]]
     if len(edges) == 0:
         return None
-    points = np.unique(edges)
+    points = _distinct(edges.ravel(), n)
     tol = tolerances.t_junction_rel
     a, b = vertices[edges[:, 0]], vertices[edges[:, 1]]
     along = b - a
