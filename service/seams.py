@@ -329,7 +329,7 @@ class TJunctions:
         )
 
 
-_T_PAIRS_MAX = 50_000_000  # (open edge, vertex) pairs tested; beyond it the surface is refused as open
+_T_PAIRS_MAX = 10_000_000  # (open edge, vertex) candidate pairs (three int64 arrays of them); beyond, refused as open
 _T_CHUNK = 1 << 20  # pairs tested at a time
 
 
