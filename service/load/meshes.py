@@ -138,14 +138,15 @@ def read_trimesh_parts(
 
     if fmt == "gltf" and data.startswith(b"\xef\xbb\xbf"):
         data = data[3:]  # a byte-order mark before the JSON (glTF 2.0 section 3.2 forbids it; trimesh cannot read past it)
+    notes: list[str] = []
     if fmt in ("gltf", "glb"):
-        doc = _gltf_document(data, fmt)
+        doc = _gltf_document(data, fmt)  # parsed once: the checks read it, the rewrites below change it
+        notes = _check_gltf_document(doc, fmt)
         if isinstance(doc, dict) and not doc.get("meshes"):  # a valid file of materials, images or cameras only
             raise EmptyGeometryError(
                 f"the {fmt.upper()} file holds no meshes, so nothing in it has triangles; a solid needs a triangle mesh",
                 format=fmt,
             )
-    notes = _check_gltf_document(data, fmt) if fmt in ("gltf", "glb") else []
     if fmt in ("gltf", "glb"):  # instances of EXT_mesh_gpu_instancing as nodes, which trimesh draws
         from .fans import fans_as_triangles
         from .gltf_indices import checked_indices
@@ -428,7 +429,7 @@ def _gltf_document(data: bytes, fmt: str) -> Any:
         return None  # the reader reports a malformed document in its own words
 
 
-def _check_gltf_document(data: bytes, fmt: str) -> list[str]:
+def _check_gltf_document(doc: Any, fmt: str) -> list[str]:
     """Refuse what trimesh's glTF reader would read as other geometry than the file's; notes on what is left out.
 
     glTF 2.0 specification: required extensions that change the geometry
@@ -439,9 +440,9 @@ def _check_gltf_document(data: bytes, fmt: str) -> list[str]:
     weights (section 3.7.2.2) and node hierarchies that are not trees
     (section 3.5.2) are refused with a sentence; triangle fans (mode 6) are
     rewritten as triangles (``fans``); point and line primitives
-    (modes 0-3) hold no volume and are left out with a note.
+    (modes 0-3) hold no volume and are left out with a note.  ``doc``: the parsed JSON (``_gltf_document``),
+    which this only reads.
     """
-    doc = _gltf_document(data, fmt)
     if not isinstance(doc, dict):
         return []
 
