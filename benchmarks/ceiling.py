@@ -2,6 +2,7 @@
 
     python -m benchmarks.ceiling                          # --workers 1,2,4,8,16, prints a markdown table
     python -m benchmarks.ceiling --workers 1,2 --out /tmp/ceiling.md
+    python -m benchmarks.ceiling --pinned                 # adds the pinned probe below
 
 For each job it forks N processes from one that has imported and warmed the
 pipeline (as the batch command's forkserver has), lets them go at once, and
@@ -21,6 +22,13 @@ Jobs, each about a second on one core:
   large data set's);
 - ``memory``: numpy ``argsort`` of 4e6 doubles (32 MB), bound by memory
   bandwidth like the weld's sorts.
+
+``--pinned`` adds a probe of what the processors share, with the pure-Python
+job pinned by ``sched_setaffinity``: one process alone on CPU 0, then pairs
+on CPU 0 and CPU j for every other j (two hardware threads of one core slow
+each other, two cores do not), then groups of 1, 2, 4, 8 and all CPUs, each
+process on a CPU of its own (a clock that falls as more cores are busy, or
+a host that gives its virtual CPUs fewer cores than it shows, slows them).
 
 Numeric libraries run on one thread and the pipeline's block threads are
 off, as in each batch worker.  The table's head gives the processor's
@@ -75,7 +83,11 @@ def _memory_job() -> Callable[[], None]:
     return job
 
 
-def _worker(job: Callable[[], None], gate: multiprocessing.synchronize.Event, times: Any, slot: int) -> None:
+def _worker(
+    job: Callable[[], None], gate: multiprocessing.synchronize.Event, times: Any, slot: int, cpu: int | None = None
+) -> None:
+    if cpu is not None:
+        os.sched_setaffinity(0, {cpu})
     gate.wait()
     times[2 * slot] = time.perf_counter()
     job()
@@ -88,14 +100,17 @@ class Timing:
     own_s: float  # the slowest process's own time for its job
 
 
-def timed(job: Callable[[], None], n: int, rounds: int) -> Timing:
-    """Best, over ``rounds``, of ``n`` forked processes running ``job`` once each, from their release."""
+def timed(job: Callable[[], None], n: int, rounds: int, cpus: list[int] | None = None) -> Timing:
+    """Best, over ``rounds``, of ``n`` forked processes running ``job`` once each, from their release.
+
+    With ``cpus`` (n of them), process i runs on ``cpus[i]`` alone.
+    """
     ctx = multiprocessing.get_context("fork")
     best = Timing(float("inf"), float("inf"))
     for _ in range(rounds):
         gate = ctx.Event()
         times = ctx.Array("d", 2 * n, lock=False)
-        procs = [ctx.Process(target=_worker, args=(job, gate, times, i)) for i in range(n)]
+        procs = [ctx.Process(target=_worker, args=(job, gate, times, i, cpus[i] if cpus else None)) for i in range(n)]
         for p in procs:
             p.start()
         time.sleep(0.2 + 0.02 * n)  # every child is waiting at the gate
@@ -109,6 +124,34 @@ def timed(job: Callable[[], None], n: int, rounds: int) -> Timing:
         if wall < best.wall_s:
             best = Timing(wall, max(b - a for a, b in zip(times[0::2], times[1::2], strict=True)))
     return best
+
+
+def pinned_probe(rounds: int) -> list[str]:
+    """Markdown lines: the pure-Python job pinned alone, in pairs with CPU 0, and in groups of distinct CPUs."""
+    cpus = sorted(os.sched_getaffinity(0))
+    first = timed(_python_job, 1, rounds, [cpus[0]])
+    alone = first.own_s
+    lines = [
+        "",
+        f"Pinned pure-Python job (best of {rounds}); alone on CPU {cpus[0]}: {alone:.3f} s. Slowdown = the slower"
+        " process's time over that.",
+        "",
+        f"| CPUs busy with CPU {cpus[0]} | " + " | ".join(str(c) for c in cpus[1:]) + " |",
+        "|---|" + "---:|" * (len(cpus) - 1),
+        "| slowdown of the pair | "
+        + " | ".join(f"{timed(_python_job, 2, rounds, [cpus[0], c]).own_s / alone:.2f}" for c in cpus[1:])
+        + " |",
+    ]
+    sizes = [k for k in (1, 2, 4, 8, 16, 32, 64) if k < len(cpus)] + [len(cpus)]
+    groups = {k: first if k == 1 else timed(_python_job, k, rounds, cpus[:k]) for k in sizes}
+    lines += [
+        "",
+        "| processes, each on its own CPU (the first k) | " + " | ".join(str(k) for k in sizes) + " |",
+        "|---|" + "---:|" * len(sizes),
+        "| slowdown of the slowest | " + " | ".join(f"{groups[k].own_s / alone:.2f}" for k in sizes) + " |",
+        "| speed-up (k t(1) / t(k)) | " + " | ".join(f"{k * groups[1].wall_s / groups[k].wall_s:.2f}x" for k in sizes) + " |",
+    ]
+    return lines
 
 
 def topology() -> str:
@@ -135,6 +178,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--workers", default="1,2,4,8,16", help="comma-separated process counts (default 1,2,4,8,16)")
     parser.add_argument("--rounds", type=int, default=2, help="rounds per count; the best counts")
     parser.add_argument("--out", default="-", help="markdown file to write ('-' for stdout)")
+    parser.add_argument("--pinned", action="store_true", help="add the pinned probe: pairs with CPU 0, groups of CPUs")
     args = parser.parse_args(argv)
     counts = [int(w) for w in args.workers.split(",")]
     for key in THREAD_LIMITS:  # before numpy is imported, as the batch command's workers start
@@ -189,6 +233,8 @@ def main(argv: list[str] | None = None) -> int:
             + " | ".join(f"{n * t1 / got[n].wall_s:.2f}x" for n in counts)
             + f" | {got[top].own_s / got[head].own_s:.2f} |"
         )
+    if args.pinned:
+        lines += pinned_probe(args.rounds)
     text = "\n".join(lines) + "\n"
     if args.out == "-":
         sys.stdout.write(text)
