@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 import sys
 import time
 from pathlib import Path
@@ -169,6 +170,22 @@ def test_ceiling_times_every_process_from_its_release_to_the_end_of_the_last_job
     got = ceiling.timed(job, 2, rounds=1)
     assert got.wall_s >= 0.05 and got.own_s >= 0.05  # the job ran in each process after the release
     assert got.wall_s >= got.own_s  # the last job ends no earlier than any process's own time
+
+
+@_FORK_OK
+def test_ceiling_runs_each_pinned_process_on_its_own_cpu() -> None:
+    import multiprocessing
+
+    from benchmarks import ceiling
+
+    cpu = sorted(os.sched_getaffinity(0))[-1]
+    seen = multiprocessing.get_context("fork").Value("i", -1)
+
+    def job() -> None:
+        seen.value = next(iter(os.sched_getaffinity(0))) if len(os.sched_getaffinity(0)) == 1 else -2
+
+    ceiling.timed(job, 1, rounds=1, cpus=[cpu])
+    assert seen.value == cpu
 
 
 @_FORK_OK
