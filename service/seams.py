@@ -258,9 +258,10 @@ def join_open_parts(parts: list[Part], tolerances: Tolerances = DEFAULT_TOLERANC
     from scipy.sparse.csgraph import connected_components
 
     k = len(bodies)
-    links = np.unique(np.stack([owner, comp + k], axis=1), axis=0)
-    size = k + int(comp.max()) + 1
-    graph = coo_matrix((np.ones(len(links)), (links[:, 0], links[:, 1])), shape=(size, size))
+    n_comp = int(comp.max()) + 1
+    links = np.unique(owner * n_comp + comp)  # one key per (part, component), sorted as integers (rows would be slow)
+    size = k + n_comp
+    graph = coo_matrix((np.ones(len(links)), (links // n_comp, links % n_comp + k)), shape=(size, size))
     _, group = connected_components(graph, directed=False)
     part_group = group[:k]
     joined: dict[int, Part] = {}
