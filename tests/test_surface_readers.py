@@ -507,6 +507,17 @@ def test_gltf_instances_are_each_weighed_where_they_are_drawn() -> None:
     assert any("2 instance(s) of 1 mesh node(s) placed by EXT_mesh_gpu_instancing" in w for w in doc["warnings"])
 
 
+def test_an_open_instance_is_refused_by_its_node_and_number() -> None:
+    doc = gltf_box_doc()
+    primitive = doc["meshes"][0]["primitives"][0]
+    doc["accessors"][primitive["indices"]]["count"] -= 3  # the box without its last triangle
+    node = next(n for n in doc["nodes"] if "mesh" in n)
+    node["name"] = "crate"
+    data = _with_instances(doc, [0.0, 0.0, 100.0])
+    with pytest.raises(NotWatertightError, match="part 'crate instance 0' is not watertight"):
+        analyze(data, filename="instanced.gltf", options=AnalysisOptions(density=1.0))
+
+
 def test_glb_instances_are_read_from_its_binary_chunk() -> None:
     glb = trimesh.Scene(trimesh.Trimesh(*box(1.0, 2.0, 3.0), process=False)).export(file_type="glb")
     json_length = int.from_bytes(glb[12:16], "little")

@@ -67,6 +67,7 @@ def expand_instances(data: bytes, fmt: str, doc: Any, companions: Mapping[str, b
     if not instanced:
         return data, []
     buffers = Buffers(doc, data, fmt, companions or {})
+    taken = {n["name"] for n in nodes if isinstance(n, dict) and isinstance(n.get("name"), str)}
     triangles = 0
     count_all = 0
     for k in instanced:
@@ -82,7 +83,10 @@ def expand_instances(data: bytes, fmt: str, doc: Any, companions: Mapping[str, b
                 limit_triangles=MAX_INSTANCED_TRIANGLES,
             )
         first = len(nodes)
-        nodes.extend({"mesh": node["mesh"], "matrix": m.T.ravel().tolist()} for m in matrices)
+        nodes.extend(
+            {"name": _instance_name(str(label), i, taken), "mesh": node["mesh"], "matrix": m.T.ravel().tolist()}
+            for i, m in enumerate(matrices)
+        )
         node["children"] = [*(node.get("children") or []), *range(first, len(nodes))]
         del node["mesh"]
         node["extensions"] = {key: value for key, value in node["extensions"].items() if key != EXTENSION}
@@ -92,6 +96,15 @@ def expand_instances(data: bytes, fmt: str, doc: Any, companions: Mapping[str, b
         "node's transform times the instance's"
     )
     return with_document(data, fmt, doc), [note]
+
+
+def _instance_name(label: str, i: int, taken: set[str]) -> str:
+    """'<node> instance <i>' (the part's name in results and messages), made unique among the document's node names."""
+    name = f"{label} instance {i}"
+    while name in taken:
+        name += "'"
+    taken.add(name)
+    return name
 
 
 def _instance_matrices(doc: Any, ext: Any, buffers: Buffers, label: str, fmt: str) -> NDArray[np.float64]:
