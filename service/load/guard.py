@@ -467,22 +467,23 @@ def _check_glb(data: bytes, ctx: _Context) -> None:
             format=ctx.fmt,
             version="1.0",
         )
-    if length != len(data):
-        extra = len(data) - length
-        state = (
-            "it is truncated or corrupt"
-            if extra < 0
-            else (f"{extra} more bytes follow its end" if extra > 1 else "1 more byte follows its end")
-        )
+    if length < 20:
         raise UnreadableFileError(
-            f"the GLB header declares {length} bytes but the file has {len(data)}; {state}: export it again",
+            f"the GLB header declares {length} bytes, too few for its 12-byte header and a chunk: export it again",
             format=ctx.fmt,
         )
+    if length > len(data):
+        raise UnreadableFileError(
+            f"the GLB header declares {length} bytes but the file has {len(data)}; it is truncated or corrupt: export it again",
+            format=ctx.fmt,
+        )
+    # bytes after the declared length are not part of the GLB (the validator's GLB_EXTRA_DATA, a warning):
+    # the reader leaves them out with a note (``meshes.read_trimesh_parts``)
     position = 12
-    while position + 8 <= len(data):
+    while position + 8 <= length:
         size, kind = struct.unpack_from("<II", data, position)
-        if position + 8 + size > len(data):
-            raise UnreadableFileError(f"a GLB chunk declares {size} bytes, past the end of the file", format=ctx.fmt)
+        if position + 8 + size > length:
+            raise UnreadableFileError(f"a GLB chunk declares {size} bytes, past the end its header declares", format=ctx.fmt)
         if kind == _GLB_JSON:
             _check_gltf_uris(_json_document(data[position + 8 : position + 8 + size], ctx), ctx)
         position += 8 + size

@@ -139,9 +139,16 @@ def read_trimesh_parts(
     if fmt == "gltf" and data.startswith(b"\xef\xbb\xbf"):
         data = data[3:]  # a byte-order mark before the JSON (glTF 2.0 section 3.2 forbids it; trimesh cannot read past it)
     notes: list[str] = []
+    declared = int.from_bytes(data[8:12], "little") if fmt == "glb" else len(data)
+    if declared < len(data):  # checked by the guard: at least a header and a chunk's
+        notes.append(
+            f"the GLB file has {len(data) - declared} byte(s) after the {declared} its header declares; they are not "
+            "part of the GLB and were left out, as glTF readers leave them"
+        )
+        data = data[:declared]
     if fmt in ("gltf", "glb"):
         doc = _gltf_document(data, fmt)  # parsed once: the checks read it, the rewrites below change it
-        notes = _check_gltf_document(doc, fmt)
+        notes += _check_gltf_document(doc, fmt)
         if isinstance(doc, dict) and not doc.get("meshes"):  # a valid file of materials, images or cameras only
             raise EmptyGeometryError(
                 f"the {fmt.upper()} file holds no meshes, so nothing in it has triangles; a solid needs a triangle mesh",
