@@ -343,6 +343,8 @@ def test_a_glb_shorter_than_its_header_says_is_refused_as_truncated() -> None:
         load_body(glb[:-1], filename="short.glb")
     with pytest.raises(UnreadableFileError, match=r"declares 8 bytes, too few for its 12-byte header and a chunk"):
         load_body(glb[:8] + struct.pack("<I", 8) + glb[12:], filename="tiny.glb")
+    with pytest.raises(UnreadableFileError, match=r"the GLB header gives version 7; binary glTF 2.0 has version 2"):
+        load_body(glb[:4] + struct.pack("<I", 7) + glb[8:], filename="seven.glb")
 
 
 def test_bytes_after_a_glbs_declared_length_are_left_out_with_a_note() -> None:

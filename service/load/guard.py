@@ -467,6 +467,12 @@ def _check_glb(data: bytes, ctx: _Context) -> None:
             format=ctx.fmt,
             version="1.0",
         )
+    if version != 2:
+        raise UnreadableFileError(
+            f"the GLB header gives version {version}; binary glTF 2.0 has version 2 (glTF 2.0 section 4.4.2): the file is "
+            "corrupt or not a GLB",
+            format=ctx.fmt,
+        )
     if length < 20:
         raise UnreadableFileError(
             f"the GLB header declares {length} bytes, too few for its 12-byte header and a chunk: export it again",
