@@ -1348,6 +1348,18 @@ def test_an_ascii_ply_whose_numbers_do_not_fill_its_elements_is_left_to_trimesh(
         analyze(data, filename="box.ply")
 
 
+def test_an_ascii_ply_whose_rows_hold_more_than_declared_is_read_by_lines_with_a_note() -> None:
+    # trimesh's fuze_ascii.ply (MIT): each face row has ten numbers after its colour where the header declares
+    # four; its binary twin fuze.ply, with the same geometry, is the reference
+    real = Path(__file__).parent / "data" / "real" / "ply"
+    ascii_doc = analyze((real / "fuze_ascii.ply").read_bytes(), filename="fuze_ascii.ply").as_dict()
+    binary_doc = analyze((real / "fuze.ply").read_bytes(), filename="fuze.ply").as_dict()
+    assert ascii_doc["volume"] == binary_doc["volume"]
+    assert ascii_doc["center_of_mass"] == binary_doc["center_of_mass"]
+    assert any("its rows hold more values than declared); it was read one row per line" in w for w in ascii_doc["warnings"])
+    assert not any("one row per line" in w for w in binary_doc["warnings"])
+
+
 @pytest.mark.parametrize("cut", [1, 3, 25], ids=["last-number", "last-row-but-one-number", "five-rows"])
 def test_a_truncated_ascii_ply_is_refused_not_weighed_as_far_as_it_goes(cut: int) -> None:
     # assimp's test/models-nonbsd/PLY/ant-half.ply declares 912 faces and ends after 259; read row by row, a

@@ -177,7 +177,7 @@ def read_trimesh_parts(
         notes += cut + placed
     if fmt == "ply":  # what trimesh's reader would misread: a header out of its order, binary faces of mixed
         # sizes, ASCII rows not each on a line of their own (every ASCII file is read here)
-        from .ply import header_fault, header_in_order, read_ascii_ply, uniform_face_rows
+        from .ply import ascii_rows_overfilled, header_fault, header_in_order, read_ascii_ply, uniform_face_rows
 
         problem = header_fault(data)
         if problem is not None:
@@ -190,6 +190,12 @@ def read_trimesh_parts(
         own = _own_ply(data, length_scale, read_ascii_ply)  # an ASCII file, read word by word
         if own is not None:
             return own, None
+        if guarded_read(partial(ascii_rows_overfilled, data), fmt):
+            notes.append(
+                "the ASCII PLY file's numbers do not fill the rows its header declares when read one after another "
+                "(its rows hold more values than declared); it was read one row per line, as trimesh reads it, "
+                "and the values past each row's declared ones were ignored"
+            )
     # the upload's own files, and nothing else: a name outside them (a texture that did not come along, a path)
     # is not found, never looked for on disk; images are not needed for the geometry (skip_materials)
     kwargs: dict[str, Any] = {"resolver": trimesh.resolvers.ZipResolver(dict(companions or {}))}

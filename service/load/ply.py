@@ -33,6 +33,7 @@ from ..errors import UnreadableFileError
 
 __all__ = [
     "PlyFaces",
+    "ascii_rows_overfilled",
     "header_fault",
     "header_in_order",
     "read_ascii_ply",
@@ -255,26 +256,39 @@ def _walk(data: bytes, order: str, elements: list[tuple[str, int, list[Property]
 
 
 def read_ascii_ply(data: bytes) -> PlyFaces | None:
+    """See ``_read_ascii``."""
+    return _read_ascii(data)[0]
+
+
+def ascii_rows_overfilled(data: bytes) -> bool:
+    """Whether an ASCII PLY file's numbers, read one after another, do not fill its declared rows exactly: rows
+    that hold more values than its header declares (read one row per line, the values past each row's declared
+    ones are ignored, as trimesh reads them)."""
+    return _read_ascii(data)[1]
+
+
+def _read_ascii(data: bytes) -> tuple[PlyFaces | None, bool]:
     """The vertices (x, y, z rounded to their declared types), every face's corners one after another, and
     the corners per face, of an ASCII PLY file read as numbers separated by white space, whatever its lines.
 
     None where the numbers do not fill its elements exactly (words that are no numbers, numbers left over, a
     list count that is no count: rows with more values than the header declares, which trimesh reads line by
-    line), or where it has no vertices and faces (the caller's own reading then stands);
+    line), or where it has no vertices and faces (the caller's own reading then stands); beside it, whether
+    the numbers were read but did not fill the rows exactly (numbers left over, or a count that is no count);
     ``UnreadableFileError`` where they end before the vertex or face rows its header declares (a truncated
     file, which read row by row gave the rows before the cut as the whole mesh) or where they fill every row
     but a face corner is no whole number.
     """
     found = _header(data)
     if found is None or found[0] != "ascii":
-        return None
+        return None, False
     _, elements, start = found
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("error")  # numpy stops at a word that is no number and warns (or raises)
             numbers = np.fromstring(data[start:].decode("latin-1"), dtype=np.float64, sep=" ")
     except (ValueError, DeprecationWarning):
-        return None
+        return None, False
     vertices: NDArray[np.float64] | None = None
     corners: list[NDArray[np.float64]] = []
     counts: list[NDArray[np.int64]] = []
@@ -284,7 +298,7 @@ def read_ascii_ply(data: bytes) -> PlyFaces | None:
             continue
         names = [p for p, _, _ in props]
         if not props or (name == "vertex" and not {"x", "y", "z"} <= set(names)):
-            return None
+            return None, False
         keep = "vertex_indices" if "vertex_indices" in names else "vertex_index"
         want = [names.index(c) for c in "xyz"] if name == "vertex" else []
         listed = names.index(keep) if name == "face" and keep in names else None
@@ -293,7 +307,7 @@ def read_ascii_ply(data: bytes) -> PlyFaces | None:
         if rows is None:
             rows = _walked_rows(numbers, at, count, props, want, listed, name, geometry_read)
         if rows is None:
-            return None
+            return None, True
         at, picked, element_corners, element_counts = rows
         if name == "vertex":
             with np.errstate(invalid="ignore", over="ignore"):  # non-finite values are refused later
@@ -301,8 +315,10 @@ def read_ascii_ply(data: bytes) -> PlyFaces | None:
         if listed is not None:
             corners.append(element_corners)
             counts.append(element_counts)
-    if vertices is None or not counts or at != len(numbers):
-        return None
+    if vertices is None or not counts:
+        return None, False
+    if at != len(numbers):
+        return None, True
     flat = np.concatenate(corners)
     fractional = flat != np.round(flat)
     if np.any(fractional):
@@ -311,7 +327,7 @@ def read_ascii_ply(data: bytes) -> PlyFaces | None:
             "fix that face or export the file again",
             format="ply",
         )
-    return vertices, flat.astype(np.int64), np.concatenate(counts)
+    return (vertices, flat.astype(np.int64), np.concatenate(counts)), False
 
 
 # what one element's rows give: the position after them, the wanted scalars (rows, len(want)), and the corners
