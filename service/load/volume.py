@@ -894,7 +894,7 @@ def _read_meshio(data: bytes, fmt: str, label: str, filename: str | None, compan
     if fmt == "inp":  # one deck, as Abaqus reads it: meshio then opens no other file
         data = abaqus_flatten(data, companions or {}, label)
         _admit_abaqus_types([data], label)
-        data = abaqus_one_node_block(data, label)
+        data = abaqus_one_node_block(abaqus_plain(data), label)
         companions = None
 
     if fmt == "mesh":
@@ -1074,6 +1074,13 @@ def _hdf5_missing(label: str, fmt: str, exc: ImportError) -> UnsupportedFormatEr
 # shells; the node layout depends on <n> alone.  Variable-node elements (C3D15V, C3D27) are not among them.
 _ABAQUS_SOLID = re.compile(r"^(?:D?C3D(?P<n>4|6|8|10|15|20)[A-UW-Z]*|SC(?P<sc>6|8)R[A-Z]*)$")
 _ABAQUS_SOLID_TYPE = {"4": "tetra", "6": "wedge", "8": "hexahedron", "10": "tetra10", "15": "wedge15", "20": "hexahedron20"}
+# Abaqus elements that weigh by their section, not as solids, by node count where meshio lacks the name
+# (it has S8R but not S8, B32 but not B32R): shells, membranes, plane and axisymmetric elements (2-D), beams
+# and trusses. They are read so that the warning can count them, and never weighed.
+_ABAQUS_FACE = re.compile(r"^(?:S|STRI|DS|M3D|SFM3D|CPE|CPEG|CPS|CAX|CGAX|DC2D|DCAX)(?P<n>[34689])(?![0-9])[A-Z0-9]*$")
+_ABAQUS_FACE_TYPE = {"3": "triangle", "4": "quad", "6": "triangle6", "8": "quad8", "9": "quad9"}
+_ABAQUS_LINE = re.compile(r"^(?:(?:B|PIPE)[23](?P<beam>[123])|T[23]D(?P<truss>[23]))(?![0-9])[A-Z0-9]*$")
+_ABAQUS_LINE_TYPE = {"1": "line", "2": "line3", "3": "line"}  # B21/B31 two nodes, B22/B32 three, B23/B33 two (cubic)
 _ABAQUS_ELEMENT = re.compile(rb"^[ \t]*\*[ \t]*ELEMENT[ \t]*(?:,(?P<params>[^\r\n]*))?$", re.IGNORECASE | re.MULTILINE)
 _ABAQUS_TYPE = re.compile(rb"(?:^|,)[ \t]*TYPE[ \t]*=[ \t]*(?P<type>[^,\s]+)", re.IGNORECASE)
 
@@ -1119,7 +1126,7 @@ def _admit_abaqus_types(texts: list[bytes], label: str) -> None:
     for name in abaqus_element_types(texts):
         known = table.get(name) or table.get(name.upper())
         m = _ABAQUS_SOLID.match(name.upper())
-        target = known or (_ABAQUS_SOLID_TYPE[m.group("n") or m.group("sc")] if m else None)
+        target = known or (_ABAQUS_SOLID_TYPE[m.group("n") or m.group("sc")] if m else _abaqus_sectioned(name.upper()))
         if target is None:
             unknown.append(name)
         else:
@@ -1131,6 +1138,17 @@ def _admit_abaqus_types(texts: list[bytes], label: str) -> None:
             "connectors or user elements would be left out although some carry mass; export the solid mesh alone",
             element_types=unknown,
         )
+
+
+def _abaqus_sectioned(name: str) -> str | None:
+    """meshio's cell type for an Abaqus shell, membrane, 2-D, beam or truss element it does not know by name."""
+    face = _ABAQUS_FACE.match(name)
+    if face:
+        return _ABAQUS_FACE_TYPE[face.group("n")]
+    line = _ABAQUS_LINE.match(name)
+    if line:
+        return _ABAQUS_LINE_TYPE[line.group("beam")] if line.group("beam") else ("line" if line.group("truss") == "2" else "line3")
+    return None
 
 
 # keywords that make or move nodes or elements from others (generation, copies, mappings, placed instances):
@@ -1153,6 +1171,9 @@ def _abaqus_keyword(line: bytes) -> bytes | None:
     return line.partition(b",")[0].strip().lstrip(b"*").replace(b" ", b"").upper()
 
 
+# blanks before a keyword's asterisk, which CalculiX reads (its own refined decks write " *ELEMENT") and meshio
+# took for a data line
+_ABAQUS_INDENT = re.compile(rb"^[ \t]+(?=\*)", re.MULTILINE)
 _ABAQUS_INPUT_PARAMETER = re.compile(rb",[ \t]*input[ \t]*=[ \t]*(?P<name>[^,\r\n]*)", re.IGNORECASE)
 MAX_INCLUDE_DEPTH = 16
 
@@ -1172,7 +1193,7 @@ def _input_name(m: re.Match[bytes]) -> str:
 
 
 def abaqus_flatten(data: bytes, companions: Mapping[str, bytes], label: str) -> bytes:
-    """The deck with each file it reads written in its place, as Abaqus reads it.
+    """The deck with each file it reads written in its place, as Abaqus reads it, keywords unindented.
 
     ``*INCLUDE, INPUT=name`` is replaced by the named file's lines, and a
     keyword that reads its data lines from a file (``*NODE, INPUT=name``)
@@ -1185,6 +1206,7 @@ def abaqus_flatten(data: bytes, companions: Mapping[str, bytes], label: str) -> 
     see ``load_body``); the result is bounded by the upload's inflation
     budget, so a file that includes itself or others many times is refused.
     """
+    data = _ABAQUS_INDENT.sub(b"", data)
     if not _ABAQUS_INPUT_PARAMETER.search(data):  # most decks read no other file: no pass over their lines
         return data
     budget = inflate_budget(len(data) + sum(len(v) for v in companions.values()))
@@ -1206,7 +1228,7 @@ def abaqus_flatten(data: bytes, companions: Mapping[str, bytes], label: str) -> 
                 if keyword != b"INCLUDE":  # the keyword stays; its data lines come from the file
                     line = line[: m.start()] + line[m.end() :]
                     out.append(line if line.endswith((b"\n", b"\r")) else line + b"\n")
-                content = companions[name]
+                content = _ABAQUS_INDENT.sub(b"", companions[name])
                 expand(content if content.endswith((b"\n", b"\r")) else content + b"\n", depth + 1)
                 continue
             out.append(line)
@@ -1221,6 +1243,51 @@ def abaqus_flatten(data: bytes, companions: Mapping[str, bytes], label: str) -> 
 
     expand(data, 0)
     return b"".join(out)
+
+
+_ABAQUS_COMMENT = re.compile(rb"^\*\*[^\n]*(?:\n|$)", re.MULTILINE)
+_ABAQUS_KEYWORD_LINE = re.compile(rb"^\*(?!\*)[^\n]*", re.MULTILINE)
+_ABAQUS_SETS = {b"NSET", b"ELSET"}
+_NODE_TRAILING_COMMAS = re.compile(rb"(?:,[ \t]*)+(\r?)$", re.MULTILINE)
+_NODE_EMPTY_FIELD = re.compile(rb",[ \t]*(?=,|\r?$)", re.MULTILINE)
+_NODE_SHORT = re.compile(rb"^([ \t]*[^,\s][^,\r\n]*(?:,[^,\r\n]*){0,2})(\r?)$", re.MULTILINE)
+_NODE_LONG = re.compile(rb"^([^,\r\n]*(?:,[^,\r\n]*){3}),[^\r\n]*", re.MULTILINE)
+
+
+def abaqus_plain(data: bytes) -> bytes:
+    """The deck as meshio's line reader takes it right: what Abaqus ignores or defaults, written out.
+
+    - Comment lines (``**``) go: Abaqus allows them anywhere, and meshio
+      ended a node or element block at one, then skipped the block's
+      remaining lines as an unknown keyword's (CalculiX's beamptied5.inp lost
+      2 of its 30 elements, rotor3.inp half its volume, without a word).
+    - Node and element sets (``*NSET``, ``*ELSET``) go: they name groups
+      and change no solid, and meshio failed on sets it cannot read (a
+      ``GENERATE`` line without its increment, which defaults to 1; a set
+      naming a node the deck does not define).
+    - Node lines get the coordinates Abaqus defaults: an omitted or empty
+      coordinate is 0, a comma at the end starts no field, and what follows
+      the third coordinate (a normal's direction cosines) is no coordinate.
+    """
+    data = _ABAQUS_COMMENT.sub(b"", data)
+    keywords = [(m.start(), _abaqus_keyword(m.group()) or b"") for m in _ABAQUS_KEYWORD_LINE.finditer(data)]
+    if not any(k in _ABAQUS_SETS or k == b"NODE" for _, k in keywords):
+        return data
+    pieces = [data[: keywords[0][0]] if keywords else data]
+    for (start, keyword), (end, _) in zip(keywords, [*keywords[1:], (len(data), b"")], strict=True):
+        block = data[start:end]
+        if keyword in _ABAQUS_SETS:
+            continue
+        if keyword == b"NODE":
+            head, newline, rows = block.partition(b"\n")
+            rows = _NODE_TRAILING_COMMAS.sub(rb"\1", rows)
+            rows = _NODE_EMPTY_FIELD.sub(b", 0", rows)
+            rows = _NODE_LONG.sub(rb"\1", rows)
+            for _ in range(3):  # at most three coordinates to add (a node line may hold its number alone)
+                rows = _NODE_SHORT.sub(rb"\1, 0\2", rows)
+            block = head + newline + rows
+        pieces.append(block)
+    return b"".join(pieces)
 
 
 def abaqus_one_node_block(data: bytes, label: str) -> bytes:

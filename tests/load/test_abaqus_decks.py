@@ -223,3 +223,39 @@ def test_a_flat_element_set_is_named_in_the_refusal() -> None:
     with pytest.raises(ZeroVolumeError, match="part 'tetra_1': the mesh encloses no volume") as err:
         weigh(deck)
     assert err.value.details["part"] == "tetra_1"
+
+
+TWO_TETS = f"*NODE\n{CORNER_TET}{FAR_TET}"
+
+
+@pytest.mark.parametrize(
+    "deck",
+    [
+        # a comment line between the elements: meshio ended the block there and dropped the second element
+        f"{TWO_TETS}*ELEMENT, TYPE=C3D4\n1, 1, 2, 3, 4\n**   2, 5, 6, 7, 8 (a note)\n2, 5, 6, 7, 8\n",
+        # a node set by GENERATE without its increment (Abaqus: 1), and one naming a node the deck lacks
+        f"{TWO_TETS}*NSET, NSET=ALL, GENERATE\n1, 8\n*NSET, NSET=GONE\n82\n*ELEMENT, TYPE=C3D4\n1, 1, 2, 3, 4\n2, 5, 6, 7, 8\n"
+        "*ELSET, ELSET=E, GENERATE\n1, 2\n",
+        # node lines that end with a comma, omit z (0), leave a field empty (0), or go on with a normal's cosines
+        "*NODE\n1, 0, 0, 0,\n2, 1, 0\n3, 0, 1, \n4, 0,, 1\n5, 10, 0, 0, 0.0, 0.0, 1.0\n6, 12, 0, 0\n7, 10, 2\n8, 10, 0, 2\n"
+        "*ELEMENT, TYPE=C3D4\n1, 1, 2, 3, 4\n2, 5, 6, 7, 8\n",
+        # keywords indented, as CalculiX's refined decks write them
+        f" *NODE\n{CORNER_TET}{FAR_TET}  *ELEMENT, TYPE=C3D4\n1, 1, 2, 3, 4\n\t*ELEMENT, TYPE=C3D4\n2, 5, 6, 7, 8\n",
+    ],
+    ids=["comment-in-elements", "sets-meshio-failed-on", "node-lines-abaqus-defaults", "indented-keywords"],
+)
+def test_what_abaqus_ignores_or_defaults_keeps_every_element(deck: str) -> None:
+    volume, centre = weigh(deck)
+    v, c = expected()
+    assert volume == pytest.approx(float(v), rel=1e-14)
+    assert centre == pytest.approx([float(x) for x in c], rel=1e-14)
+
+
+@pytest.mark.parametrize(("element", "nodes"), [("S8", "2, 3, 4, 2, 3, 4, 2, 3"), ("s4", "2, 3, 4, 2"), ("B32R", "2, 3, 4")])
+def test_shells_and_beams_meshio_lacks_are_left_out_with_the_solids_weighed(element: str, nodes: str) -> None:
+    deck = f"{TWO_TETS}*ELEMENT, TYPE=C3D4\n1, 1, 2, 3, 4\n2, 5, 6, 7, 8\n*ELEMENT, TYPE={element}\n3, {nodes}\n"
+    doc = analyze(deck.encode(), filename="deck.inp").as_dict()
+    v, c = expected()
+    assert doc["mass"] / doc["density"] == pytest.approx(float(v), rel=1e-14)
+    assert doc["center_of_mass"] == pytest.approx([float(x) for x in c], rel=1e-14)
+    assert any("whose mass depends on section properties; they were not weighed" in w for w in doc["warnings"])
