@@ -120,6 +120,9 @@ def tessellated(loaded: Loaded, deflection: float) -> Loaded:
     parts = []
     for part in loaded.parts:
         body = part.body
+        if isinstance(body, MeshBody):  # a solid of triangles alone (read.py): already its tessellation
+            parts.append(part)
+            continue
         assert isinstance(body, BrepBody)
         vertices, faces = occ.tessellate(body.solid, deflection)
         # coordinates stay in the model unit as read; length_scale turns them into metres, as for the B-rep

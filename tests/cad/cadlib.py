@@ -130,3 +130,40 @@ def write_iges(shapes: Sequence[Any], unit: str = "MM") -> bytes:
         writer.AddShape(shape)
     writer.ComputeModel()
     return _written(".igs", writer.Write)
+
+
+def triangles_solid(corners: Sequence[tuple[float, float, float]], triangles: Sequence[tuple[int, int, int]]) -> Any:
+    """A solid whose faces are triangles alone, with no surface (what AP242's tessellated geometry reads as):
+    one face per triangle, each with its own three nodes, wound as given."""
+    from OCP.BRep import BRep_Builder
+    from OCP.gp import gp_Pnt
+    from OCP.Poly import Poly_Triangle, Poly_Triangulation
+    from OCP.TopoDS import TopoDS_Face, TopoDS_Shell, TopoDS_Solid
+
+    builder = BRep_Builder()
+    shell = TopoDS_Shell()
+    builder.MakeShell(shell)
+    for triangle in triangles:
+        mesh = Poly_Triangulation(3, 1, False)
+        for i, k in enumerate(triangle):
+            mesh.SetNode(i + 1, gp_Pnt(*corners[k]))
+        mesh.SetTriangle(1, Poly_Triangle(1, 2, 3))
+        face = TopoDS_Face()
+        builder.MakeFace(face, mesh)
+        builder.Add(shell, face)
+    solid = TopoDS_Solid()
+    builder.MakeSolid(solid)
+    builder.Add(solid, shell)
+    return solid
+
+
+def write_tessellated_step(parts: Sequence[tuple[str, Any]]) -> bytes:
+    """``write_step`` with OpenCASCADE's writer of tessellated geometry on (``TRIANGULATED_FACE``)."""
+    from OCP.Interface import Interface_Static
+
+    before = Interface_Static.IVal_s("write.step.tessellated")
+    Interface_Static.SetIVal_s("write.step.tessellated", 1)
+    try:
+        return write_step(parts)
+    finally:
+        Interface_Static.SetIVal_s("write.step.tessellated", before)

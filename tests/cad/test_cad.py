@@ -338,3 +338,36 @@ def test_a_label_without_a_name_has_none_and_does_not_crash() -> None:
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
     assert out.returncode == 0, out.stderr[-500:]
     assert out.stdout.strip() == "None"
+
+
+# the tetrahedron with corners (0,0,0), (a,0,0), (0,a,0), (0,0,a): volume a^3/6, centroid (a/4, a/4, a/4)
+TET_CORNERS = [(0.0, 0.0, 0.0), (10.0, 0.0, 0.0), (0.0, 10.0, 0.0), (0.0, 0.0, 10.0)]
+TET_OUTWARD = [(0, 2, 1), (0, 1, 3), (1, 2, 3), (0, 3, 2)]
+
+
+@pytest.mark.parametrize("winding", ["outward", "inward"])
+@pytest.mark.parametrize("geometry", ["brep", "mesh"])
+def test_a_solid_of_triangles_alone_is_weighed_as_the_surface_it_is(winding: str, geometry: str) -> None:
+    # AP242 tessellated geometry (TRIANGULATED_FACE): no exact surface to integrate; OpenCASCADE's own surface
+    # measure failed on it ("Bnd_Box is void") and the file was refused with that
+    from tests.cad.cadlib import triangles_solid, write_tessellated_step
+
+    faces = TET_OUTWARD if winding == "outward" else [(a, c, b) for a, b, c in TET_OUTWARD]
+    data = write_tessellated_step([("tet", triangles_solid(TET_CORNERS, faces))])
+    assert b"TRIANGULATED_FACE" in data
+    doc = analyze(data, filename="tet.step", options=AnalysisOptions(geometry=geometry)).as_dict()
+    volume = Fraction(10) ** 3 / 6 * Fraction(1, 10**9)  # mm^3 -> m^3
+    assert doc["volume"] == pytest.approx(float(volume), rel=1e-14)
+    assert doc["mass"] == pytest.approx(float(volume * 1000), rel=1e-14)
+    assert doc["center_of_mass"] == pytest.approx([0.0025] * 3, rel=1e-14)
+    assert any("tessellated geometry" in w for w in doc["warnings"])
+
+
+def test_solids_of_triangles_beside_exact_ones_are_refused_by_name() -> None:
+    from tests.cad.cadlib import triangles_solid, write_tessellated_step
+
+    data = write_tessellated_step(
+        [("tet", triangles_solid(TET_CORNERS, TET_OUTWARD)), ("block", box(5.0, 5.0, 5.0, (20.0, 0.0, 0.0)))]
+    )
+    with pytest.raises(UnsupportedFormatError, match="solid\\(s\\) of triangles alone \\('tet'\\) beside solids of exact geometry"):
+        analyze(data, filename="mixed.step")
