@@ -200,7 +200,7 @@ def _read(data: bytes, fmt: str) -> tuple[list[Solid], str | None, list[str]]:
                 "export it again from the CAD tool",
                 library="OpenCASCADE",
             )
-        unit = _declared_unit(reader, fmt)
+        unit = _declared_unit(reader, fmt, data)
         if not reader.Transfer(doc):
             raise UnreadableFileError(
                 f"OpenCASCADE read the {fmt.upper()} file but could not build its shapes", library="OpenCASCADE"
@@ -222,7 +222,7 @@ def _reader(fmt: str) -> Any:
     return reader
 
 
-def _declared_unit(reader: Any, fmt: str) -> str | None:
+def _declared_unit(reader: Any, fmt: str, data: bytes) -> str | None:
     """The length unit the file states, in our names (an unknown one as the file spells it)."""
     if fmt == "step":
         from OCP.collections import Sequence_TCollection_AsciiString
@@ -230,6 +230,9 @@ def _declared_unit(reader: Any, fmt: str) -> str | None:
         lengths, angles, solid_angles = (Sequence_TCollection_AsciiString() for _ in range(3))
         reader.ChangeReader().FileUnits(lengths, angles, solid_angles)
         names = {str(lengths.Value(i).ToCString()).strip().lower() for i in range(1, lengths.Length() + 1)}
+        names.discard("")
+        if not names:  # the reader converted the unit but gave it no name (NIST's CTC 05: an inch it leaves blank)
+            names = _step_length_units(data)
     else:
         names = {_iges_unit(reader.WS().Model().GlobalSection())}
     names.discard("")
@@ -237,6 +240,31 @@ def _declared_unit(reader: Any, fmt: str) -> str | None:
         return None
     name: str = names.pop()
     return _UNIT_NAMES.get(name, name)
+
+
+_STEP_COMPLEX = re.compile(rb"=\s*\(([^;]*)\)\s*;")
+_STEP_CONVERSION = re.compile(rb"CONVERSION_BASED_UNIT\s*\(\s*'([^']*)'", re.IGNORECASE)
+_STEP_SI_LENGTH = re.compile(rb"SI_UNIT\s*\(\s*(?:\.(\w+)\.|\$)\s*,\s*\.METRE\.", re.IGNORECASE)
+_SI_PREFIX = {b"": "m", b"MILLI": "mm", b"CENTI": "cm", b"MICRO": "um", b"KILO": "km"}
+
+
+def _step_length_units(data: bytes) -> set[str]:
+    """The length units a STEP file's text declares (ISO 10303-41): the names of its conversion-based ones
+    (an inch is 25.4 of a millimetre there, the millimetre then only its base), else its SI ones."""
+    conversions: set[str] = set()
+    si: set[str] = set()
+    for m in _STEP_COMPLEX.finditer(data):
+        entity = m.group(1)
+        if b"LENGTH_UNIT" not in entity.upper():
+            continue
+        named = _STEP_CONVERSION.search(entity)
+        if named:
+            conversions.add(named.group(1).decode("latin-1").strip().lower())
+            continue
+        metre = _STEP_SI_LENGTH.search(entity)
+        if metre:
+            si.add(_SI_PREFIX.get((metre.group(1) or b"").upper(), ""))
+    return conversions or si
 
 
 # IGES 5.3, global section parameter 14 (units flag) -> unit; 3 means "the name in parameter 15"

@@ -371,3 +371,27 @@ def test_solids_of_triangles_beside_exact_ones_are_refused_by_name() -> None:
     )
     with pytest.raises(UnsupportedFormatError, match="solid\\(s\\) of triangles alone \\('tet'\\) beside solids of exact geometry"):
         analyze(data, filename="mixed.step")
+
+
+def test_an_inch_the_reader_leaves_unnamed_is_named_from_the_files_units() -> None:
+    # NIST's CTC 05 declares CONVERSION_BASED_UNIT('inch', 25.4 mm) as a complex entity whose name
+    # OpenCASCADE's FileUnits leaves blank (it converts the numbers all the same): it was reported as metres
+    import re
+
+    text = write_step([("block", box(10.0, 20.0, 30.0))]).decode()
+    unit = re.search(r"#(\d+) = \( LENGTH_UNIT\(\) NAMED_UNIT\(\*\) SI_UNIT\(\.MILLI\.,\.METRE\.\) \);", text)
+    assert unit is not None
+    text = text.replace(
+        unit.group(0), f"#{unit.group(1)}=(\nCONVERSION_BASED_UNIT('inch',#90001)\nLENGTH_UNIT()\nNAMED_UNIT(#90002)\n);"
+    )
+    end = text.rfind("ENDSEC;")
+    text = (
+        text[:end]
+        + "#90001=MEASURE_WITH_UNIT(LENGTH_MEASURE(25.4),#90003);\n#90002=DIMENSIONAL_EXPONENTS(1.,0.,0.,0.,0.,0.,0.);\n"
+        + "#90003=(\nLENGTH_UNIT()\nNAMED_UNIT(*)\nSI_UNIT(.MILLI.,.METRE.)\n);\n"
+        + text[end:]
+    )
+    doc = analyze(text.encode(), filename="inch.step").as_dict()
+    assert doc["source"]["units"] == "in"
+    assert doc["volume"] == pytest.approx(float(Fraction(254) * 508 * 762 / 10**9), rel=REL)  # 10 x 20 x 30 inches
+    assert not any("several units" in w for w in doc["warnings"])
