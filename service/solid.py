@@ -68,6 +68,19 @@ def closed_surface(body: MeshBody) -> tuple[NDArray[np.float64], NDArray[np.int6
     return vertices, faces, warnings
 
 
+def _collapse_cause(body: MeshBody) -> str:
+    """Why every triangle collapsed, where the coordinates' storage explains it: float32 steps at the
+    largest coordinate above 1e-6 of the body's size (a part far from the origin).  Where they are finer,
+    the file's corners themselves coincide (a frame of an animation squashed flat), and nothing is said."""
+    if body.coordinate_eps < 2.0**-24 or len(body.vertices) == 0:
+        return ""
+    span = float(np.max(np.ptp(body.vertices, axis=0)))
+    step = body.coordinate_eps * float(np.max(np.abs(body.vertices)))
+    if step < 1e-6 * span:
+        return ""
+    return "; its float32 coordinates are too coarse at that distance from the origin: export it in float64 or nearer the origin"
+
+
 def oriented_surface(body: MeshBody) -> OrientedSurface:
     """``closed_surface``, with the first integration pass of the faces it returns where that came free.
 
@@ -81,12 +94,7 @@ def oriented_surface(body: MeshBody) -> OrientedSurface:
     if np.any(degenerate):
         faces = faces[~degenerate]  # zero-area faces contribute nothing to any integral
     if len(faces) == 0:
-        cause = (
-            ("; its float32 coordinates are too coarse at that distance from the origin: export it in float64 or nearer the origin")
-            if body.coordinate_eps >= 2.0**-24
-            else ""
-        )
-        raise ZeroVolumeError(f"every triangle of the mesh is degenerate; the file holds no solid{cause}")
+        raise ZeroVolumeError(f"every triangle of the mesh is degenerate; the file holds no solid{_collapse_cause(body)}")
     topo = surface_topology(faces, len(vertices))
     warnings: list[str] = []
     if topo.nonmanifold_edges:  # a triangle listed twice shares each edge with its copy: four faces on an edge

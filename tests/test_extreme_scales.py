@@ -104,3 +104,24 @@ def test_a_tensor_near_the_top_of_float64_is_diagonalised_without_overflow() -> 
         warnings.simplefilter("error")
         frame = PrincipalFrame.from_tensor(np.diag([1e308, 1.5e308, 1.7e308]))
     assert frame.moments.tolist() == [1e308, 1.5e308, 1.7e308]
+
+
+@pytest.mark.parametrize(
+    ("offset", "scale", "blamed"),
+    [(1e5, 1e-3, True), (0.0, 1.0, False)],
+    ids=["a-millimetre-part-100-km-out", "a-shape-squashed-onto-itself-at-the-origin"],
+)
+def test_a_mesh_of_collapsed_triangles_blames_float32_only_where_its_steps_explain_it(
+    offset: float, scale: float, blamed: bool
+) -> None:
+    from benchmarks.cases import stl_bytes
+    from inertia.errors import ZeroVolumeError
+    from inertia.pipeline import analyze
+
+    v = np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]) * scale + offset
+    if not blamed:  # corners written onto each other in pairs: every face collapses in the file itself
+        v[1], v[3] = v[0], v[2]
+    f = np.array([[0, 2, 1], [0, 1, 3], [1, 2, 3], [0, 3, 2]])
+    with pytest.raises(ZeroVolumeError, match="every triangle of the mesh is degenerate") as err:
+        analyze(stl_bytes(v, f), filename="tet.stl")
+    assert ("float32 coordinates are too coarse" in str(err.value)) is blamed

@@ -407,6 +407,13 @@ def _vtk_missing(label: str, fmt: str) -> UnsupportedFormatError:
     )
 
 
+def _legacy_vtk_part4(data: bytes) -> bytes:
+    """The first word after a legacy VTK file's three header lines (version, title, ASCII or BINARY): DATASET
+    for a data set, FIELD for field data alone (VTK's file formats, \"Simple Legacy Formats\", parts 1-4)."""
+    lines = data[:4096].splitlines()[3:]
+    return next((line.split()[0].upper() for line in lines if line.strip()), b"")
+
+
 def _read_vtk(data: bytes, fmt: str, label: str) -> _Mesh:
     try:
         from vtkmodules.util.numpy_support import vtk_to_numpy
@@ -435,6 +442,12 @@ def _read_vtk(data: bytes, fmt: str, label: str) -> _Mesh:
         "inp": vtkAVSucdReader,
     }
     reader_for = _vtk_xml_reader(data, fmt, label) if fmt in VTK_XML_TYPES.values() else fmt
+    if reader_for == "vtk" and _legacy_vtk_part4(data) == b"FIELD":
+        raise EmptyGeometryError(
+            f"{label} holds field data alone (FIELD where a legacy VTK file's DATASET would stand): no points or "
+            "cells, nothing to weigh; send the data set the field belongs to",
+            format=fmt,
+        )
     window = vtkStringOutputWindow()
     polydata = False
     with _VTK_LOCK, _upload_dir(data, fmt, None, None) as path:  # the output window is process-wide

@@ -558,3 +558,13 @@ def test_a_damaged_files_own_bytes_quoted_by_its_reader_are_shown_printable() ->
     with pytest.raises(LoadError) as info:
         load_body(data, filename="liver.vtk")
     assert info.value.message.isprintable() and "\ufffd" not in info.value.message
+
+
+@pytest.mark.parametrize("mode", ["ASCII", "BINARY"])
+def test_a_legacy_vtk_file_of_field_data_alone_says_so(mode: str) -> None:
+    # pyvista's vtk-data financial.vtk has this layout: FIELD where DATASET would stand; vtkDataSetReader
+    # answered "did not create output for port 0"
+    data = f"# vtk DataFile Version 2.0\nfinancial records\n{mode}\n\nFIELD records 1\ntime 1 3 float\n".encode()
+    data += b"1 2 3\n" if mode == "ASCII" else np.array([1, 2, 3], dtype=">f4").tobytes()
+    with pytest.raises(EmptyGeometryError, match="holds field data alone \\(FIELD where a legacy VTK file's DATASET"):
+        load_body(data, filename="records.vtk")
