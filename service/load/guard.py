@@ -182,7 +182,19 @@ def _attrs(text: bytes) -> dict[str, str]:
     }
 
 
-def _refuse_doctype(xml: bytes, ctx: _Context) -> None:
+# a document type that names a DTD and declares nothing itself, as XDMF files write theirs
+# (<!DOCTYPE Xdmf SYSTEM "Xdmf.dtd" []>): XML parsers do not fetch the DTD, and there is nothing to expand
+_BARE_DOCTYPE = re.compile(
+    rb"<!DOCTYPE[ \t\r\n]+[\w:.-]+(?:[ \t\r\n]+(?:SYSTEM|PUBLIC)(?:[ \t\r\n]+(?:\"[^\"<>\[\]]*\"|'[^'<>\[\]]*'))+)?"
+    rb"[ \t\r\n]*(?:\[[ \t\r\n]*\])?[ \t\r\n]*>",
+    re.IGNORECASE,
+)
+
+
+def _refuse_doctype(xml: bytes, ctx: _Context, bare_allowed: bool = False) -> None:
+    """Refuse a document type or entity declarations; with ``bare_allowed``, one that only names a DTD passes."""
+    if bare_allowed:
+        xml = _BARE_DOCTYPE.sub(b"", xml, count=1)
     if _DOCTYPE.search(xml):
         raise ExternalReferenceError(
             f"the {ctx.fmt.upper()} file declares a document type or entities (<!DOCTYPE>/<!ENTITY>), which can "
@@ -196,9 +208,11 @@ _XINCLUDE = re.compile(rb"<[\w]*:?include\b([^>]*)>", re.IGNORECASE)
 
 
 def _check_xdmf(data: bytes, ctx: _Context) -> None:
-    _refuse_doctype(data, ctx)
+    _refuse_doctype(data, ctx, bare_allowed=True)
     for match in _XINCLUDE.finditer(data):
-        ctx.reference(_attrs(match.group(1)).get("href", ""), "XInclude href")
+        href = _attrs(match.group(1)).get("href", "")
+        if href.strip():  # none: a part of this same document (an xpointer, as time series repeat their mesh)
+            ctx.reference(href, "XInclude href")
     for match in _XDMF_ITEM.finditer(data):
         fmt = _attrs(match.group(1)).get("Format", "XML")
         if fmt.upper() in ("HDF", "BINARY"):

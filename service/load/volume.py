@@ -1407,12 +1407,26 @@ def _refuse_unapplied(keyword: bytes, line: bytes, data: list[bytes], label: str
             )
 
 
+_XDMF_TEMPORAL = re.compile(rb"CollectionType\s*=\s*[\"']Temporal[\"']", re.IGNORECASE)
+
+
+def _xdmf_time_series_mesh(path: str) -> Any:
+    """The mesh of an XDMF time series (a temporal collection of grids over one mesh, as dolfinx and meshio's
+    ``TimeSeriesWriter`` write results): its points and cells, the steps' fields left aside."""
+    import meshio
+
+    points, cells = meshio.xdmf.TimeSeriesReader(path).read_points_cells()
+    return meshio.Mesh(points, cells)
+
+
 def _meshio_read(data: bytes, fmt: str, label: str, filename: str | None, companions: Mapping[str, bytes] | None) -> Any:
     """``meshio.read`` of the upload in its private folder; every failure an ``UnreadableFileError``."""
     import meshio
 
     with _upload_dir(data, fmt, filename, companions) as path, _quiet() as printed, _without_hdf5(data, fmt):
         try:
+            if fmt == "xdmf" and _XDMF_TEMPORAL.search(data):
+                return _xdmf_time_series_mesh(path)
             return meshio.read(path, file_format=VOLUME_FORMATS[fmt])
         except KeyboardInterrupt:
             raise

@@ -568,3 +568,32 @@ def test_a_legacy_vtk_file_of_field_data_alone_says_so(mode: str) -> None:
     data += b"1 2 3\n" if mode == "ASCII" else np.array([1, 2, 3], dtype=">f4").tobytes()
     with pytest.raises(EmptyGeometryError, match="holds field data alone \\(FIELD where a legacy VTK file's DATASET"):
         load_body(data, filename="records.vtk")
+
+
+def test_the_document_type_xdmf_files_declare_is_read_an_entity_still_refused() -> None:
+    # dolfinx and legacy FEniCS write <!DOCTYPE Xdmf SYSTEM "Xdmf.dtd" []>: a DTD named, nothing declared
+    from inertia.errors import ExternalReferenceError
+
+    declaration = '<?xml version="1.0"?>\n'
+    named = XDMF_XML.replace(declaration, declaration + '<!DOCTYPE Xdmf SYSTEM "Xdmf.dtd" []>\n', 1)
+    doc = analyze(named.encode(), filename="cube.xdmf", options=AnalysisOptions(density=1.0)).as_dict()
+    assert doc["mass"] == pytest.approx(8 / 6, rel=1e-15)
+    hostile = XDMF_XML.replace(declaration, declaration + '<!DOCTYPE Xdmf [<!ENTITY e SYSTEM "file:///etc/hostname">]>\n', 1)
+    with pytest.raises(ExternalReferenceError, match="declares a document type or entities"):
+        analyze(hostile.encode(), filename="cube.xdmf")
+
+
+def test_an_xdmf_time_series_is_weighed_by_its_mesh(tmp_path: Path) -> None:
+    # a temporal collection of grids over one mesh (results over time, as dolfinx and meshio write them; each
+    # step includes the mesh by an XInclude xpointer into the same document): the corner tetrahedron of
+    # edge 2, volume 8/6, centroid (1/2, 1/2, 1/2)
+    points = np.array([[0.0, 0.0, 0.0], [2.0, 0.0, 0.0], [0.0, 2.0, 0.0], [0.0, 0.0, 2.0]])
+    path = tmp_path / "series.xdmf"
+    with meshio.xdmf.TimeSeriesWriter(str(path), data_format="XML") as writer:
+        writer.write_points_cells(points, [("tetra", np.array([[0, 1, 2, 3]]))])
+        for t in (0.0, 1.0):
+            writer.write_data(t, point_data={"u": np.full(4, t)})
+    assert b'CollectionType="Temporal"' in path.read_bytes()
+    doc = analyze(path.read_bytes(), filename="series.xdmf", options=AnalysisOptions(density=1.0)).as_dict()
+    assert doc["mass"] == pytest.approx(8 / 6, rel=1e-15)
+    assert doc["center_of_mass"] == pytest.approx([0.5, 0.5, 0.5], rel=1e-15)
