@@ -442,3 +442,32 @@ def test_a_requested_total_mass_says_the_constants_are_not_the_molecules() -> No
     scaled = analyze_points(_points(water()), AnalysisOptions(units="angstrom", mass=1.0)).as_dict()
     assert not plain["warnings"]
     assert any("rotational constants are those of that scaled body" in w for w in scaled["warnings"])
+
+
+def test_a_missing_comment_line_is_suggested_when_the_second_line_is_an_atom(client: Any) -> None:
+    text = "\n".join(["3", *_water_rows()]) + "\n"
+    r = client.post("/v1/analyze/mesh", files={"file": ("w.xyz", text.encode())})
+    message = r.json()["error"]["message"]
+    assert r.status_code == 422 and "holds 2 atom lines" in message and "is the comment line missing?" in message
+
+
+@pytest.mark.parametrize(
+    ("properties", "lacks"),
+    [
+        ("species:S:1:frc:R:3", "lack a position column ('pos:R:3')"),  # QUIP's force files: no positions at all
+        ("species:S:1:pos:I:3", "lack positions as three real numbers ('pos:R:3'; it says 'pos:I:3')"),
+        ("name:S:1:pos:R:3", "lack an element column ('species:S:1' or 'Z:I:1')"),
+    ],
+)
+def test_an_extended_xyz_layout_is_refused_for_what_it_lacks_alone(client: Any, properties: str, lacks: str) -> None:
+    text = "\n".join(["3", f"Properties={properties}", *_water_rows()]) + "\n"
+    r = client.post("/v1/analyze/mesh", files={"file": ("w.xyz", text.encode())})
+    message = r.json()["error"]["message"]
+    assert r.status_code == 415 and lacks in message
+    assert ("element column" in message) is properties.startswith("name")
+
+
+def test_a_lattice_without_pbc_is_said_to_be_read_as_periodic_not_quoted(client: Any) -> None:
+    text = "\n".join(["3", 'Lattice="20 0 0 0 20 0 0 0 20" Properties=species:S:1:pos:R:3', *_water_rows()]) + "\n"
+    doc = client.post("/v1/analyze/mesh", files={"file": ("w.xyz", text.encode())}).json()
+    assert any("a Lattice without pbc, periodic as ASE reads it" in w for w in doc["warnings"])

@@ -220,7 +220,12 @@ def _xyz_records(text: str) -> tuple[list[Any], list[str]]:
     layout = _xyz_layout(lines[1] if len(lines) > 1 else "")
     atoms = lines[2 : 2 + count]
     if len(atoms) < count:
-        raise UnreadableFileError(f"the XYZ file announces {count} atoms but holds {len(atoms)} atom lines")
+        hint = (
+            " (its second line, always a comment in XYZ, holds what looks like an atom: is the comment line missing?)"
+            if len(atoms) == count - 1 and len(lines) > 1 and _is_atom_line(lines[1], layout)
+            else ""
+        )
+        raise UnreadableFileError(f"the XYZ file announces {count} atoms but holds {len(atoms)} atom lines{hint}")
     records = []
     for k, line in enumerate(atoms):
         fields = line.split()
@@ -256,8 +261,9 @@ def _xyz_records(text: str) -> tuple[list[Any], list[str]]:
     info = _key_values(lines[1]) if len(lines) > 1 else {}
     pbc = info.get("pbc", "T T T" if "Lattice" in info else "")  # ASE: a Lattice without pbc is periodic
     if any(flag in ("T", "t", "True", "true", "1") for flag in pbc.split()):
+        said = f"pbc={pbc!r}" if "pbc" in info else "a Lattice without pbc, periodic as ASE reads it"
         warnings.append(
-            f"the XYZ file describes a periodic cell (pbc={pbc!r}); its {count} atoms were analysed as one isolated "
+            f"the XYZ file describes a periodic cell ({said}); its {count} atoms were analysed as one isolated "
             "cluster, without their periodic images"
         )
     if after:
@@ -369,12 +375,19 @@ def _xyz_layout(comment: str) -> _XyzLayout:
     numbers = columns.get("Z") if "species" in columns else None
     pos = columns.get("pos")
     mass = columns.get("masses")
-    if species is None or species[2] != 1 or pos is None or pos[:3:2] != ("R", 3):
+    lacking = []
+    if species is None or species[2] != 1:
+        lacking.append("an element column ('species:S:1' or 'Z:I:1')")
+    if pos is None:
+        lacking.append("a position column ('pos:R:3')")
+    elif pos[:3:2] != ("R", 3):
+        lacking.append(f"positions as three real numbers ('pos:R:3'; it says 'pos:{pos[0]}:{pos[2]}')")
+    if lacking:
         raise UnsupportedFormatError(
-            f"the extended XYZ file's columns ({shown}) name no element column ('species:S:1' or "
-            "'Z:I:1') and position column ('pos:R:3'); write the file with both",
+            f"the extended XYZ file's columns ({shown}) lack {' and '.join(lacking)}; write the file with them",
             format="xyz",
         )
+    assert species is not None and pos is not None
     if mass is not None and (mass[0] not in ("R", "I") or mass[2] != 1):
         raise UnreadableFileError(f"the extended XYZ Properties={shown!r} has a masses column that is not one number per atom")
     names = {species[1]: "element", pos[1]: "x y z", **({} if mass is None else {mass[1]: "mass"})}
