@@ -213,7 +213,11 @@ def _parser() -> argparse.ArgumentParser:
         choices=METHODS,
         help="motion method: exact (closed form / elliptic), dop853, rk45 or splitting (default exact)",
     )
-    a.add_argument("--json", action="store_true", help="print the API's JSON instead of a table (errors as JSON too)")
+    a.add_argument(
+        "--json",
+        action="store_true",
+        help="print the API's JSON instead of a table (an error as JSON too, on standard error, with a non-zero exit status)",
+    )
     a.add_argument(
         "--output-units",
         choices=tuple(OUTPUT_UNITS),
