@@ -1261,10 +1261,44 @@ def abaqus_flatten(data: bytes, companions: Mapping[str, bytes], label: str) -> 
 _ABAQUS_COMMENT = re.compile(rb"^\*\*[^\n]*(?:\n|$)", re.MULTILINE)
 _ABAQUS_KEYWORD_LINE = re.compile(rb"^\*(?!\*)[^\n]*", re.MULTILINE)
 _ABAQUS_SETS = {b"NSET", b"ELSET"}
-_NODE_TRAILING_COMMAS = re.compile(rb"(?:,[ \t]*)+(\r?)$", re.MULTILINE)
-_NODE_EMPTY_FIELD = re.compile(rb",[ \t]*(?=,|\r?$)", re.MULTILINE)
-_NODE_SHORT = re.compile(rb"^([ \t]*[^,\s][^,\r\n]*(?:,[^,\r\n]*){0,2})(\r?)$", re.MULTILINE)
-_NODE_LONG = re.compile(rb"^([^,\r\n]*(?:,[^,\r\n]*){3}),[^\r\n]*", re.MULTILINE)
+_EMPTY_FIELD = re.compile(rb",[ \t]*(?:,|\r?\n|\r?$)")
+
+
+def _line_words(rows: bytes) -> NDArray[np.int64]:
+    """Each line's number of words (runs of characters other than commas and blanks), in a few passes over
+    the bytes: the blocks of a large deck hold millions of lines."""
+    arr = np.frombuffer(rows, dtype=np.uint8)
+    ends = np.flatnonzero(arr == 10)
+    if len(arr) and arr[-1] != 10:
+        ends = np.append(ends, len(arr))
+    word = _WORD_BYTE[arr]
+    first = np.flatnonzero(word[1:] & ~word[:-1]) + 1  # where a word starts (after a comma or a blank)
+    if len(word) and word[0]:
+        first = np.concatenate([[0], first])
+    return np.bincount(np.searchsorted(ends, first), minlength=len(ends))[: len(ends)].astype(np.int64)
+
+
+_WORD_BYTE = np.ones(256, dtype=bool)
+_WORD_BYTE[np.frombuffer(b", \t\r\n", dtype=np.uint8)] = False
+
+
+def _node_rows(rows: bytes) -> bytes:
+    """A node block's data lines with Abaqus's defaults written out: the number and three coordinates, an
+    omitted or empty one 0, nothing after the third (a normal's direction cosines), no comma at the end."""
+    words = _line_words(rows)
+    if np.all((words == 4) | (words == 0)) and _EMPTY_FIELD.search(rows) is None:
+        return rows
+    lines = rows.split(b"\n")
+    for k in range(len(lines)):
+        line = lines[k]
+        if not line.strip():
+            continue
+        fields = [f.strip() for f in line.rstrip(b"\r").split(b",")]
+        while len(fields) > 1 and not fields[-1]:
+            fields.pop()  # a comma at the end starts no field
+        fields = [f or b"0" for f in fields[:4]] + [b"0"] * (4 - len(fields[:4]))
+        lines[k] = b", ".join(fields) + (b"\r" if line.endswith(b"\r") else b"")
+    return b"\n".join(lines)
 
 
 def abaqus_plain(data: bytes) -> bytes:
@@ -1281,10 +1315,18 @@ def abaqus_plain(data: bytes) -> bytes:
     - Node lines get the coordinates Abaqus defaults: an omitted or empty
       coordinate is 0, a comma at the end starts no field, and what follows
       the third coordinate (a normal's direction cosines) is no coordinate.
+    - Element lines are read as CalculiX reads them: an element's node
+      numbers, from its first line and as many lines after it as it needs,
+      up to the number its type has; numbers past that on a line are not
+      nodes.  meshio took all numbers of a block as one run and cut it into
+      rows of the type's length: one line with two numbers too many failed
+      the block (CalculiX's transition.inp), and lines that made up a
+      multiple of the length would have been cut at the wrong places.
     """
-    data = _ABAQUS_COMMENT.sub(b"", data)
+    if data.startswith(b"**") or b"\n**" in data or b"\r**" in data:
+        data = _ABAQUS_COMMENT.sub(b"", data)
     keywords = [(m.start(), _abaqus_keyword(m.group()) or b"") for m in _ABAQUS_KEYWORD_LINE.finditer(data)]
-    if not any(k in _ABAQUS_SETS or k == b"NODE" for _, k in keywords):
+    if not any(k in _ABAQUS_SETS or k in (b"NODE", b"ELEMENT") for _, k in keywords):
         return data
     pieces = [data[: keywords[0][0]] if keywords else data]
     for (start, keyword), (end, _) in zip(keywords, [*keywords[1:], (len(data), b"")], strict=True):
@@ -1293,14 +1335,58 @@ def abaqus_plain(data: bytes) -> bytes:
             continue
         if keyword == b"NODE":
             head, newline, rows = block.partition(b"\n")
-            rows = _NODE_TRAILING_COMMAS.sub(rb"\1", rows)
-            rows = _NODE_EMPTY_FIELD.sub(b", 0", rows)
-            rows = _NODE_LONG.sub(rb"\1", rows)
-            for _ in range(3):  # at most three coordinates to add (a node line may hold its number alone)
-                rows = _NODE_SHORT.sub(rb"\1, 0\2", rows)
-            block = head + newline + rows
+            block = head + newline + _node_rows(rows)
+        if keyword == b"ELEMENT":
+            head, newline, rows = block.partition(b"\n")
+            nodes = _abaqus_element_nodes(head)
+            if nodes is not None:
+                block = head + newline + _element_rows(rows, nodes)
         pieces.append(block)
     return b"".join(pieces)
+
+
+def _abaqus_element_nodes(keyword_line: bytes) -> int | None:
+    """Nodes per element of an ``*ELEMENT`` line's type, as meshio's tables give it; None where unknown."""
+    from meshio import _common
+    from meshio.abaqus import _abaqus
+
+    t = _ABAQUS_TYPE.search(keyword_line.partition(b",")[2])
+    table = getattr(_abaqus, "abaqus_to_meshio_type", None)
+    counts = getattr(_common, "num_nodes_per_cell", None)
+    if t is None or not isinstance(table, dict) or not isinstance(counts, dict):
+        return None
+    name = t.group("type").decode("latin-1")
+    cell = table.get(name) or table.get(name.upper())
+    nodes = counts.get(cell) if cell is not None else None
+    return int(nodes) if isinstance(nodes, int) else None
+
+
+def _element_rows(rows: bytes, nodes: int) -> bytes:
+    """An element block's data lines, one element per line: its number and its first ``nodes`` node numbers,
+    gathered from as many lines as it takes (CalculiX's ``elements.f``); the rows as they are where an element
+    is left incomplete (meshio then names the fault), or where every element already ends at a line's end
+    (meshio's reading is then the same)."""
+    counts = _line_words(rows)
+    ends = np.cumsum(counts[counts > 0])
+    total = int(ends[-1]) if len(ends) else 0
+    if total % (nodes + 1) == 0 and np.all(np.isin(np.arange(nodes + 1, total + 1, nodes + 1), ends)):
+        return rows
+    out: list[bytes] = []
+    element: list[bytes] = []
+    for line in rows.splitlines():
+        words = [w.strip() for w in line.split(b",") if w.strip()]
+        if not words:
+            continue
+        if not element:
+            element = words[: nodes + 1]
+        else:
+            element += words[: nodes + 1 - len(element)]
+        if len(element) == nodes + 1:
+            out.append(b", ".join(element))
+            element = []
+    if element:
+        return rows
+    return b"\n".join(out) + b"\n" if out else rows
 
 
 def abaqus_one_node_block(data: bytes, label: str) -> bytes:

@@ -259,3 +259,21 @@ def test_shells_and_beams_meshio_lacks_are_left_out_with_the_solids_weighed(elem
     assert doc["mass"] / doc["density"] == pytest.approx(float(v), rel=1e-14)
     assert doc["center_of_mass"] == pytest.approx([float(x) for x in c], rel=1e-14)
     assert any("whose mass depends on section properties; they were not weighed" in w for w in doc["warnings"])
+
+
+@pytest.mark.parametrize(
+    "elements",
+    [
+        "1, 1, 2, 3, 4, 17\n2, 5, 6, 7, 8, 17, 18\n",  # numbers past the type's nodes (CalculiX's transition.inp)
+        "1, 1, 2,\n3, 4\n2, 5, 6, 7,\n8, 19\n",  # continuation lines, the last with one number too many
+        "1, 1, 2, 3, 4, 9, 9, 9, 9, 9\n2, 5, 6, 7, 8, 9, 9, 9, 9, 9\n",  # ten numbers a line: two rows of five to meshio
+    ],
+    ids=["extra-numbers", "continued", "a-multiple-of-the-row"],
+)
+def test_element_lines_are_read_as_calculix_reads_them(elements: str) -> None:
+    # CalculiX (elements.f) takes an element's nodes from its first line and the lines after it until it
+    # has as many as its type needs; numbers past those on a line are not nodes
+    volume, centre = weigh(f"{TWO_TETS}*ELEMENT, TYPE=C3D4\n{elements}")
+    v, c = expected()
+    assert volume == pytest.approx(float(v), rel=1e-14)
+    assert centre == pytest.approx([float(x) for x in c], rel=1e-14)
