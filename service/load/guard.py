@@ -182,10 +182,11 @@ def _attrs(text: bytes) -> dict[str, str]:
     }
 
 
-# a document type that names a DTD and declares nothing itself, as XDMF files write theirs
-# (<!DOCTYPE Xdmf SYSTEM "Xdmf.dtd" []>): XML parsers do not fetch the DTD, and there is nothing to expand
+# a document type that names a DTD by a plain file name and declares nothing itself, as XDMF files write
+# theirs (<!DOCTYPE Xdmf SYSTEM "Xdmf.dtd" []>): XML parsers do not fetch the DTD, and there is nothing to
+# expand; a DTD named by a path, a URL or a PUBLIC identifier is refused as any other declaration
 _BARE_DOCTYPE = re.compile(
-    rb"<!DOCTYPE[ \t\r\n]+[\w:.-]+(?:[ \t\r\n]+(?:SYSTEM|PUBLIC)(?:[ \t\r\n]+(?:\"[^\"<>\[\]]*\"|'[^'<>\[\]]*'))+)?"
+    rb"<!DOCTYPE[ \t\r\n]+[\w:.-]+(?:[ \t\r\n]+SYSTEM[ \t\r\n]+(?:\"[\w.-]*\"|'[\w.-]*'))?"
     rb"[ \t\r\n]*(?:\[[ \t\r\n]*\])?[ \t\r\n]*>",
     re.IGNORECASE,
 )
@@ -203,8 +204,9 @@ def _refuse_doctype(xml: bytes, ctx: _Context, bare_allowed: bool = False) -> No
         )
 
 
-_XDMF_ITEM = re.compile(rb"<DataItem\b([^>]*)>([^<]*)", re.IGNORECASE)
-_XINCLUDE = re.compile(rb"<[\w]*:?include\b([^>]*)>", re.IGNORECASE)
+_TAG_ATTRIBUTES = rb"((?:[^>\"']|\"[^\"]*\"|'[^']*')*)"  # a tag's attributes: a '>' inside a quoted value is no end
+_XDMF_ITEM = re.compile(rb"<DataItem\b" + _TAG_ATTRIBUTES + rb">([^<]*)", re.IGNORECASE)
+_XINCLUDE = re.compile(rb"<[\w]*:?include\b" + _TAG_ATTRIBUTES + rb">", re.IGNORECASE)
 
 
 def _check_xdmf(data: bytes, ctx: _Context) -> None:

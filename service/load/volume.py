@@ -928,6 +928,8 @@ def _read_meshio(data: bytes, fmt: str, label: str, filename: str | None, compan
     if fmt == "msh":
         _gmsh_node_order(mesh)
     out = _mesh_from_meshio(mesh, label)
+    if fmt == "xdmf" and isinstance(mesh.info, list):  # what the time series' reading chose (_xdmf_time_series_mesh)
+        out.warnings.extend(str(note) for note in mesh.info)
     version = _gmsh_format(data) if fmt == "msh" else None
     if version is not None and version[0] <= 2:  # MSH 4 lists an element once
         _drop_repeated_cells(out, label)
@@ -1191,6 +1193,13 @@ _ABAQUS_INPUT_PARAMETER = re.compile(rb",[ \t]*input[ \t]*=[ \t]*(?P<name>[^,\r\
 MAX_INCLUDE_DEPTH = 16
 
 
+def _abaqus_lines(data: bytes) -> bytes:
+    """The deck's lines ended by \\n alone (meshio reads \\r\\n and a bare \\r as line ends too), keywords unindented."""
+    if b"\r" in data:
+        data = data.replace(b"\r\n", b"\n").replace(b"\r", b"\n")
+    return _ABAQUS_INDENT.sub(b"", data)
+
+
 def abaqus_input_names(data: bytes) -> set[str]:
     """The file names a deck's keyword lines read (``*INCLUDE, INPUT=name`` and the like)."""
     names = set()
@@ -1219,7 +1228,7 @@ def abaqus_flatten(data: bytes, companions: Mapping[str, bytes], label: str) -> 
     see ``load_body``); the result is bounded by the upload's inflation
     budget, so a file that includes itself or others many times is refused.
     """
-    data = _ABAQUS_INDENT.sub(b"", data)
+    data = _abaqus_lines(data)
     if not _ABAQUS_INPUT_PARAMETER.search(data):  # most decks read no other file: no pass over their lines
         return data
     budget = inflate_budget(len(data) + sum(len(v) for v in companions.values()))
@@ -1241,7 +1250,7 @@ def abaqus_flatten(data: bytes, companions: Mapping[str, bytes], label: str) -> 
                 if keyword != b"INCLUDE":  # the keyword stays; its data lines come from the file
                     line = line[: m.start()] + line[m.end() :]
                     out.append(line if line.endswith((b"\n", b"\r")) else line + b"\n")
-                content = _ABAQUS_INDENT.sub(b"", companions[name])
+                content = _abaqus_lines(companions[name])
                 expand(content if content.endswith((b"\n", b"\r")) else content + b"\n", depth + 1)
                 continue
             out.append(line)
@@ -1323,7 +1332,7 @@ def abaqus_plain(data: bytes) -> bytes:
       the block (CalculiX's transition.inp), and lines that made up a
       multiple of the length would have been cut at the wrong places.
     """
-    if data.startswith(b"**") or b"\n**" in data or b"\r**" in data:
+    if data.startswith(b"**") or b"\n**" in data:
         data = _ABAQUS_COMMENT.sub(b"", data)
     keywords = [(m.start(), _abaqus_keyword(m.group()) or b"") for m in _ABAQUS_KEYWORD_LINE.finditer(data)]
     if not any(k in _ABAQUS_SETS or k in (b"NODE", b"ELEMENT") for _, k in keywords):
@@ -1493,16 +1502,65 @@ def _refuse_unapplied(keyword: bytes, line: bytes, data: list[bytes], label: str
             )
 
 
+_XDMF_DATA_ITEM = re.compile(rb"(<DataItem\b(?:[^>\"']|\"[^\"]*\"|'[^']*')*>)([^<]*)", re.IGNORECASE)
+_BINARY_FORMAT = re.compile(rb"\bFormat\s*=\s*[\"']Binary[\"']", re.IGNORECASE)
+
+
+def _binary_items_beside(path: str) -> None:
+    """Point the XDMF file's ``Binary`` data items at the files of its private folder, by absolute path.
+
+    meshio reads a Binary item's file name relative to the process's working directory (``np.fromfile``),
+    not to the XDMF file: a name that is a file of the server's working directory would have been read
+    instead of the upload's own file.  The guard admits plain names of the upload's files only; each is
+    written here as the path of that file in the folder (missing there: meshio says the file is not found).
+    """
+    folder = os.path.dirname(path)
+    with open(path, "rb") as fh:
+        text = fh.read()
+
+    def beside(m: re.Match[bytes]) -> bytes:
+        if not _BINARY_FORMAT.search(m.group(1)) or not m.group(2).strip():
+            return m.group(0)
+        name = _safe_name(m.group(2).strip().decode("utf-8", "replace"))
+        return m.group(1) + os.path.join(folder, name or "missing").encode()
+
+    changed = _XDMF_DATA_ITEM.sub(beside, text)
+    if changed != text:
+        with open(path, "wb") as out:
+            out.write(changed)
+
+
 _XDMF_TEMPORAL = re.compile(rb"CollectionType\s*=\s*[\"']Temporal[\"']", re.IGNORECASE)
 
 
 def _xdmf_time_series_mesh(path: str) -> Any:
     """The mesh of an XDMF time series (a temporal collection of grids over one mesh, as dolfinx and meshio's
-    ``TimeSeriesWriter`` write results): its points and cells, the steps' fields left aside."""
+    ``TimeSeriesWriter`` write results): its points and cells, the steps' fields left aside.
+
+    meshio's ``TimeSeriesReader`` takes the last grid beside the collection, else the first step's own
+    mesh: several grids beside it, or a spatial collection, are refused as ``meshio.read`` refuses them;
+    steps that each carry their own mesh (one that moves) are weighed at the first step, with a note.
+    """
+    import xml.etree.ElementTree as ET
+
     import meshio
 
+    domain = ET.parse(path).getroot().find("Domain")  # the guard has refused entities and document types
+    grids = [] if domain is None else domain.findall("Grid")
+    meshes = [g for g in grids if g.get("GridType", "Uniform") == "Uniform"]
+    kinds = {g.get("CollectionType", "Spatial") for g in grids if g.get("GridType") == "Collection"}
+    if len(meshes) > 1 or kinds - {"Temporal"}:
+        what = f"{len(meshes)} meshes beside its time series" if len(meshes) > 1 else "a spatial collection of grids"
+        raise UnsupportedFormatError(
+            f"the XDMF file holds {what}, which are not read as one body; send one mesh per file", format="xdmf"
+        )
+    notes = []
+    steps = [s for g in grids if g.get("GridType") == "Collection" for s in g.findall("Grid")]
+    own = [s for s in steps if s.find("Geometry") is not None]
+    if not meshes and len(own) > 1:
+        notes.append(f"the XDMF time series' {len(steps)} steps each carry their own mesh; the mesh of its first step was weighed")
     points, cells = meshio.xdmf.TimeSeriesReader(path).read_points_cells()
-    return meshio.Mesh(points, cells)
+    return meshio.Mesh(points, cells, info=notes)
 
 
 def _meshio_read(data: bytes, fmt: str, label: str, filename: str | None, companions: Mapping[str, bytes] | None) -> Any:
@@ -1511,10 +1569,12 @@ def _meshio_read(data: bytes, fmt: str, label: str, filename: str | None, compan
 
     with _upload_dir(data, fmt, filename, companions) as path, _quiet() as printed, _without_hdf5(data, fmt):
         try:
+            if fmt == "xdmf":
+                _binary_items_beside(path)
             if fmt == "xdmf" and _XDMF_TEMPORAL.search(data):
                 return _xdmf_time_series_mesh(path)
             return meshio.read(path, file_format=VOLUME_FORMATS[fmt])
-        except KeyboardInterrupt:
+        except (KeyboardInterrupt, UnsupportedFormatError):  # ours: said as it stands
             raise
         except BaseException as exc:  # meshio calls sys.exit(1) and raises KeyError, ValueError, ...
             if isinstance(exc, ImportError) and (exc.name or "").partition(".")[0] == "h5py":

@@ -277,3 +277,12 @@ def test_element_lines_are_read_as_calculix_reads_them(elements: str) -> None:
     v, c = expected()
     assert volume == pytest.approx(float(v), rel=1e-14)
     assert centre == pytest.approx([float(x) for x in c], rel=1e-14)
+
+
+@pytest.mark.parametrize("newline", ["\n", "\r\n", "\r"], ids=["lf", "crlf", "cr"])
+def test_a_comment_in_a_deck_of_any_line_ends_removes_only_its_line(newline: str) -> None:
+    deck = f"** made by a tool\n{TWO_TETS}*ELEMENT, TYPE=C3D4\n1, 1, 2, 3, 4\n** between\n2, 5, 6, 7, 8\n"
+    volume, centre = weigh(deck.replace("\n", newline))
+    v, c = expected()
+    assert volume == pytest.approx(float(v), rel=1e-14)
+    assert centre == pytest.approx([float(x) for x in c], rel=1e-14)

@@ -597,3 +597,72 @@ def test_an_xdmf_time_series_is_weighed_by_its_mesh(tmp_path: Path) -> None:
     doc = analyze(path.read_bytes(), filename="series.xdmf", options=AnalysisOptions(density=1.0)).as_dict()
     assert doc["mass"] == pytest.approx(8 / 6, rel=1e-15)
     assert doc["center_of_mass"] == pytest.approx([0.5, 0.5, 0.5], rel=1e-15)
+
+
+def test_an_xdmf_binary_item_is_the_uploads_file_never_one_in_the_working_directory(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    # meshio reads a Binary item's name relative to the process's working directory: a decoy there (the
+    # corner tetrahedron of edge 5) must not be read in place of the upload's own file (edge 1, volume 1/6)
+    monkeypatch.chdir(tmp_path)
+    np.array([[0, 0, 0], [5, 0, 0], [0, 5, 0], [0, 0, 5]], dtype=np.float32).tofile("pts.bin")
+    upload = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]], dtype=np.float32).tobytes()
+    doc = (
+        b'<Xdmf Version="3.0"><Domain><Grid Name="mesh" GridType="Uniform"><Geometry GeometryType="XYZ">'
+        b'<DataItem Dimensions="4 3" Format="Binary" DataType="Float" Precision="4">pts.bin</DataItem></Geometry>'
+        b'<Topology TopologyType="Tetrahedron" NumberOfElements="1"><DataItem Dimensions="1 4" Format="XML" '
+        b'DataType="Int">0 1 2 3</DataItem></Topology></Grid><Grid Name="ts" GridType="Collection" '
+        b'CollectionType="Temporal"><Grid Name="s" GridType="Uniform"><Time Value="0"/></Grid></Grid></Domain></Xdmf>'
+    )
+    loaded = load_body([("a.xdmf", doc), ("pts.bin", upload)])
+    props = analyze_loaded(loaded, AnalysisOptions(density=1.0)).as_dict()
+    assert props["mass"] == pytest.approx(1 / 6, rel=1e-12)
+
+
+@pytest.mark.parametrize(
+    "declaration",
+    [
+        '<!DOCTYPE Xdmf SYSTEM "file:///etc/passwd" []>',  # a DTD named by a URL or a path is no bare name
+        '<!DOCTYPE Xdmf PUBLIC "-//x" "http://example.org/x.dtd">',
+    ],
+)
+def test_a_document_type_naming_a_dtd_by_path_or_url_is_refused(declaration: str) -> None:
+    from inertia.errors import ExternalReferenceError
+
+    declared = XDMF_XML.replace('<?xml version="1.0"?>\n', '<?xml version="1.0"?>\n' + declaration + "\n", 1)
+    with pytest.raises(ExternalReferenceError, match="declares a document type or entities"):
+        analyze(declared.encode(), filename="cube.xdmf")
+
+
+def test_an_xinclude_href_after_a_quoted_angle_bracket_is_still_checked() -> None:
+    from inertia.errors import ExternalReferenceError
+
+    tricked = XDMF_XML.replace("<Domain>", '<Domain><xi:include xpointer="a>b" href="/etc/passwd"/>', 1)
+    with pytest.raises(ExternalReferenceError, match="XInclude href '/etc/passwd'"):
+        analyze(tricked.encode(), filename="cube.xdmf")
+
+
+def _series(inner: str) -> bytes:
+    return (
+        '<?xml version="1.0"?><Xdmf Version="3.0" xmlns:xi="http://www.w3.org/2001/XInclude"><Domain>' + inner + "</Domain></Xdmf>"
+    ).encode()
+
+
+def _grid(name: str, edge: int, extra: str = "") -> str:
+    return (
+        f'<Grid Name="{name}" GridType="Uniform"><Geometry GeometryType="XYZ"><DataItem Dimensions="4 3" Format="XML">'
+        f'0 0 0 {edge} 0 0 0 {edge} 0 0 0 {edge}</DataItem></Geometry><Topology TopologyType="Tetrahedron" '
+        f'NumberOfElements="1"><DataItem Dimensions="1 4" Format="XML" DataType="Int">0 1 2 3</DataItem></Topology>'
+        f"{extra}</Grid>"
+    )
+
+
+def test_an_xdmf_time_series_beside_two_meshes_is_refused_one_that_moves_is_weighed_at_its_first_step() -> None:
+    temporal = '<Grid Name="ts" GridType="Collection" CollectionType="Temporal">{}</Grid>'
+    two = _series(_grid("mesh", 1) + _grid("other", 2) + temporal.format(_grid("s", 1, '<Time Value="0"/>')))
+    with pytest.raises(UnsupportedFormatError, match="holds 2 meshes beside its time series"):
+        analyze(two, filename="two.xdmf")
+    moving = _series(temporal.format(_grid("a", 1, '<Time Value="0"/>') + _grid("b", 2, '<Time Value="1"/>')))
+    doc = analyze(moving, filename="moving.xdmf", options=AnalysisOptions(density=1.0)).as_dict()
+    assert doc["mass"] == pytest.approx(1 / 6, rel=1e-12)  # the first step's tetrahedron of edge 1
+    assert any("2 steps each carry their own mesh; the mesh of its first step was weighed" in w for w in doc["warnings"])
