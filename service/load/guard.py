@@ -49,6 +49,8 @@ from ..errors import ExternalReferenceError, InputTooLargeError, UnreadableFileE
 __all__ = [
     "check_upload",
     "own_name",
+    "xml_attributes",
+    "XDMF_DATA_ITEM",
     "plain_name",
     "refuse_reference",
     "inflate_budget",
@@ -173,7 +175,7 @@ _DOCTYPE = re.compile(rb"<!(?:DOCTYPE|ENTITY)", re.IGNORECASE)
 _ATTR = re.compile(rb"([\w:]+)\s*=\s*(?:\"([^\"]*)\"|'([^']*)')")
 
 
-def _attrs(text: bytes) -> dict[str, str]:
+def xml_attributes(text: bytes) -> dict[str, str]:
     return {
         m.group(1).decode("ascii", "replace"): (m.group(2) if m.group(2) is not None else m.group(3) or b"").decode(
             "utf-8", "replace"
@@ -205,18 +207,18 @@ def _refuse_doctype(xml: bytes, ctx: _Context, bare_allowed: bool = False) -> No
 
 
 _TAG_ATTRIBUTES = rb"((?:[^>\"']|\"[^\"]*\"|'[^']*')*)"  # a tag's attributes: a '>' inside a quoted value is no end
-_XDMF_ITEM = re.compile(rb"<DataItem\b" + _TAG_ATTRIBUTES + rb">([^<]*)", re.IGNORECASE)
+XDMF_DATA_ITEM = re.compile(rb"<DataItem\b" + _TAG_ATTRIBUTES + rb">([^<]*)", re.IGNORECASE)
 _XINCLUDE = re.compile(rb"<[\w]*:?include\b" + _TAG_ATTRIBUTES + rb">", re.IGNORECASE)
 
 
 def _check_xdmf(data: bytes, ctx: _Context) -> None:
     _refuse_doctype(data, ctx, bare_allowed=True)
     for match in _XINCLUDE.finditer(data):
-        href = _attrs(match.group(1)).get("href", "")
+        href = xml_attributes(match.group(1)).get("href", "")
         if href.strip():  # none: a part of this same document (an xpointer, as time series repeat their mesh)
             ctx.reference(href, "XInclude href")
-    for match in _XDMF_ITEM.finditer(data):
-        fmt = _attrs(match.group(1)).get("Format", "XML")
+    for match in XDMF_DATA_ITEM.finditer(data):
+        fmt = xml_attributes(match.group(1)).get("Format", "XML")
         if fmt.upper() in ("HDF", "BINARY"):
             text = match.group(2).decode("utf-8", "replace").strip()
             ctx.reference(text.split(":", 1)[0] if fmt.upper() == "HDF" else text, f"{fmt} data item")
@@ -238,7 +240,7 @@ def _check_vtk_xml(data: bytes, ctx: _Context) -> None:
     for match in _PIECE_SOURCE.finditer(xml):
         ctx.reference(match.group(1).decode("utf-8", "replace"), "Piece Source")
     root = _VTK_ROOT.search(xml)
-    attrs = _attrs(root.group(1)) if root else {}
+    attrs = xml_attributes(root.group(1)) if root else {}
     compressor = attrs.get("compressor")
     if not compressor:
         return  # uncompressed arrays are no larger than the file
@@ -249,7 +251,7 @@ def _check_vtk_xml(data: bytes, ctx: _Context) -> None:
     blocks = _Blocks(ctx, header, compressor)
     offsets: list[int] = []
     for match in _DATA_ARRAY.finditer(xml):
-        arr = _attrs(match.group(1))
+        arr = xml_attributes(match.group(1))
         fmt = arr.get("format", "ascii")
         if fmt == "binary" and not match.group(2):
             end = xml.find(b"</DataArray>", match.end())
@@ -266,7 +268,7 @@ def _check_appended(data: bytes, tag: re.Match[bytes], offsets: list[int], block
     if start < 0:
         raise UnreadableFileError("the VTK file's appended data does not start with '_'", format=blocks.ctx.fmt)
     blob = data[start + 1 : stop if stop > start else len(data)]
-    base64_encoded = _attrs(tag.group(1)).get("encoding", "raw") == "base64"
+    base64_encoded = xml_attributes(tag.group(1)).get("encoding", "raw") == "base64"
     for offset in offsets:
         if base64_encoded:
             blocks.check_base64(blob[offset:], appended=True)

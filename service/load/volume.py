@@ -77,7 +77,7 @@ from numpy.typing import NDArray
 from ..body import CellBlock, MeshBody, Part, VolumeBody, stored_eps
 from ..cells import CELL_NODES, VOXEL_TO_HEXAHEDRON
 from ..errors import EmptyGeometryError, ExternalReferenceError, InputTooLargeError, UnreadableFileError, UnsupportedFormatError
-from .guard import INFLATE_RATIO, inflate_budget, own_name, refuse_reference
+from .guard import INFLATE_RATIO, XDMF_DATA_ITEM, inflate_budget, own_name, refuse_reference, xml_attributes
 from .polygons import fan_split_note, fan_triangles
 from .sniff import VOLUME_FORMATS, VTK_FORMATS, VTK_XML_TYPES, vtk_xml_root_type
 
@@ -1502,10 +1502,6 @@ def _refuse_unapplied(keyword: bytes, line: bytes, data: list[bytes], label: str
             )
 
 
-_XDMF_DATA_ITEM = re.compile(rb"(<DataItem\b(?:[^>\"']|\"[^\"]*\"|'[^']*')*>)([^<]*)", re.IGNORECASE)
-_BINARY_FORMAT = re.compile(rb"\bFormat\s*=\s*[\"']Binary[\"']", re.IGNORECASE)
-
-
 def _binary_items_beside(path: str) -> None:
     """Point the XDMF file's ``Binary`` data items at the files of its private folder, by absolute path.
 
@@ -1519,12 +1515,12 @@ def _binary_items_beside(path: str) -> None:
         text = fh.read()
 
     def beside(m: re.Match[bytes]) -> bytes:
-        if not _BINARY_FORMAT.search(m.group(1)) or not m.group(2).strip():
+        if xml_attributes(m.group(1)).get("Format", "").upper() != "BINARY" or not m.group(2).strip():
             return m.group(0)
         name = _safe_name(m.group(2).strip().decode("utf-8", "replace"))
-        return m.group(1) + os.path.join(folder, name or "missing").encode()
+        return m.group(0)[: m.start(2) - m.start(0)] + os.path.join(folder, name or "missing").encode()
 
-    changed = _XDMF_DATA_ITEM.sub(beside, text)
+    changed = XDMF_DATA_ITEM.sub(beside, text)
     if changed != text:
         with open(path, "wb") as out:
             out.write(changed)
