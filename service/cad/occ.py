@@ -880,47 +880,16 @@ def triangles_only(solid: Solid) -> bool:
 
 
 def carried_triangles(solid: Solid) -> tuple[NDArray[np.float64], NDArray[np.int64]]:
-    """The triangles a tessellated solid carries [mm], faces wound as the solid orients them, and points
-    given twice (each face lists its own) joined where their coordinates are equal."""
+    """The triangles a tessellated solid carries [mm] (``_triangles``), and points given twice (each face
+    lists its own) joined where their coordinates are equal."""
     try:
-        from OCP.BRep import BRep_Tool
-        from OCP.TopAbs import TopAbs_FACE, TopAbs_REVERSED
-        from OCP.TopExp import TopExp_Explorer
-        from OCP.TopLoc import TopLoc_Location
-        from OCP.TopoDS import TopoDS
-
-        points: list[NDArray[np.float64]] = []
-        faces: list[NDArray[np.int64]] = []
-        offset = 0
-        explorer = TopExp_Explorer(solid.shape, TopAbs_FACE)
-        while explorer.More():
-            face = TopoDS.Face(explorer.Current())
-            loc = TopLoc_Location()
-            tri = BRep_Tool.Triangulation_s(face, loc)
-            if tri is None or tri.NbTriangles() == 0:
-                raise UnreadableFileError(
-                    f"a face of the solid {solid.name!r} has neither an exact surface nor triangles", part=solid.name
-                )
-            trsf = loc.Transformation()
-            xyz = np.array(
-                [(q.X(), q.Y(), q.Z()) for q in (tri.Node(i).Transformed(trsf) for i in range(1, tri.NbNodes() + 1))],
-                dtype=np.float64,
-            ).reshape(-1, 3)
-            t = np.array([tri.Triangle(k).Get() for k in range(1, tri.NbTriangles() + 1)], dtype=np.int64) - 1
-            if face.Orientation() == TopAbs_REVERSED:
-                t = t[:, ::-1]
-            points.append(xyz)
-            faces.append(t + offset)
-            offset += len(xyz)
-            explorer.Next()
+        vertices, faces = _triangles(solid.shape, solid.name)
     except ServiceError:
         raise
     except (Exception, SystemExit) as exc:
         raise _translated(exc, f"read the triangles of the solid {solid.name!r}") from exc
-    if not faces:
-        raise EmptyGeometryError(f"the solid {solid.name!r} has no faces", part=solid.name)
-    unique, inverse = np.unique(np.concatenate(points), axis=0, return_inverse=True)
-    return unique, inverse.reshape(-1)[np.concatenate(faces)].astype(np.int64)
+    unique, inverse = np.unique(vertices, axis=0, return_inverse=True)
+    return unique, inverse.reshape(-1)[faces].astype(np.int64)
 
 
 def _fixed(shape: Any) -> Any:
