@@ -177,20 +177,21 @@ def read_trimesh_parts(
         notes += cut + placed
     if fmt == "ply":  # what trimesh's reader would misread: a header out of its order, binary faces of mixed
         # sizes, ASCII rows not each on a line of their own (every ASCII file is read here)
-        from .ply import ascii_rows_overfilled, header_fault, header_in_order, read_ascii_ply, uniform_face_rows
+        from .ply import header_fault, header_in_order, read_ascii_ply_rows, read_binary_ply, uniform_face_rows
 
         problem = header_fault(data)
         if problem is not None:
             raise UnreadableFileError(problem, format=fmt)
         data = guarded_read(partial(header_in_order, data), fmt)
         if not guarded_read(partial(uniform_face_rows, data), fmt):
-            own = _own_ply(data, length_scale)
+            own = _own_ply(guarded_read(partial(read_binary_ply, data), fmt), length_scale)
             if own is not None:
                 return own, None
-        own = _own_ply(data, length_scale, read_ascii_ply)  # an ASCII file, read word by word
+        found, overfilled = guarded_read(partial(read_ascii_ply_rows, data), fmt)  # an ASCII file, read word by word
+        own = _own_ply(found, length_scale)
         if own is not None:
             return own, None
-        if guarded_read(partial(ascii_rows_overfilled, data), fmt):
+        if overfilled:
             notes.append(
                 "the ASCII PLY file's numbers do not fill the rows its header declares when read one after another "
                 "(its rows hold more values than declared); it was read one row per line, as trimesh reads it, "
@@ -212,7 +213,11 @@ def read_trimesh_parts(
         fault = _gltf_fault(data, fmt, companions) if fmt in ("gltf", "glb") else None
         if fault is not None:
             raise fault from None
-        own = _own_ply(data, length_scale) if fmt == "ply" else None  # faces of several lengths, a \r header
+        own = None
+        if fmt == "ply":  # faces of several lengths, a \r header
+            from .ply import read_binary_ply
+
+            own = _own_ply(guarded_read(partial(read_binary_ply, data), fmt), length_scale)
         if own is None:
             raise
         return own, None
@@ -264,13 +269,11 @@ def read_trimesh_parts(
     return parts, _declared_unit(scene, fmt)
 
 
-def _own_ply(data: bytes, length_scale: float, read: Callable[[bytes], PlyFaces | None] | None = None) -> list[Part] | None:
-    """A PLY file trimesh would misread, by ``read`` (default ``ply.read_binary_ply``); None where that cannot
-    read it either (trimesh's reading then stands)."""
-    from .ply import read_binary_ply
+def _own_ply(found: PlyFaces | None, length_scale: float) -> list[Part] | None:
+    """The part of a PLY file trimesh would misread, from our own reading of it (``ply.read_binary_ply``,
+    ``ply.read_ascii_ply_rows``); None where that could not read it either (trimesh's reading then stands)."""
     from .polygons import fan_split_note, fan_triangles
 
-    found = guarded_read(partial(read or read_binary_ply, data), "ply")
     if found is None:
         return None
     vertices, corners, counts = found

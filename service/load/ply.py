@@ -33,10 +33,10 @@ from ..errors import UnreadableFileError
 
 __all__ = [
     "PlyFaces",
-    "ascii_rows_overfilled",
     "header_fault",
     "header_in_order",
     "read_ascii_ply",
+    "read_ascii_ply_rows",
     "read_binary_ply",
     "uniform_face_rows",
 ]
@@ -256,18 +256,11 @@ def _walk(data: bytes, order: str, elements: list[tuple[str, int, list[Property]
 
 
 def read_ascii_ply(data: bytes) -> PlyFaces | None:
-    """See ``_read_ascii``."""
-    return _read_ascii(data)[0]
+    """See ``read_ascii_ply_rows``."""
+    return read_ascii_ply_rows(data)[0]
 
 
-def ascii_rows_overfilled(data: bytes) -> bool:
-    """Whether an ASCII PLY file's numbers, read one after another, do not fill its declared rows exactly: rows
-    that hold more values than its header declares (read one row per line, the values past each row's declared
-    ones are ignored, as trimesh reads them)."""
-    return _read_ascii(data)[1]
-
-
-def _read_ascii(data: bytes) -> tuple[PlyFaces | None, bool]:
+def read_ascii_ply_rows(data: bytes) -> tuple[PlyFaces | None, bool]:
     """The vertices (x, y, z rounded to their declared types), every face's corners one after another, and
     the corners per face, of an ASCII PLY file read as numbers separated by white space, whatever its lines.
 
