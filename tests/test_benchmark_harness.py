@@ -9,7 +9,7 @@ from pathlib import Path
 
 import pytest
 
-from benchmarks import harness
+from benchmarks import harness, timeline
 
 
 def test_best_of_keeps_the_fastest_run_and_its_result() -> None:
@@ -213,3 +213,51 @@ def test_mass_report_names_a_missing_peer_instead_of_failing(monkeypatch: pytest
 
     monkeypatch.setattr(importlib.metadata, "version", version)
     assert mass.machine_info()["numpy-stl"] == "not installed"
+
+
+def _timeline(tasks: list[tuple[int, float, float, int]]) -> timeline.Timeline:
+    forked = {pid: 0.5 for pid, *_ in tasks}
+    return timeline.Timeline(
+        launch=100.0,
+        main=100.05,
+        server=100.1,
+        preloaded=100.4,
+        exit=102.2,
+        forked={pid: 100.0 + t for pid, t in forked.items()},
+        tasks=[timeline.Task(pid, 100.0 + s, 100.0 + e, n) for pid, s, e, n in tasks],
+    )
+
+
+def test_timeline_profile_phases_come_from_the_tasks_times() -> None:
+    # worker 1: two tasks 0.6-1.0 and 1.1-2.0; worker 2: one task 0.7-1.5; worker 3 never got one
+    tl = _timeline([(1, 0.6, 1.0, 3), (1, 1.1, 2.0, 3), (2, 0.7, 1.5, 2)])
+    p = timeline.profile(tl, workers=3)
+    assert p["first_task"] == pytest.approx(0.6) and p["last_end"] == pytest.approx(2.0)
+    assert p["first_idle"] == pytest.approx(1.5)  # worker 2's last task ended first
+    assert p["all_busy"] == pytest.approx(2.0)  # one worker never had work: never all busy before the end
+    assert p["busy_s"] == pytest.approx(0.4 + 0.9 + 0.8)
+    assert p["busy_share"] == pytest.approx(2.1 / (3 * 1.4))
+    assert p["gap_sum_s"] == pytest.approx(0.1) and p["gap_mean_ms"] == pytest.approx(100.0)
+    assert p["workers_used"] == 2 and p["tasks"] == 3
+    assert p["preloaded"] == pytest.approx(0.4) and p["exit"] == pytest.approx(2.2)
+
+    p2 = timeline.profile(tl, workers=2)
+    assert p2["all_busy"] == pytest.approx(0.7)  # both workers had started a task
+
+
+def test_timeline_chart_marks_idle_busy_and_not_yet_forked() -> None:
+    tl = _timeline([(1, 1.14, 2.16, 1)])  # forked at 0.5 s of a 2.2 s run
+    row = timeline.chart(tl, columns=22)[0]  # 0.1 s a column
+    assert row == "....." + " " * 6 + "|" + "#" * 10
+
+
+def test_timeline_traces_every_task_of_a_real_run(tmp_path: Path) -> None:
+    from benchmarks import scale
+
+    scale.generate(tmp_path / "in", 12, 80, seed=1)
+    tl = timeline.traced_run(tmp_path / "in", tmp_path / "out.jsonl", workers=2)
+    assert sum(t.files for t in tl.tasks) == 12  # every file analysed in a traced task
+    assert len((tmp_path / "out.jsonl").read_text().splitlines()) == 12
+    assert tl.launch < tl.main < tl.server <= tl.preloaded < min(t.start for t in tl.tasks)
+    assert max(t.end for t in tl.tasks) < tl.exit
+    assert set(tl.forked) == {t.pid for t in tl.tasks}
