@@ -51,7 +51,7 @@ LAYERS: list[tuple[str, list[str]]] = [
     ("derived", ["export", "frames", "rotational"]),
     ("results", ["options", "results", "report"]),
     ("pipeline", ["pipeline", "few_points"]),
-    ("surfaces", ["api", "app", "batch", "cli", "web", "__main__", ""]),
+    ("surfaces", ["api", "app", "batch", "cli", "web", "__main__", "_contract_names", ""]),
 ]
 
 

@@ -7,6 +7,7 @@ import json
 import os
 import subprocess
 import sys
+from pathlib import Path
 
 import pytest
 
@@ -122,3 +123,19 @@ def test_numpy_imported_after_the_setting_starts_no_blas_threads() -> None:
     env = {k: v for k, v in os.environ.items() if k not in ("OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "OMP_NUM_THREADS")}
     out = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, cwd=ROOT, env=env, check=True)
     assert out.stdout.split() == ["1"]
+
+
+def test_the_contracts_names_work_outside_the_checkout(tmp_path: Path) -> None:
+    # API.md: "The ASGI application is `service.app:app` ... (also `python -m service serve ...`)"; from a folder
+    # other than the checkout's root only the installed distribution can answer to these names
+    probe = "import inertia.app, service.app; print(service.app.app is inertia.app.app, service.__file__)"
+    out = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True, cwd=tmp_path, check=True)
+    same, where = out.stdout.split()
+    assert same == "True" and not Path(where).is_relative_to(tmp_path)
+    box = str(SAMPLES / "box.stl")
+    cli = subprocess.run([sys.executable, "-m", "service", "analyze", box, "--json"], capture_output=True, text=True, cwd=tmp_path)
+    assert cli.returncode == 0, cli.stderr
+    got, expected = json.loads(cli.stdout), json.loads(run("analyze", box, "--json").stdout)
+    for doc in (got, expected):
+        del doc["diagnostics"]["elapsed_s"]
+    assert got == expected
