@@ -197,6 +197,14 @@ def test_points_files_json_and_csv(tmp_path: Path) -> None:
         assert doc["classification"]["kind"] == "linear_rotator"
 
 
+@pytest.mark.parametrize("end", ["\r", "\r\n", "\n"], ids=["cr", "crlf", "lf"])
+def test_a_points_csv_reads_the_same_with_any_line_ending(end: str) -> None:
+    # a lone \r (classic Mac, some spreadsheet exports) ends a row for the csv module's readers; it had escaped
+    # as csv.Error "new-line character seen in unquoted field"
+    doc = analyze(end.join(["mass,x,y,z", "1,0,0,0", "3,2,0,0", ""]).encode(), filename="p.csv").as_dict()
+    assert doc["mass"] == 4.0 and doc["center_of_mass"] == [1.5, 0.0, 0.0]
+
+
 def test_truncated_binary_stl_is_unreadable() -> None:
     data = export(box_mesh(), "stl")
     with pytest.raises(UnreadableFileError):

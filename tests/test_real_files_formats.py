@@ -362,3 +362,13 @@ def test_bytes_after_a_glbs_declared_length_are_left_out_with_a_note() -> None:
     assert doc["mass"] == pytest.approx(6.0, rel=1e-12)
     note = f"the GLB file has {len(tail)} byte(s) after the {len(glb)} its header declares"
     assert any(note in w for w in doc["warnings"])
+
+
+def test_a_vtu_whose_points_are_fewer_than_its_cells_use_is_refused_by_name() -> None:
+    # NumberOfPoints="1e308": VTK's reader keeps one point, and the tetra10 cells' nodes run past it; the warning
+    # about 2-D cells apart from the volume indexed the points with those nodes first (an IndexError)
+    from inertia.errors import UnreadableFileError
+
+    data = (REAL / "vtu" / "tetra.vtu").read_bytes().replace(b'NumberOfPoints="22"', b'NumberOfPoints="1e308"')
+    with pytest.raises(UnreadableFileError, match="refers to a point that does not exist"):
+        load_body(data, filename="tetra.vtu")

@@ -720,12 +720,22 @@ def _accessor_past_buffer(doc: dict[str, Any]) -> None:
     doc["accessors"][0]["count"] = 5000
 
 
+def _view_before_buffer(doc: dict[str, Any]) -> None:
+    doc["bufferViews"][0]["byteOffset"] = -1  # before the buffer's first byte: numpy's error was all one read
+
+
+def _fractional_offset(doc: dict[str, Any]) -> None:
+    doc["accessors"][0]["byteOffset"] = 0.5  # the schema's integer; int() made it 0
+
+
 @pytest.mark.parametrize(
     "change, words",
     [
         (_primitives_as_object, r"mesh 0 has no array of primitives \(meshes\[0\]\.primitives"),
         (_view_past_buffer, r"buffer view 0 runs past the end of buffer 0 \(bytes 0 to 5000 of its 144\)"),
         (_accessor_past_buffer, r"accessor 0 runs past its buffer \(mesh 0\)"),
+        (_view_before_buffer, r"accessor \d has its view's byteOffset -1, which is no byte count"),
+        (_fractional_offset, r"accessor 0 has byteOffset 0\.5, which is no byte count"),
     ],
 )
 def test_a_gltf_file_trimesh_cannot_read_has_its_fault_named(change: Callable[[dict[str, Any]], None], words: str) -> None:
@@ -1328,6 +1338,16 @@ def test_an_ascii_ply_gives_one_result_however_its_numbers_are_split(gaps: list[
     regular = analyze(_ONE_ROW_PER_LINE, filename="box.ply").as_dict()
     for key in ("mass", "center_of_mass", "inertia_tensor", "principal", "warnings"):
         assert doc[key] == regular[key]
+
+
+def test_an_ascii_ply_integer_coordinate_with_a_fraction_is_refused_not_truncated() -> None:
+    # rply (the reader of the PLY format's author's tools) refuses "2.5" in an int property; cast to the
+    # declared int it would move the vertex to 2 and weigh another body, without a word
+    data = _ascii_box_ply(lambda k: "\n" if k in _row_ends() else " ", kind="int")
+    doc = analyze(data, filename="box.ply").as_dict()  # whole numbers in int properties: the 1 x 2 x 3 box
+    assert doc["mass"] / doc["density"] == pytest.approx(6.0, rel=1e-15)
+    with pytest.raises(UnreadableFileError, match=r"declares vertex property 'y' as an integer but has the value 2\.5"):
+        analyze(data.replace(b" 2.0 ", b" 2.5 ", 1), filename="box.ply")
 
 
 def test_an_ascii_ply_read_by_words_keeps_the_declared_float_type() -> None:

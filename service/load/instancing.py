@@ -235,11 +235,17 @@ def accessor_values(doc: Any, index: Any, buffers: Buffers, fmt: str, normalize:
     raw = buffers.get(view["buffer"])
     dtype = np.dtype(_COMPONENTS[component])
     item = dtype.itemsize * width
-    stride = int(view.get("byteStride") or item)
-    view_start = int(view.get("byteOffset", 0))
-    start = view_start + int(acc.get("byteOffset", 0))
+    fields = {"its view's byteStride": view.get("byteStride") or item, "its view's byteOffset": view.get("byteOffset", 0)}
+    fields |= {"its view's byteLength": view.get("byteLength", len(raw)), "byteOffset": acc.get("byteOffset", 0)}
+    for name, value in fields.items():  # glTF 2.0 schema: integers >= 0 (a stride >= 4)
+        if isinstance(value, bool) or not isinstance(value, int) or value < 0:
+            raise UnreadableFileError(
+                f"the {fmt.upper()} file's accessor {index} has {name} {value!r}, which is no byte count", format=fmt
+            )
+    stride, view_start = fields["its view's byteStride"], fields["its view's byteOffset"]
+    view_length, start = fields["its view's byteLength"], view_start + fields["byteOffset"]
     end = start + (count - 1) * stride + item if count else start
-    if start < view_start or stride < item or end > len(raw) or end > view_start + int(view.get("byteLength", len(raw))):
+    if stride < item or end > len(raw) or end > view_start + view_length:
         raise UnreadableFileError(f"the {fmt.upper()} file's accessor {index} runs past its buffer", format=fmt)
     values = np.empty((count, width), dtype=np.float64)
     for k in range(width):  # each component: a strided view of the buffer, copied out

@@ -303,6 +303,15 @@ def read_ascii_ply_rows(data: bytes) -> tuple[PlyFaces | None, bool]:
             return None, True
         at, picked, element_corners, element_counts = rows
         if name == "vertex":
+            for k, j in enumerate(want):
+                column = picked[:, k]
+                if np.issubdtype(np.dtype(props[j][1]), np.integer) and np.any(column != np.round(column)):
+                    # read as the declared integers they would silently lose their fractions (rply refuses such a word)
+                    raise UnreadableFileError(
+                        f"the ASCII PLY file declares vertex property {props[j][0]!r} as an integer but has the value "
+                        f"{float(column[np.argmax(column != np.round(column))])!r}; declare it float in the header",
+                        format="ply",
+                    )
             with np.errstate(invalid="ignore", over="ignore"):  # non-finite values are refused later
                 vertices = np.stack([picked[:, k].astype(props[j][1]).astype(np.float64) for k, j in enumerate(want)], axis=1)
         if listed is not None:

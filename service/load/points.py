@@ -161,9 +161,12 @@ def _file_records(text: str, fmt: str) -> tuple[list[Any], list[str], str | None
         if not isinstance(doc, dict):
             return records, [], None, MassUnit.KG
         return (records, *_document_keys(doc))
-    reader = csv.DictReader(io.StringIO(text))
-    rows = list(reader)
-    header = set(reader.fieldnames or ())
+    reader = csv.DictReader(io.StringIO(text, newline=""))  # as the csv module reads files: \r, \n, \r\n end rows
+    try:
+        rows = list(reader)
+        header = set(reader.fieldnames or ())
+    except csv.Error as exc:
+        raise UnreadableFileError(f"the CSV cannot be read as rows of comma-separated values ({exc})") from exc
     if not {"x", "y", "z"} <= header or not {"mass", "element"} & header:
         raise UnreadableFileError("the CSV needs a header with columns mass,x,y,z (or element,x,y,z) and one row per point")
     if not rows:

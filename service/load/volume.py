@@ -619,8 +619,9 @@ def _surface_apart_warning(mesh: _Mesh, lower_nodes: NDArray[np.int64], label: s
     if len(lower_nodes) == 0:
         return
     used = np.zeros(len(mesh.points), dtype=bool)
-    for b in mesh.blocks:
-        used[b.nodes.ravel()] = True
+    for b in mesh.blocks:  # a node number past the points is refused later, by name, with the cells' checks
+        nodes = b.nodes.ravel()
+        used[nodes[(nodes >= 0) & (nodes < len(used))]] = True
     inside = (lower_nodes >= 0) & (lower_nodes < len(used))
     apart = np.unique(lower_nodes[inside][~used[lower_nodes[inside]]])
     if len(apart):
