@@ -93,6 +93,11 @@ GAUSS[[1, 3, 5, 13, 11, 9]] = np.concatenate([_WG[:-1], _WG[:-1]])
 GAUSS[7] = _WG[-1]
 
 MAX_DEPTH = 16  # bisections of one starting interval; past it the interval is taken with its error
+# Intervals evaluated by one adaptive integration, per starting interval (plus a floor): a smooth integrand
+# needs a few each, a singular corner a few dozen along one path; one that never converges (a degenerate
+# surface) doubles them every round, 2^16 times its start by MAX_DEPTH.  Past the budget the open intervals
+# are taken with their errors, as at MAX_DEPTH.
+WORK_PER_START, WORK_FLOOR = 16, 2048
 
 
 def is_analytic(face: Any) -> bool:
@@ -163,15 +168,19 @@ def _adaptive(
     total, error = np.zeros((count, SUMS)), np.zeros((count, SUMS))
     keep = hi > lo
     lo, hi, owner = lo[keep], hi[keep], owner[keep]
+    budget = WORK_PER_START * lo.size + WORK_FLOOR
     for depth in range(MAX_DEPTH + 1):
         if lo.size == 0:
             break
+        budget -= lo.size
         middle, half = 0.5 * (lo + hi), 0.5 * (hi - lo)
         nodes = (middle[:, None] + half[:, None] * NODES).ravel()
         f = values(nodes, np.repeat(owner, NODES.size)).reshape(lo.size, NODES.size, SUMS)
+        if not np.all(np.isfinite(f)):
+            raise ValueError("the surface gives a point or normal that is not a finite number (degenerate geometry)")
         kronrod = half[:, None] * np.einsum("k,ikj->ij", KRONROD, f)
         difference = np.abs(kronrod - half[:, None] * np.einsum("k,ikj->ij", GAUSS, f))
-        done = np.all(difference <= tolerance, axis=1) | (depth == MAX_DEPTH)
+        done = np.all(difference <= tolerance, axis=1) | (depth == MAX_DEPTH) | (budget < 2 * lo.size)
         np.add.at(total, owner[done], kronrod[done])
         np.add.at(error, owner[done], difference[done])
         lo, middle, hi, owner = lo[~done], middle[~done], hi[~done], owner[~done]

@@ -133,3 +133,34 @@ def test_faces_that_do_not_close_are_named_and_priced() -> None:
     other = sum(green.face_sums(f, elsewhere, tolerance)[0][0] for f in green.closed_shell_faces(solid))
     assert 1e-7 < abs(other - integral.volume) / integral.volume <= integral.estimate
     assert 1e-6 < integral.estimate < 1e-3
+
+
+def test_an_integrand_that_never_converges_stops_at_the_work_budget_with_its_error() -> None:
+    # a mutated STEP file's degenerate face kept every interval open: doubling them for 16 rounds, nested in
+    # an edge's own adaptive rule, ran for minutes in gigabytes; past the budget the open intervals are
+    # taken with their (large) errors, as at the depth limit
+    from inertia.cad import green
+
+    evaluated = []
+    rng = np.random.default_rng(0)
+
+    def noise(x: np.ndarray, owner: np.ndarray) -> np.ndarray:
+        evaluated.append(len(x) // NODES.size)
+        return rng.standard_normal((len(x), green.SUMS))
+
+    starts = 10
+    lo, hi = np.arange(starts, dtype=np.float64), np.arange(1, starts + 1, dtype=np.float64)
+    total, error = green._adaptive(noise, lo, hi, np.zeros(starts, dtype=np.intp), 1, np.full(green.SUMS, 1e-12))
+    assert sum(evaluated) <= green.WORK_PER_START * starts + green.WORK_FLOOR + 2 * max(evaluated)
+    assert np.all(error > 1e-3) and np.all(np.isfinite(total))  # the error says the sums are worthless
+
+
+def test_a_surface_point_that_is_no_number_is_refused_not_bisected() -> None:
+    from inertia.cad import green
+
+    def nan(x: np.ndarray, owner: np.ndarray) -> np.ndarray:
+        return np.full((len(x), green.SUMS), np.nan)
+
+    one = np.zeros(1, dtype=np.intp)
+    with pytest.raises(ValueError, match="not a finite number"):
+        green._adaptive(nan, np.zeros(1), np.ones(1), one, 1, np.full(green.SUMS, 1e-12))
