@@ -19,11 +19,14 @@ error's class (its nearest listed base class):
 from __future__ import annotations
 
 import argparse
+import contextlib
 import gc
 import json
 import os
 import re
+import signal
 import sys
+import traceback
 from collections.abc import Callable, Sequence
 from typing import TYPE_CHECKING, Any
 
@@ -35,6 +38,7 @@ from .errors import (
     InvalidParameterError,
     LoadError,
     ServiceError,
+    UnreadableFileError,
 )
 from .tolerances import DEFAULT_TOLERANCES
 from .vocabulary import METHODS, MODELS, ExportFormat, Geometry, Isotopes, Model, MotionMethod, values
@@ -271,7 +275,7 @@ def one_blas_thread() -> None:
 def console_main() -> int:
     """The ``inertia`` command and ``python -m inertia``: ``main`` in a process that ends next."""
     one_blas_thread()  # numpy is not imported yet (``import inertia.cli`` does not import it)
-    code = main()
+    code = main(isolate=True)  # a process of its own, with no thread yet: ``analyze`` may fork
     # Nothing is allocated after this: move every object to the permanent
     # generation, so the interpreter's final garbage collections do not walk
     # the objects of every imported module (Dask, tornado, numpy): ~0.15 s
@@ -319,15 +323,27 @@ def as_options(text: str) -> str:
     return _ADVICE.sub(lambda m: f"--{m[1]} {m[2]}" if m[1] in ADVICE_OPTIONS else m[0], text)
 
 
-def main(argv: Sequence[str] | None = None) -> int:
+def main(argv: Sequence[str] | None = None, *, isolate: bool = False) -> int:
+    """The command on ``argv`` (default: the process's arguments); its exit status.
+
+    ``isolate``: analyse a file in a forked child (see ``_analyze_isolated``); only for a process of its own
+    that has no thread yet, as ``console_main``'s.
+    """
     args = _parser().parse_args(joined_negative_values(sys.argv[1:] if argv is None else argv))
     as_json = bool(getattr(args, "json", False))
+    if args.command == "analyze":
+        if isolate and hasattr(os, "fork"):
+            return _analyze_isolated(args, as_json)
+        return _handled(lambda: _analyze(args), as_json)
+    if args.command == "batch":
+        return _handled(lambda: _batch(args), as_json)
+    return _handled(lambda: _serve(args), as_json)
+
+
+def _handled(command: Callable[[], int], as_json: bool) -> int:
+    """Run ``command``; a ``ServiceError`` becomes its envelope on stderr and its exit status."""
     try:
-        if args.command == "analyze":
-            return _analyze(args)
-        if args.command == "batch":
-            return _batch(args)
-        return _serve(args)
+        return command()
     except ServiceError as exc:
         if as_json:
             print(json.dumps(exc.as_dict()), file=sys.stderr)
@@ -340,6 +356,48 @@ def main(argv: Sequence[str] | None = None) -> int:
     except KeyboardInterrupt:
         print("interrupted", file=sys.stderr)
         return EXIT_INTERRUPTED
+
+
+# ``inertia analyze`` as a command (``console_main``) analyses the file in a forked child: a native reader
+# (VTK's, OpenCASCADE's) that crashes on a corrupt file takes the child with it, and the command still
+# answers with an error, as the HTTP service's compute processes and the batch's workers do.  Not in ``main``
+# called in-process (a test, an embedding program), where forking a process with threads is unsafe.
+_CRASH_SIGNALS = {signal.SIGSEGV, signal.SIGBUS, signal.SIGILL, signal.SIGFPE, signal.SIGABRT}
+
+
+def _analyze_isolated(args: argparse.Namespace, as_json: bool) -> int:
+    """``_analyze`` in a forked child; its exit status, or an error where a signal ended it."""
+    sys.stdout.flush()
+    sys.stderr.flush()
+    pid = os.fork()
+    if pid == 0:  # the child: the whole command, then out without the parent's exit handlers
+        code = EXIT_INTERNAL
+        try:
+            code = _handled(lambda: _analyze(args), as_json)
+        except BaseException:
+            traceback.print_exc()
+        finally:
+            with contextlib.suppress(Exception):
+                sys.stdout.flush()
+                sys.stderr.flush()
+            os._exit(code)
+    previous = signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C reaches the child, which says so
+    try:
+        _, status = os.waitpid(pid, 0)
+    finally:
+        signal.signal(signal.SIGINT, previous)
+    if not os.WIFSIGNALED(status) or os.WTERMSIG(status) == signal.SIGINT:
+        return os.waitstatus_to_exitcode(status) if os.WIFEXITED(status) else EXIT_INTERRUPTED
+    sig = signal.Signals(os.WTERMSIG(status))
+    if sig in _CRASH_SIGNALS:
+        cause = f"a file reader crashed on it ({sig.name}); the file is likely corrupt: check it, or export it again"
+    else:
+        cause = f"the system stopped the analysis ({sig.name}), as it does when memory runs out; try a smaller file"
+    return _handled(lambda: _raise(UnreadableFileError(f"the file {args.file!r} could not be analysed: {cause}")), as_json)
+
+
+def _raise(exc: ServiceError) -> int:
+    raise exc
 
 
 def exit_code(exc: ServiceError) -> int:

@@ -99,7 +99,8 @@ def test_the_command_runs_blas_on_one_thread_unless_the_user_chose(monkeypatch: 
 
     seen: list[list[str | None]] = []
 
-    def fake_main() -> int:
+    def fake_main(isolate: bool = False) -> int:
+        assert isolate  # the command's own process: its analysis may fork
         seen.append([os.environ.get(k) for k in ("OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "OMP_NUM_THREADS")])
         return 0
 

@@ -88,3 +88,33 @@ def test_a_readers_own_failure_is_an_unreadable_file_on_the_command_line_too(
     error = json.loads(capsys.readouterr().err)["error"]
     assert error["code"] == "unreadable_file"
     assert "could not be read" in error["message"] or "too deeply" in error["message"]
+
+
+_CRASHING_ANALYSIS = """\
+import os, signal, sys
+from inertia import cli
+cli._analyze = lambda args: os.kill(os.getpid(), signal.{sig})
+sys.exit(cli.main(["analyze", "part.stl", "--json"], isolate=True))
+"""
+
+
+@pytest.mark.parametrize(
+    ("sig", "words"), [("SIGSEGV", "a file reader crashed on it (SIGSEGV)"), ("SIGKILL", "as it does when memory runs out")]
+)
+def test_the_command_answers_when_its_analysis_dies_by_a_signal(sig: str, words: str) -> None:
+    # a native reader's crash (or the kernel's OOM killer) ends the forked child, not the command
+    done = subprocess.run([sys.executable, "-c", _CRASHING_ANALYSIS.format(sig=sig)], capture_output=True, text=True)
+    assert done.returncode == 3, done.stderr
+    error = json.loads(done.stderr)["error"]
+    assert error["code"] == "unreadable_file" and words in error["message"] and "'part.stl'" in error["message"]
+
+
+def test_a_file_that_crashes_vtks_reader_gets_an_error_from_the_command(tmp_path: Path) -> None:
+    # an AVS UCD node numbered -2 makes vtkAVSucdReader write outside its arrays (a segfault with VTK 9.x):
+    # the command died with SIGSEGV and printed nothing
+    pytest.importorskip("vtk")
+    source = Path(__file__).parent / "data" / "real" / "inp" / "cellsnd.ascii.inp"
+    bad = tmp_path / "cells.inp"
+    bad.write_bytes(source.read_bytes().replace(b"\n5 2.000000 0.000000 0.000000", b"\n-2 2.000000 0.000000 0.000000"))
+    done = subprocess.run([sys.executable, "-m", "inertia", "analyze", str(bad)], capture_output=True, text=True)
+    assert done.returncode == 3 and "(unreadable_file)" in done.stderr, done.stderr

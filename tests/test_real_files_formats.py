@@ -365,10 +365,29 @@ def test_bytes_after_a_glbs_declared_length_are_left_out_with_a_note() -> None:
 
 
 def test_a_vtu_whose_points_are_fewer_than_its_cells_use_is_refused_by_name() -> None:
-    # NumberOfPoints="1e308": VTK's reader keeps one point, and the tetra10 cells' nodes run past it; the warning
+    # NumberOfPoints="1": VTK's reader keeps one point, and the tetra10 cells' nodes run past it; the warning
     # about 2-D cells apart from the volume indexed the points with those nodes first (an IndexError)
     from inertia.errors import UnreadableFileError
 
-    data = (REAL / "vtu" / "tetra.vtu").read_bytes().replace(b'NumberOfPoints="22"', b'NumberOfPoints="1e308"')
+    data = (REAL / "vtu" / "tetra.vtu").read_bytes().replace(b'NumberOfPoints="22"', b'NumberOfPoints="1"')
     with pytest.raises(UnreadableFileError, match="refers to a point that does not exist"):
         load_body(data, filename="tetra.vtu")
+
+
+@pytest.mark.parametrize(
+    ("old", "new", "words"),
+    [
+        (b'NumberOfPoints="5"', b'NumberOfPoints="-1"', r"NumberOfPoints='-1', which is no count"),
+        (b'NumberOfPoints="5"', b'NumberOfPoints="1e308"', r"NumberOfPoints='1e308', which is no count"),
+        (b'NumberOfComponents="3"', b'NumberOfComponents="1000000000000"', r"NumberOfComponents=1000000000000, more values"),
+    ],
+    ids=["negative", "not-an-integer", "absurd-components"],
+)
+def test_vtk_xml_counts_no_file_can_hold_are_refused_before_vtk_reads_them(old: bytes, new: bytes, words: str) -> None:
+    # VTK's XML readers trust these: -1 points crashed the process (SIGSEGV), 1e12 components looped for minutes
+    from inertia.errors import UnreadableFileError
+
+    data = (REAL / "vtu" / "cell_Pyramid.vtu").read_bytes()
+    assert old in data
+    with pytest.raises(UnreadableFileError, match=words):
+        load_body(data.replace(old, new, 1), filename="pyramid.vtu")

@@ -228,6 +228,8 @@ def _check_xdmf(data: bytes, ctx: _Context) -> None:
 _VTK_ROOT = re.compile(rb"<VTKFile\b([^>]*)>")
 _PIECE_SOURCE = re.compile(rb"<Piece\b[^>]*\bSource\s*=\s*[\"']([^\"']*)", re.IGNORECASE)
 _DATA_ARRAY = re.compile(rb"<DataArray\b([^>]*?)(/?)>")
+_PIECE = re.compile(rb"<Piece\b" + _TAG_ATTRIBUTES + rb">")
+_PIECE_COUNTS = ("NumberOfPoints", "NumberOfCells", "NumberOfVerts", "NumberOfLines", "NumberOfStrips", "NumberOfPolys")
 _APPENDED = re.compile(rb"<AppendedData\b([^>]*)>")
 _HEADER_TYPES = {"UInt32": "I", "UInt64": "Q"}
 _BLOCK_COMPRESSORS = ("vtkZLibDataCompressor", "vtkLZMADataCompressor", "vtkLZ4DataCompressor")
@@ -242,6 +244,7 @@ def _check_vtk_xml(data: bytes, ctx: _Context) -> None:
     root = _VTK_ROOT.search(xml)
     attrs = xml_attributes(root.group(1)) if root else {}
     compressor = attrs.get("compressor")
+    _check_vtk_counts(xml, ctx.budget if compressor else len(data), ctx)
     if not compressor:
         return  # uncompressed arrays are no larger than the file
     if compressor not in _BLOCK_COMPRESSORS:
@@ -260,6 +263,37 @@ def _check_vtk_xml(data: bytes, ctx: _Context) -> None:
             offsets.append(_int(arr.get("offset", "0"), ctx))
     if offsets and appended:
         _check_appended(data, appended, offsets, blocks)
+
+
+def _check_vtk_counts(xml: bytes, limit: int, ctx: _Context) -> None:
+    """Refuse a piece's count or an array's component count that is no count, or more values than the file
+    can hold (``limit``: its size, each value taking a byte at least; compressed, the inflation budget).
+    VTK's readers trust them: a negative count crashed the process, 1e12 components looped for minutes."""
+
+    def count(text: str, name: str) -> int:
+        value = text.strip()
+        if not value.isdigit():
+            raise UnreadableFileError(f"the VTK file gives {name}={text!r}, which is no count", format=ctx.fmt)
+        if int(value) > limit:
+            raise UnreadableFileError(
+                f"the VTK file gives {name}={value}, more values than its data can hold; it is corrupt", format=ctx.fmt
+            )
+        return int(value)
+
+    largest = 0
+    for match in _PIECE.finditer(xml):
+        piece = xml_attributes(match.group(1))
+        largest = max([largest, *(count(piece[name], name) for name in _PIECE_COUNTS if name in piece)])
+    for match in _DATA_ARRAY.finditer(xml):
+        array = xml_attributes(match.group(1))
+        components = count(array.get("NumberOfComponents", "1"), "NumberOfComponents")
+        tuples = count(array["NumberOfTuples"], "NumberOfTuples") if "NumberOfTuples" in array else largest
+        if components * tuples > limit:
+            raise UnreadableFileError(
+                f"the VTK file gives an array of {components} components for {tuples} tuples, more values than its "
+                "data can hold; it is corrupt",
+                format=ctx.fmt,
+            )
 
 
 def _check_appended(data: bytes, tag: re.Match[bytes], offsets: list[int], blocks: _Blocks) -> None:
