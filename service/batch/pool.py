@@ -12,7 +12,8 @@ the whole pool (``BrokenProcessPool``): every task in flight then fails,
 though only one of them caused it.  The pool is started again, and the files
 of those tasks are analysed one at a time, each alone on the pool, so the
 file that kills its worker again is known for sure and becomes an
-``internal_error`` row; the others get their rows as usual.
+``unreadable_file`` row (as the HTTP service answers it); the others get
+their rows as usual.
 """
 
 from __future__ import annotations
@@ -25,6 +26,7 @@ from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wai
 from concurrent.futures.process import BrokenProcessPool
 from typing import Any
 
+from ..errors import UnreadableFileError
 from ..pipeline import AnalysisOptions
 from .rows import error_row
 from .sinks import render
@@ -32,7 +34,7 @@ from .sources import Source
 from .tasks import InternalError, render_sources
 from .workers import start_forkserver
 
-__all__ = ["run_pool"]
+__all__ = ["died_on", "run_pool"]
 
 Rendered = list[tuple[Any, bool]]
 
@@ -124,14 +126,25 @@ def _isolate(
     for src in suspects:
         try:
             rows = pool.submit(task, [src], options, fmt).result()
-        except BrokenProcessPool as exc:
-            rows = [_failed(src, exc, fmt)]
+        except BrokenProcessPool:
+            rows = [died_on(src, fmt)]
             _stop(pool)
             pool = _new_pool(workers)
         except Exception as exc:
             rows = [_failed(src, exc, fmt)]
         write(rows)
     return pool
+
+
+def died_on(src: Source, fmt: str) -> tuple[Any, bool]:
+    """The row of a file whose worker died while it alone was analysed: a native reader crashed on it, or it
+    needed more memory than there was (the file is what the user can act on, as the HTTP service says)."""
+    err = UnreadableFileError(
+        "the reader stopped abnormally on this file (its worker process died); the file may be corrupt or need "
+        "more memory than a worker has: check it, or send a simpler one",
+        filename=src.name,
+    )
+    return render(error_row(src.name, err), fmt), True
 
 
 def _failed(src: Source, exc: BaseException, fmt: str) -> tuple[Any, bool]:

@@ -42,7 +42,7 @@ from typing import Any
 from ..errors import InvalidParameterError
 from ..pipeline import AnalysisOptions
 from .extras import ensure_installed, require
-from .pool import run_pool
+from .pool import died_on, run_pool
 from .rows import error_row
 from .sinks import Sink, done_names, open_sink, output_format, render
 from .sources import Source, list_sources
@@ -340,6 +340,8 @@ def _rows(future: Any, group: list[Source], resubmit: Callable[[list[Source]], N
             for src in group:
                 resubmit([src])
             return []
+        if type(exc).__name__ == "KilledWorker":  # the file alone kept killing its workers: as the local pool says it
+            return [died_on(group[0], fmt)]
         err = InternalError(
             f"the analysis of this file failed on the worker ({type(exc).__name__}: {exc}); "
             "it may need more memory than a worker has"

@@ -206,6 +206,21 @@ def test_a_task_whose_worker_died_is_split_into_single_files() -> None:
     assert "more memory" in row["error"]["message"]
 
 
+class KilledWorker(Exception):
+    """Named as distributed's: a task whose workers kept dying."""
+
+
+class _KilledFuture:
+    def result(self) -> Any:
+        raise KilledWorker("attempted to run task 3 times, and all those workers died")
+
+
+def test_a_file_that_keeps_killing_dask_workers_is_unreadable_as_on_the_pool() -> None:
+    ((text, is_error),) = runner._rows(_KilledFuture(), [Source("a.stl", "/a")], lambda g: None)
+    row = json.loads(text)
+    assert is_error and row["error"]["code"] == "unreadable_file" and "its worker process died" in row["error"]["message"]
+
+
 class _Rows:
     """A sink and progress bar that keep the JSON Lines rows written to them."""
 

@@ -325,9 +325,10 @@ def test_a_file_that_kills_its_worker_is_one_error_row_and_the_rest_complete(lib
     run_pool(groups, 2, 4, AnalysisOptions(), "jsonl", written.extend, task=crashing_task)
     rows = by_name([json.loads(text) for text, _ in written])
     assert set(rows) == set(library[1]) | {"crash_me.stl"}  # every file once, none lost with the pool
-    assert rows["crash_me.stl"]["error"]["code"] == "internal_error"
+    assert rows["crash_me.stl"]["error"]["code"] == "unreadable_file"  # as the HTTP service answers it
+    assert "its worker process died" in rows["crash_me.stl"]["error"]["message"]
     errors = {name: row["error"]["code"] for name, row in rows.items() if "error" in row}
-    assert errors == {**BROKEN, "crash_me.stl": "internal_error"}
+    assert errors == {**BROKEN, "crash_me.stl": "unreadable_file"}
     for name in library[1]:
         assert rows[name] == reference(folder / name, name), name
 
