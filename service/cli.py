@@ -363,6 +363,7 @@ def _handled(command: Callable[[], int], as_json: bool) -> int:
 # answers with an error, as the HTTP service's compute processes and the batch's workers do.  Not in ``main``
 # called in-process (a test, an embedding program), where forking a process with threads is unsafe.
 _CRASH_SIGNALS = {signal.SIGSEGV, signal.SIGBUS, signal.SIGILL, signal.SIGFPE, signal.SIGABRT}
+_STOP_SIGNALS = (signal.SIGTERM, signal.SIGHUP)
 
 
 def _analyze_isolated(args: argparse.Namespace, as_json: bool) -> int:
@@ -381,14 +382,21 @@ def _analyze_isolated(args: argparse.Namespace, as_json: bool) -> int:
                 sys.stdout.flush()
                 sys.stderr.flush()
             os._exit(code)
-    previous = signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C reaches the child, which says so
+    # Ctrl-C reaches the child too (one process group), which says so; a request to stop is passed on
+    previous = {
+        signal.SIGINT: signal.signal(signal.SIGINT, signal.SIG_IGN),
+        **{sig: signal.signal(sig, lambda number, _: os.kill(pid, number)) for sig in _STOP_SIGNALS},
+    }
     try:
         _, status = os.waitpid(pid, 0)
     finally:
-        signal.signal(signal.SIGINT, previous)
+        for sig, handler in previous.items():
+            signal.signal(sig, handler)
     if not os.WIFSIGNALED(status) or os.WTERMSIG(status) == signal.SIGINT:
         return os.waitstatus_to_exitcode(status) if os.WIFEXITED(status) else EXIT_INTERRUPTED
     sig = signal.Signals(os.WTERMSIG(status))
+    if sig in _STOP_SIGNALS:
+        return 128 + sig.value  # stopped as asked, as a shell reports it
     if sig in _CRASH_SIGNALS:
         cause = f"a file reader crashed on it ({sig.name}); the file is likely corrupt: check it, or export it again"
     else:

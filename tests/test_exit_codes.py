@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import os
 import subprocess
 import sys
 from pathlib import Path
@@ -118,3 +119,32 @@ def test_a_file_that_crashes_vtks_reader_gets_an_error_from_the_command(tmp_path
     bad.write_bytes(source.read_bytes().replace(b"\n5 2.000000 0.000000 0.000000", b"\n-2 2.000000 0.000000 0.000000"))
     done = subprocess.run([sys.executable, "-m", "inertia", "analyze", str(bad)], capture_output=True, text=True)
     assert done.returncode == 3 and "(unreadable_file)" in done.stderr, done.stderr
+
+
+_SLOW_ANALYSIS = """\
+import os, sys, time
+from inertia import cli
+def slow(args):
+    open(sys.argv[1], "w").write(str(os.getpid()))
+    time.sleep(30)
+    return 0
+cli._analyze = slow
+sys.exit(cli.main(["analyze", "part.stl"], isolate=True))
+"""
+
+
+def test_a_request_to_stop_the_command_stops_its_analysis_too(tmp_path: Path) -> None:
+    import signal
+    import time
+
+    marker = tmp_path / "child.pid"
+    command = subprocess.Popen([sys.executable, "-c", _SLOW_ANALYSIS, str(marker)], stderr=subprocess.PIPE, text=True)
+    deadline = time.monotonic() + 20
+    while not marker.exists() or not marker.read_text():
+        assert time.monotonic() < deadline and command.poll() is None
+        time.sleep(0.05)
+    child = int(marker.read_text())
+    command.send_signal(signal.SIGTERM)
+    assert command.wait(timeout=10) == 128 + signal.SIGTERM
+    with pytest.raises(ProcessLookupError):  # the forked analysis is gone with it (reaped by the command)
+        os.kill(child, 0)

@@ -272,7 +272,7 @@ def _check_vtk_counts(xml: bytes, limit: int, ctx: _Context) -> None:
 
     def count(text: str, name: str) -> int:
         value = text.strip()
-        if not value.isdigit():
+        if not (value.isascii() and value.isdigit()):
             raise UnreadableFileError(f"the VTK file gives {name}={text!r}, which is no count", format=ctx.fmt)
         if int(value) > limit:
             raise UnreadableFileError(
@@ -280,14 +280,15 @@ def _check_vtk_counts(xml: bytes, limit: int, ctx: _Context) -> None:
             )
         return int(value)
 
-    largest = 0
     for match in _PIECE.finditer(xml):
         piece = xml_attributes(match.group(1))
-        largest = max([largest, *(count(piece[name], name) for name in _PIECE_COUNTS if name in piece)])
+        for name in _PIECE_COUNTS:
+            if name in piece:
+                count(piece[name], name)
     for match in _DATA_ARRAY.finditer(xml):
         array = xml_attributes(match.group(1))
         components = count(array.get("NumberOfComponents", "1"), "NumberOfComponents")
-        tuples = count(array["NumberOfTuples"], "NumberOfTuples") if "NumberOfTuples" in array else largest
+        tuples = count(array["NumberOfTuples"], "NumberOfTuples") if "NumberOfTuples" in array else 1
         if components * tuples > limit:
             raise UnreadableFileError(
                 f"the VTK file gives an array of {components} components for {tuples} tuples, more values than its "
