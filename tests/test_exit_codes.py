@@ -110,13 +110,13 @@ def test_the_command_answers_when_its_analysis_dies_by_a_signal(sig: str, words:
     assert error["code"] == "unreadable_file" and words in error["message"] and "'part.stl'" in error["message"]
 
 
-def test_a_file_that_crashes_vtks_reader_gets_an_error_from_the_command(tmp_path: Path) -> None:
-    # an AVS UCD node numbered -2 makes vtkAVSucdReader write outside its arrays (a segfault with VTK 9.x):
-    # the command died with SIGSEGV and printed nothing
-    pytest.importorskip("vtk")
-    source = Path(__file__).parent / "data" / "real" / "inp" / "cellsnd.ascii.inp"
-    bad = tmp_path / "cells.inp"
-    bad.write_bytes(source.read_bytes().replace(b"\n5 2.000000 0.000000 0.000000", b"\n-2 2.000000 0.000000 0.000000"))
+def test_a_file_that_crashes_a_native_reader_gets_an_error_from_the_command(tmp_path: Path) -> None:
+    # a STEP style usage pointing at an entity of another type makes OpenCASCADE's STEP transfer (OCP 8.0)
+    # write through a bad pointer: the command died with SIGSEGV and printed nothing
+    pytest.importorskip("OCP")
+    source = Path(__file__).parent / "data" / "real" / "step" / "red_cube_blue_cylinder.step"
+    bad = tmp_path / "styled.step"
+    bad.write_bytes(source.read_bytes().replace(b"SURFACE_STYLE_USAGE( .BOTH., #134 )", b"SURFACE_STYLE_USAGE( .BOTH., #2 )"))
     done = subprocess.run([sys.executable, "-m", "inertia", "analyze", str(bad)], capture_output=True, text=True)
     assert done.returncode == 3 and "(unreadable_file)" in done.stderr, done.stderr
 

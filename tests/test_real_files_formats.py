@@ -391,3 +391,32 @@ def test_vtk_xml_counts_no_file_can_hold_are_refused_before_vtk_reads_them(old: 
     assert old in data
     with pytest.raises(UnreadableFileError, match=words):
         load_body(data.replace(old, new, 1), filename="pyramid.vtu")
+
+
+@pytest.mark.parametrize(
+    ("old", "new"), [(b"\n5 2.000000 0.000000", b"\n-2 2.000000 0.000000"), (b"\n1 1 tri 8 4 1", b"\n1 1 tri 8 -4 1")]
+)
+def test_an_avs_ucd_file_with_a_negative_number_is_refused_before_vtk_reads_it(old: bytes, new: bytes) -> None:
+    # vtkAVSucdReader indexes its node map with the numbers as written: a node or a corner numbered -2 or -4
+    # crashed the process (SIGSEGV)
+    from inertia.errors import UnreadableFileError
+
+    data = (REAL / "inp" / "cellsnd.ascii.inp").read_bytes()
+    assert old in data
+    with pytest.raises(UnreadableFileError, match="with a negative number"):
+        load_body(data.replace(old, new, 1), filename="cells.inp")
+
+
+@pytest.mark.parametrize(
+    "new",
+    [b"POINTS -1 float", b"POINTS 1e9 float", b"POINTS 99999999999 float"],
+    ids=["negative", "not-an-integer", "more-than-the-file"],
+)
+def test_a_legacy_vtk_count_no_file_can_hold_is_refused_before_vtk_reads_it(new: bytes) -> None:
+    # vtkDataSetReader trusts POINTS n: -1 crashed the process (SIGSEGV)
+    from inertia.errors import UnreadableFileError
+
+    data = (REAL / "vtk" / "AngularSector.vtk").read_bytes()
+    assert b"POINTS 10141 float" in data
+    with pytest.raises(UnreadableFileError, match="gives a count that is no count or more than the file holds"):
+        load_body(data.replace(b"POINTS 10141 float", new, 1), filename="sector.vtk")

@@ -297,6 +297,30 @@ def _check_vtk_counts(xml: bytes, limit: int, ctx: _Context) -> None:
             )
 
 
+# a legacy VTK file's keywords followed by counts (VTK's reader takes its keywords in any case)
+_LEGACY_COUNTS = re.compile(
+    rb"^[ \t]*(POINTS|CELLS|CELL_TYPES|VERTICES|LINES|POLYGONS|TRIANGLE_STRIPS|POINT_DATA|CELL_DATA"
+    rb"|[XYZ]_COORDINATES)[ \t]+([^ \t\r\n]*)(?:[ \t]+([0-9+-][^ \t\r\n]*))?",
+    re.IGNORECASE | re.MULTILINE,
+)
+_LEGACY_SIZES = (b"CELLS", b"VERTICES", b"LINES", b"POLYGONS", b"TRIANGLE_STRIPS")
+
+
+def _check_legacy_vtk(data: bytes, ctx: _Context) -> None:
+    """Refuse a legacy VTK count that is no count or more than the file can hold: VTK's reader trusts them
+    (``POINTS -1 double`` crashed the process)."""
+    for match in _LEGACY_COUNTS.finditer(data):
+        keyword = match.group(1).upper()
+        values = [match.group(2)] + ([match.group(3)] if keyword in _LEGACY_SIZES and match.group(3) else [])
+        for value in values:
+            if not value.isdigit() or int(value) > len(data):
+                text = b" ".join(v for v in match.groups() if v).decode("latin-1")[:80]
+                raise UnreadableFileError(
+                    f"the legacy VTK file's {text!r} gives a count that is no count or more than the file holds; it is corrupt",
+                    format=ctx.fmt,
+                )
+
+
 def _check_appended(data: bytes, tag: re.Match[bytes], offsets: list[int], blocks: _Blocks) -> None:
     start = data.find(b"_", tag.end())
     stop = data.rfind(b"</AppendedData>")
@@ -649,6 +673,7 @@ _CHECKS: dict[str, Callable[[bytes, _Context], None]] = {
     "fem": _check_nastran,
     "xdmf": _check_xdmf,
     "xmf": _check_xdmf,
+    "vtk": _check_legacy_vtk,
     "vtu": _check_vtk_xml,
     "vtp": _check_vtk_xml,
     "vts": _check_vtk_xml,

@@ -267,6 +267,7 @@ def read_volume_parts(
         )
     if fmt == "inp" and is_avs_ucd(data):  # the other format named .inp: VTK reads it, meshio would take it for Abaqus
         label = _label(filename, "ucd")
+        _refuse_negative_ucd_ids(data, label)
         mesh = _read_vtk(data, "ucd", label)
     else:
         label = _label(filename, fmt)
@@ -317,6 +318,21 @@ def is_avs_ucd(data: bytes) -> bool:
         fields = line.split()
         return len(fields) == 5 and all(f.isdigit() for f in fields)
     return False
+
+
+# ASCII UCD: a line that starts with a negative number (a node's or a cell's number: data values follow
+# the number of their node or cell), or a cell line "number material type nodes..." with a negative node
+_UCD_NEGATIVE_ID = re.compile(rb"^[ \t]*-[0-9]|^[ \t]*[0-9]+[ \t]+[0-9]+[ \t]+[A-Za-z]+[^\n]*?[ \t]-[0-9]", re.MULTILINE)
+
+
+def _refuse_negative_ucd_ids(data: bytes, label: str) -> None:
+    """VTK's UCD reader indexes its node map with node numbers as written: a negative one crashed the process."""
+    if data[:1] != b"\x07" and (found := _UCD_NEGATIVE_ID.search(data)):
+        line = data[found.start() : data.find(b"\n", found.start()) % (len(data) + 1)].decode("latin-1").strip()
+        raise UnreadableFileError(
+            f"{label} numbers a node or cell with a negative number ({line[:80]!r}); AVS UCD numbers are >= 0",
+            format="inp",
+        )
 
 
 def _label(filename: str | None, fmt: str) -> str:
