@@ -237,7 +237,9 @@ def accessor_values(doc: Any, index: Any, buffers: Buffers, fmt: str, normalize:
     item = dtype.itemsize * width
     fields = {"its view's byteStride": view.get("byteStride") or item, "its view's byteOffset": view.get("byteOffset", 0)}
     fields |= {"its view's byteLength": view.get("byteLength", len(raw)), "byteOffset": acc.get("byteOffset", 0)}
-    for name, value in fields.items():  # glTF 2.0 schema: integers >= 0 (a stride >= 4)
+    for name, value in fields.items():  # glTF 2.0 schema: integers >= 0 (a stride >= 4); 12.0 is 12 to a JSON reader
+        if isinstance(value, float) and value.is_integer():
+            fields[name] = value = int(value)
         if isinstance(value, bool) or not isinstance(value, int) or value < 0:
             raise UnreadableFileError(
                 f"the {fmt.upper()} file's accessor {index} has {name} {value!r}, which is no byte count", format=fmt
