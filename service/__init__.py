@@ -7,6 +7,7 @@ The pipeline: bytes -> ``load_body`` -> ``mass_properties`` -> ``principal_frame
 from __future__ import annotations
 
 import importlib
+import logging
 from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
@@ -17,6 +18,11 @@ if TYPE_CHECKING:
     from .pipeline import AnalysisOptions, AnalysisResult, analyze, analyze_points, precession
     from .principal import PrincipalFrame, principal_frame
     from .tolerances import Tolerances
+
+# A library's logging goes where its user's configuration sends it (the HTTP service's: uvicorn's); with none,
+# Python's last-resort handler would print warnings and their tracebacks on stderr, beside the command's own
+# error envelope (logging HOWTO, "Configuring Logging for a Library").
+logging.getLogger(__name__).addHandler(logging.NullHandler())
 
 # Names are imported on first use (PEP 562), so ``import inertia`` and the CLI
 # start without numpy: ``inertia batch`` starts its workers' forkserver first.

@@ -148,3 +148,13 @@ def test_a_request_to_stop_the_command_stops_its_analysis_too(tmp_path: Path) ->
     assert command.wait(timeout=10) == 128 + signal.SIGTERM
     with pytest.raises(ProcessLookupError):  # the forked analysis is gone with it (reaped by the command)
         os.kill(child, 0)
+
+
+def test_a_reader_failure_the_command_reports_prints_the_envelope_alone(tmp_path: Path) -> None:
+    # the catch-all logs the reader's exception with its traceback; with no logging configured, Python's
+    # last-resort handler printed it on stderr before the JSON envelope
+    bad = tmp_path / "odd.gltf"
+    bad.write_text('{"asset": {"version": "2.0"}, "meshes": [{"primitives": [{"attributes": {"POSITION": 0}}]}], "accessors": 7}')
+    done = subprocess.run([sys.executable, "-m", "inertia", "analyze", str(bad), "--json"], capture_output=True, text=True)
+    assert done.returncode == 3
+    assert json.loads(done.stderr)["error"]["code"] == "unreadable_file"  # the envelope and nothing else

@@ -13,7 +13,7 @@ import pytest
 import trimesh
 
 from benchmarks.cases import box
-from inertia.errors import EmptyGeometryError, UnreadableFileError, UnsupportedFormatError
+from inertia.errors import EmptyGeometryError, InvalidParameterError, UnreadableFileError, UnsupportedFormatError
 from inertia.load import load_body
 from inertia.mass import parallel_axis
 from inertia.pipeline import AnalysisOptions, analyze
@@ -203,6 +203,13 @@ def test_a_points_csv_reads_the_same_with_any_line_ending(end: str) -> None:
     # as csv.Error "new-line character seen in unquoted field"
     doc = analyze(end.join(["mass,x,y,z", "1,0,0,0", "3,2,0,0", ""]).encode(), filename="p.csv").as_dict()
     assert doc["mass"] == 4.0 and doc["center_of_mass"] == [1.5, 0.0, 0.0]
+
+
+def test_a_points_number_past_a_doubles_range_is_an_invalid_parameter() -> None:
+    # JSON integers have no limit: 10^400 was float()'s OverflowError, seen only by the catch-all
+    data = json.dumps({"points": [{"mass": 1, "position": [10**400, 0, 0]}, {"mass": 1, "position": [0, 0, 0]}]}).encode()
+    with pytest.raises(InvalidParameterError, match="point 0 has a number too large for a double"):
+        analyze(data, filename="p.json")
 
 
 def test_truncated_binary_stl_is_unreadable() -> None:

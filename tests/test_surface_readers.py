@@ -734,8 +734,8 @@ def _fractional_offset(doc: dict[str, Any]) -> None:
         (_primitives_as_object, r"mesh 0 has no array of primitives \(meshes\[0\]\.primitives"),
         (_view_past_buffer, r"buffer view 0 runs past the end of buffer 0 \(bytes 0 to 5000 of its 144\)"),
         (_accessor_past_buffer, r"accessor 0 runs past its buffer \(mesh 0\)"),
-        (_view_before_buffer, r"accessor \d has its view's byteOffset -1, which is no byte count"),
-        (_fractional_offset, r"accessor 0 has byteOffset 0\.5, which is no byte count"),
+        (_view_before_buffer, r"bufferViews\[0\]\.byteOffset is not a whole number >= 0"),
+        (_fractional_offset, r"accessors\[0\]\.byteOffset is not a whole number >= 0"),
     ],
 )
 def test_a_gltf_file_trimesh_cannot_read_has_its_fault_named(change: Callable[[dict[str, Any]], None], words: str) -> None:
@@ -744,6 +744,28 @@ def test_a_gltf_file_trimesh_cannot_read_has_its_fault_named(change: Callable[[d
     change(doc)
     with pytest.raises(UnreadableFileError, match=words):
         analyze(json.dumps(doc).encode(), filename="broken.gltf")
+
+
+@pytest.mark.parametrize(
+    ("path", "value", "words"),
+    [
+        (("accessors",), True, "accessors is not an array of objects"),
+        (("accessors", 0, "count"), True, r"accessors\[0\]\.count is not a whole number >= 0"),
+        (("accessors", 0, "type"), ["VEC3"], r"accessors\[0\]\.type is not a string"),
+        (("bufferViews", 0, "buffer"), {"0": 0}, r"bufferViews\[0\]\.buffer is not a whole number >= 0"),
+        (("meshes", 0, "primitives", 0, "attributes"), True, r"primitives\[0\]\.attributes is not an object"),
+        (("nodes",), [{"children": [-1]}], r"nodes\[0\]\.children is not an array of whole numbers >= 0"),
+    ],
+)
+def test_a_gltf_document_of_the_wrong_shape_is_refused_by_its_path(path: tuple[Any, ...], value: Any, words: str) -> None:
+    # each was one reader's own TypeError ("object of type 'bool' has no len()", "unhashable type: 'list'")
+    doc = gltf_box_doc()
+    target: Any = doc
+    for key in path[:-1]:
+        target = target[key]
+    target[path[-1]] = value
+    with pytest.raises(UnreadableFileError, match=words + ", as the glTF 2.0 schema requires"):
+        analyze(json.dumps(doc).encode(), filename="shape.gltf")
 
 
 def _box_indices(doc: dict[str, Any]) -> tuple[dict[str, Any], np.ndarray]:

@@ -445,6 +445,98 @@ def _gltf_document(data: bytes, fmt: str) -> Any:
         return None  # the reader reports a malformed document in its own words
 
 
+# The glTF 2.0 schema's shapes of what the readers here and trimesh's use (section 5, "Properties Reference"):
+# top-level arrays of objects, and in each object the fields' kinds.  "index": an integer (not a boolean) >= 0.
+_GLTF_ARRAYS = ("accessors", "buffers", "bufferViews", "meshes", "nodes", "scenes", "skins", "materials")
+_GLTF_FIELDS: dict[str, dict[str, str]] = {
+    "accessors": {
+        "bufferView": "index",
+        "byteOffset": "index",
+        "componentType": "index",
+        "count": "index",
+        "type": "string",
+        "normalized": "boolean",
+        "sparse": "object",
+    },
+    "buffers": {"byteLength": "index", "uri": "string"},
+    "bufferViews": {"buffer": "index", "byteOffset": "index", "byteLength": "index", "byteStride": "index"},
+    "meshes": {"weights": "numbers"},  # "primitives" not an array: the readers below name it
+    "nodes": {
+        "children": "indices",
+        "mesh": "index",
+        "skin": "index",
+        "camera": "index",
+        "matrix": "numbers",
+        "rotation": "numbers",
+        "scale": "numbers",
+        "translation": "numbers",
+        "extensions": "object",
+    },
+    "scenes": {"nodes": "indices"},
+}
+_GLTF_PRIMITIVE = {"attributes": "object", "indices": "index", "mode": "index", "targets": "objects"}
+
+
+def _gltf_index(v: Any) -> bool:
+    return isinstance(v, int) and not isinstance(v, bool) and v >= 0
+
+
+def _gltf_number(v: Any) -> bool:
+    return isinstance(v, (int, float)) and not isinstance(v, bool)
+
+
+_GLTF_KINDS: dict[str, Callable[[Any], bool]] = {
+    "index": lambda v: _gltf_index(v) or (isinstance(v, float) and v.is_integer() and v >= 0),
+    "string": lambda v: isinstance(v, str),
+    "boolean": lambda v: isinstance(v, bool),
+    "object": lambda v: isinstance(v, dict),
+    "objects": lambda v: isinstance(v, list) and all(isinstance(x, dict) for x in v),
+    "indices": lambda v: isinstance(v, list) and all(_gltf_index(x) for x in v),
+    "numbers": lambda v: isinstance(v, list) and all(_gltf_number(x) for x in v),
+}
+
+
+def _gltf_kind_fault(value: Any, kind: str) -> bool:
+    """Whether ``value`` is not of the schema's ``kind``."""
+    return not _GLTF_KINDS[kind](value)
+
+
+def _refuse_misshapen_gltf(doc: dict[str, Any], fmt: str) -> None:
+    """Refuse a glTF document whose arrays or fields are not of the schema's kinds, naming the first one: each
+    reader would otherwise fail on it with an error of its own (``len()`` of a boolean, a list as a key)."""
+
+    def fault(path: str, kind: str) -> UnreadableFileError:
+        return UnreadableFileError(
+            f"the {fmt.upper()} file's {path} is not {_GLTF_KIND_WORDS[kind]}, as the glTF 2.0 schema requires; "
+            "the file is corrupt or not glTF 2.0",
+            format=fmt,
+        )
+
+    for name in _GLTF_ARRAYS:
+        if name in doc and _gltf_kind_fault(doc[name], "objects"):
+            raise fault(name, "objects")
+        for i, item in enumerate(doc.get(name) or []):
+            for field, kind in _GLTF_FIELDS.get(name, {}).items():
+                if field in item and _gltf_kind_fault(item[field], kind):
+                    raise fault(f"{name}[{i}].{field}", kind)
+            primitives = item.get("primitives") if name == "meshes" else None
+            for j, primitive in enumerate(primitives if isinstance(primitives, list) else []):
+                for field, kind in _GLTF_PRIMITIVE.items() if isinstance(primitive, dict) else ():
+                    if field in primitive and _gltf_kind_fault(primitive[field], kind):
+                        raise fault(f"{name}[{i}].primitives[{j}].{field}", kind)
+
+
+_GLTF_KIND_WORDS = {
+    "index": "a whole number >= 0",
+    "string": "a string",
+    "boolean": "true or false",
+    "object": "an object",
+    "objects": "an array of objects",
+    "indices": "an array of whole numbers >= 0",
+    "numbers": "an array of numbers",
+}
+
+
 def _check_gltf_document(doc: Any, fmt: str) -> list[str]:
     """Refuse what trimesh's glTF reader would read as other geometry than the file's; notes on what is left out.
 
@@ -481,6 +573,7 @@ def _check_gltf_document(doc: Any, fmt: str) -> list[str]:
             version=version,
         )
 
+    _refuse_misshapen_gltf(doc, fmt)
     required = doc.get("extensionsRequired", [])
     unknown = (
         [str(e) for e in required if isinstance(e, str) and not e.startswith(_HARMLESS_GLTF_EXTENSIONS)]

@@ -88,6 +88,8 @@ def points_from_records(
             if rec.get("mass") is not None:
                 given.append(masses[-1])
             pos = [_number(x) for x in _sequence(rec["position"])]
+        except OverflowError as exc:  # a JSON integer past a double's range (10^400)
+            raise InvalidParameterError(f"point {k} has a number too large for a double (over 1.8e308)", index=k) from exc
         except (KeyError, TypeError, ValueError) as exc:
             raise InvalidParameterError(
                 f"point {k} must be an object with a numeric 'mass' (or an 'element') and a 'position' of 3 numbers", index=k
