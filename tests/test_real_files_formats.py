@@ -420,3 +420,22 @@ def test_a_legacy_vtk_count_no_file_can_hold_is_refused_before_vtk_reads_it(new:
     assert b"POINTS 10141 float" in data
     with pytest.raises(UnreadableFileError, match="gives a count that is no count or more than the file holds"):
         load_body(data.replace(b"POINTS 10141 float", new, 1), filename="sector.vtk")
+
+
+@pytest.mark.parametrize(
+    ("extra", "words"),
+    [
+        ("*NODE\n1, 0, 0, 0\n2, 1, 0, 0\n2, 3, 0, 0\n3, 0, 1, 0\n4, 0, 0, 1\n", "defines node 2 more than once"),
+        ("*NODE\n1, 0, 0, 0\n2, 1, 0, 0\n3, 0, 1, 0\n4, 0, 0, 1\n", "defines element 1 more than once"),
+    ],
+    ids=["node", "element"],
+)
+def test_an_abaqus_deck_that_numbers_two_nodes_or_elements_alike_is_refused(extra: str, words: str) -> None:
+    # meshio kept a repeated node's last coordinates and counted a repeated element twice (volume 7/6 of 1)
+    from inertia.errors import UnreadableFileError
+
+    elements = "*ELEMENT, TYPE=C3D4\n1, 1, 2, 3, 4\n" + ("1, 1, 2, 3, 4\n" if "element" in words else "")
+    with pytest.raises(UnreadableFileError, match=words):
+        load_body((extra + elements).encode(), filename="tet.inp")
+    single = "*NODE\n1, 0, 0, 0\n2, 1, 0, 0\n3, 0, 1, 0\n4, 0, 0, 1\n*ELEMENT, TYPE=C3D4\n1, 1, 2, 3, 4\n"
+    assert load_body(single.encode(), filename="tet.inp").parts  # one of each: read

@@ -925,6 +925,7 @@ def _read_meshio(data: bytes, fmt: str, label: str, filename: str | None, compan
         data = abaqus_flatten(data, companions or {}, label)
         _admit_abaqus_types([data], label)
         data = abaqus_one_node_block(abaqus_plain(data), label)
+        _refuse_renumbered(data, label)
         companions = None
 
     if fmt == "mesh":
@@ -1476,6 +1477,30 @@ def abaqus_one_node_block(data: bytes, label: str) -> bytes:
     first = blocks[0][0]
     dropped = {i for start, end in blocks + reference_points for i in range(start, end)}
     return b"".join([*lines[: first + 1], *rows, *(line for i, line in enumerate(lines) if i > first and i not in dropped)])
+
+
+_ABAQUS_ROW_NUMBER = re.compile(rb"^[ \t]*([0-9]+)[ \t]*,", re.MULTILINE)
+
+
+def _refuse_renumbered(data: bytes, label: str) -> None:
+    """Refuse a deck (plain, its nodes in one block) that gives two nodes or two elements one number: meshio
+    kept the last coordinates of a node and counted a repeated element twice, a body no other reader gives."""
+    keywords = [(m.start(), _abaqus_keyword(m.group()) or b"") for m in _ABAQUS_KEYWORD_LINE.finditer(data)]
+    numbers: dict[bytes, list[bytes]] = {b"NODE": [], b"ELEMENT": []}
+    for (start, keyword), (end, _) in zip(keywords, [*keywords[1:], (len(data), b"")], strict=True):
+        if keyword in numbers:
+            rows = data[start:end].partition(b"\n")[2]
+            numbers[keyword] += _ABAQUS_ROW_NUMBER.findall(rows)
+    for keyword, found in numbers.items():
+        values = np.sort(np.array([int(n) for n in found], dtype=np.int64))
+        repeated = values[1:][values[1:] == values[:-1]]
+        if len(repeated):
+            what = "node" if keyword == b"NODE" else "element"
+            raise UnreadableFileError(
+                f"{label} defines {what} {int(repeated[0])} more than once ({len(repeated)} repeated {what} numbers), "
+                f"so which body it means is ambiguous: number each {what} once",
+                keyword=keyword.decode(),
+            )
 
 
 def _all_zero(rows: list[bytes]) -> bool:
