@@ -1488,8 +1488,9 @@ def _refuse_renumbered(data: bytes, label: str) -> None:
     keywords = [(m.start(), _abaqus_keyword(m.group()) or b"") for m in _ABAQUS_KEYWORD_LINE.finditer(data)]
     numbers: dict[bytes, list[bytes]] = {b"NODE": [], b"ELEMENT": []}
     for (start, keyword), (end, _) in zip(keywords, [*keywords[1:], (len(data), b"")], strict=True):
-        if keyword in numbers:
-            rows = data[start:end].partition(b"\n")[2]
+        head, _, rows = data[start:end].partition(b"\n")
+        # an element block of a type meshio's tables lack may keep continuation lines, which start with a node
+        if keyword == b"NODE" or (keyword == b"ELEMENT" and _abaqus_element_nodes(head) is not None):
             numbers[keyword] += _ABAQUS_ROW_NUMBER.findall(rows)
     for keyword, found in numbers.items():
         values = np.sort(np.array([int(n) for n in found], dtype=np.int64))
