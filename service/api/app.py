@@ -33,7 +33,8 @@ def _configure_logging() -> None:
     logger = logging.getLogger("inertia")
     if logger.level == logging.NOTSET:
         logger.setLevel(logging.INFO)
-    if not logger.handlers and not logging.getLogger().handlers:
+    # the package's own NullHandler (``inertia/__init__``) only keeps a library's logs quiet: not a host's handler
+    if all(isinstance(h, logging.NullHandler) for h in logger.handlers) and not logging.getLogger().handlers:
         handler = logging.StreamHandler(sys.stderr)
         handler.setFormatter(logging.Formatter("%(asctime)s %(levelname)s %(name)s %(message)s"))
         logger.addHandler(handler)
