@@ -235,19 +235,12 @@ def accessor_values(doc: Any, index: Any, buffers: Buffers, fmt: str, normalize:
     raw = buffers.get(view["buffer"])
     dtype = np.dtype(_COMPONENTS[component])
     item = dtype.itemsize * width
-    fields = {"its view's byteStride": view.get("byteStride") or item, "its view's byteOffset": view.get("byteOffset", 0)}
-    fields |= {"its view's byteLength": view.get("byteLength", len(raw)), "byteOffset": acc.get("byteOffset", 0)}
-    for name, value in fields.items():  # glTF 2.0 schema: integers >= 0 (a stride >= 4); 12.0 is 12 to a JSON reader
-        if isinstance(value, float) and value.is_integer():
-            fields[name] = value = int(value)
-        if isinstance(value, bool) or not isinstance(value, int) or value < 0:
-            raise UnreadableFileError(
-                f"the {fmt.upper()} file's accessor {index} has {name} {value!r}, which is no byte count", format=fmt
-            )
-    stride, view_start = fields["its view's byteStride"], fields["its view's byteOffset"]
-    view_length, start = fields["its view's byteLength"], view_start + fields["byteOffset"]
+    # the schema's check (``meshes._refuse_misshapen_gltf``) made these whole numbers >= 0 (12.0 may be a float)
+    stride = int(view.get("byteStride") or item)
+    view_start = int(view.get("byteOffset", 0))
+    start = view_start + int(acc.get("byteOffset", 0))
     end = start + (count - 1) * stride + item if count else start
-    if stride < item or end > len(raw) or end > view_start + view_length:
+    if start < view_start or stride < item or end > len(raw) or end > view_start + int(view.get("byteLength", len(raw))):
         raise UnreadableFileError(f"the {fmt.upper()} file's accessor {index} runs past its buffer", format=fmt)
     values = np.empty((count, width), dtype=np.float64)
     for k in range(width):  # each component: a strided view of the buffer, copied out
